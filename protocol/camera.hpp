@@ -1,0 +1,53 @@
+// Camera math in double precision, shared by the GPU path (which turns it into
+// camera-relative float matrices) and the CPU reference (which traces rays).
+#pragma once
+
+#include "protocol/scene.hpp"
+
+namespace beamcast {
+
+// Orthonormal camera frame in world space.
+struct CameraBasis {
+  Vec3 eye{};
+  Vec3 right{};
+  Vec3 up{};
+  Vec3 forward{};        // viewing direction (camera looks down local -Z)
+  double tan_half_fov = 0.0;  // perspective: tan(fov_y / 2)
+  double half_height = 0.0;   // orthographic: half the view height
+  double aspect = 1.0;        // width / height
+};
+
+// A view ray: p(t) = origin + t * dir, |dir| = 1, visible for t in [t_min, t_max]
+// (t_min on the near plane, t_max on the far plane).
+struct Ray {
+  Vec3 origin{};
+  Vec3 dir{};
+  double t_min = 0.0;
+  double t_max = 0.0;
+};
+
+// Requires a validated camera (see scene_json): target != position, up not
+// parallel to the view direction, unit-length-able quaternion.
+CameraBasis camera_basis(const Camera& cam);
+
+// The ray through the pixel centre (px + 0.5, py + 0.5), px to the right, py
+// upward from the bottom row (OpenGL window convention).
+Ray camera_ray(const Camera& cam, const CameraBasis& basis, int px, int py);
+
+// Same, for a point in normalized device coordinates [-1, 1]^2.
+Ray camera_ray_ndc(const Camera& cam, const CameraBasis& basis, double ndc_x, double ndc_y);
+
+// Small vector helpers used across the project.
+inline Vec3 operator+(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+inline Vec3 operator-(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+inline Vec3 operator*(double s, const Vec3& a) { return {s * a[0], s * a[1], s * a[2]}; }
+inline double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double length(const Vec3& a);
+Vec3 normalize(const Vec3& a);
+// Rotates v by the unit quaternion q = (w, x, y, z).
+Vec3 rotate(const std::array<double, 4>& q, const Vec3& v);
+
+}  // namespace beamcast

@@ -1,0 +1,118 @@
+// Scene model: what a client describes. Pure data, no GL, no sockets.
+// Every later scene element (lights, media, SLIM surfaces, volumes) is a new
+// member here and a new pass in render/, never a change to the existing ones.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "protocol/density.hpp"
+
+namespace beamcast {
+
+using Vec3 = std::array<double, 3>;
+using Color = std::array<double, 3>;  // linear RGB
+
+// A glowing body whose density depends on the normalized distance x = dist/radius
+// to its center (sphere) or to its axis segment (capsule).
+struct SphereBeam {
+  Vec3 center{};
+};
+struct CapsuleBeam {
+  Vec3 p0{};
+  Vec3 p1{};
+  bool cap0 = true;  // hemisphere beyond p0
+  bool cap1 = true;  // hemisphere beyond p1
+};
+
+struct Beam {
+  std::variant<SphereBeam, CapsuleBeam> shape;
+  double radius = 1.0;
+  Color color{1.0, 1.0, 1.0};
+  double intensity = 1.0;
+  Density density;
+};
+
+struct PlaneOccluder {
+  Vec3 point{};
+  Vec3 normal{0.0, 1.0, 0.0};
+};
+struct BoxOccluder {
+  Vec3 center{};
+  Vec3 size{1.0, 1.0, 1.0};             // full edge lengths
+  std::array<double, 4> rotation{1, 0, 0, 0};  // unit quaternion w, x, y, z
+};
+struct SphereOccluder {
+  Vec3 center{};
+  double radius = 1.0;
+};
+// Triangles already transformed to world space (the OBJ is read and
+// transformed when the scene is loaded, so renderers never touch files).
+struct MeshOccluder {
+  std::string file;  // as named in the scene, for messages
+  std::vector<Vec3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+struct Occluder {
+  std::variant<PlaneOccluder, BoxOccluder, SphereOccluder, MeshOccluder> shape;
+  Color albedo{0.8, 0.8, 0.8};
+};
+
+// One directional light for Lambert shading of occluders.
+struct DirectionalLight {
+  Vec3 direction{-0.4, -1.0, -0.3};  // direction the light travels (need not be unit)
+  Color color{1.0, 1.0, 1.0};
+  double intensity = 1.0;
+  double ambient = 0.15;
+};
+
+enum class Projection { kPerspective, kOrthographic };
+
+struct Camera {
+  std::string name;  // optional; frames are named after it
+  Vec3 position{0.0, 0.0, 5.0};
+  // Orientation: camera looks down its local -Z with local +Y up (OpenGL).
+  // Either a look-at target with an up vector, or a quaternion (w, x, y, z).
+  std::optional<Vec3> target;
+  std::optional<std::array<double, 4>> rotation;
+  Vec3 up{0.0, 1.0, 0.0};
+  Projection projection = Projection::kPerspective;
+  double fov_y_deg = 45.0;     // perspective: vertical field of view
+  double ortho_height = 2.0;   // orthographic: world height of the view
+  double near_plane = 0.01;
+  double far_plane = 1000.0;
+  int width = 512;
+  int height = 512;
+};
+
+enum class ToneCurve { kExponential, kReinhard, kClamp };
+
+struct OutputSettings {
+  double exposure = 1.0;
+  ToneCurve tone = ToneCurve::kExponential;
+  int bit_depth = 8;  // 8 or 16 bits per channel PNG
+};
+
+// How the beam line integrals are evaluated; accuracy knobs live here.
+struct RenderSettings {
+  int table_d = 128;  // rows of g(d, s) (d axis)
+  int table_s = 128;  // columns of g(d, s) (s axis)
+  int f_table = 1024;  // samples of the 1D table of f for the near-parallel path
+};
+
+struct Scene {
+  Color background{0.0, 0.0, 0.0};
+  DirectionalLight light;
+  std::vector<Beam> beams;
+  std::vector<Occluder> occluders;
+  std::vector<Camera> cameras;
+  OutputSettings output;
+  RenderSettings render;
+};
+
+}  // namespace beamcast

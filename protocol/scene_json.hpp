@@ -1,0 +1,47 @@
+// JSON <-> scene model. Parsing validates everything a renderer relies on, so a
+// Scene that comes out of here is safe to render; bad input throws ProtocolError
+// with the JSON pointer of the offending field.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "protocol/errors.hpp"
+#include "protocol/scene.hpp"
+
+namespace beamcast {
+
+// Named limits; a scene over any of them is rejected with code "limit_exceeded".
+struct SceneLimits {
+  int max_beams = 100000;
+  int max_occluders = 10000;
+  int max_cameras = 256;
+  int max_width = 8192;
+  int max_height = 8192;
+  std::int64_t max_pixels = 8192LL * 8192LL;  // per camera
+  std::int64_t max_mesh_triangles = 2000000;  // summed over the scene
+  int max_density_samples = 4096;
+  int min_table = 8;
+  int max_table = 1024;
+  double max_abs_coordinate = 1e12;  // any position or size, world units
+};
+
+struct SceneLoadOptions {
+  // Mesh files are read only from below this directory; absolute paths and
+  // ".." components are refused. Empty: meshes are refused.
+  std::filesystem::path assets_dir;
+  SceneLimits limits;
+};
+
+// Throws ProtocolError.
+Scene parse_scene(const nlohmann::json& j, const SceneLoadOptions& opts);
+// One camera object (used by requests that send only camera poses); `path` is
+// the JSON pointer of `j` for error messages.
+Camera parse_camera(const nlohmann::json& j, const std::string& path, const SceneLimits& limits);
+// Reads and parses a scene file; JSON syntax errors become code "bad_json".
+Scene load_scene_file(const std::filesystem::path& file, const SceneLoadOptions& opts);
+
+}  // namespace beamcast
