@@ -1,0 +1,173 @@
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "client/cli/commands.hpp"
+#include "protocol/scene_json.hpp"
+#include "render/image.hpp"
+#include "render/pass_plan.hpp"
+#include "render/reference.hpp"
+#include "render/renderer.hpp"
+
+namespace beamcast::cli {
+namespace {
+
+struct RenderArgs {
+  std::string scene;
+  std::string out = ".";
+  std::string assets;
+  bool reference = false;
+  bool json = false;
+  bool hdr = false;
+  int device = -1;
+  std::string platform = "auto";
+  int threads = 0;
+};
+
+std::string frame_stem(const Camera& cam, std::size_t index) {
+  return cam.name.empty() ? "camera_" + std::to_string(index) : cam.name;
+}
+
+// Writes the linear HDR buffer as raw little-endian float32 RGB (with a one-line
+// JSON header file beside it) for analysis scripts.
+void write_hdr(const std::filesystem::path& file, const HdrImage& hdr) {
+  std::FILE* f = std::fopen(file.c_str(), "wb");
+  if (!f) throw std::runtime_error("cannot write " + file.string());
+  std::fwrite(hdr.rgb.data(), sizeof(float), hdr.rgb.size(), f);
+  std::fclose(f);
+}
+
+int run_render(const RenderArgs& args) {
+  namespace fs = std::filesystem;
+  SceneLoadOptions load;
+  load.assets_dir = args.assets.empty() ? fs::path(args.scene).parent_path() : fs::path(args.assets);
+  if (load.assets_dir.empty()) load.assets_dir = ".";
+  Scene scene;
+  try {
+    scene = load_scene_file(args.scene, load);
+  } catch (const ProtocolError& e) {
+    std::fprintf(stderr, "beamcast: %s: [%s] %s%s%s\n", args.scene.c_str(), e.info().code.c_str(),
+                 e.info().path.c_str(), e.info().path.empty() ? "" : ": ",
+                 e.info().message.c_str());
+    return 2;
+  }
+  fs::create_directories(args.out);
+
+  nlohmann::json summary;
+  summary["scene"] = args.scene;
+  summary["method"] = args.reference ? "reference" : "gpu";
+  summary["passes"] = plan_passes(scene);
+  summary["frames"] = nlohmann::json::array();
+
+  std::unique_ptr<Renderer> renderer;
+  std::vector<FrameResult> frames;
+  if (!args.reference) {
+    RendererOptions ropts;
+    ropts.egl.device_index = args.device;
+    ropts.egl.platform = args.platform;
+    renderer = std::make_unique<Renderer>(ropts);
+    std::fprintf(stderr, "beamcast: renderer: %s\n", renderer->description().c_str());
+    summary["renderer"] = renderer->description();
+    frames = renderer->render(scene, FrameOptions{.read_hdr = args.hdr});
+  } else {
+    summary["renderer"] = "CPU reference (double precision)";
+    ReferenceOptions refopts;
+    refopts.threads = args.threads;
+    for (const Camera& cam : scene.cameras) {
+      const auto t0 = std::chrono::steady_clock::now();
+      FrameResult fr;
+      fr.hdr = render_reference(scene, cam, refopts);
+      fr.image = tone_map(fr.hdr, scene.output);
+      fr.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                       .count();
+      if (!args.hdr) fr.hdr = {};
+      frames.push_back(std::move(fr));
+    }
+  }
+
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const Camera& cam = scene.cameras[i];
+    const FrameResult& fr = frames[i];
+    const fs::path file = fs::path(args.out) / (frame_stem(cam, i) + ".png");
+    write_png(file, fr.image);
+    nlohmann::json jf;
+    jf["camera"] = frame_stem(cam, i);
+    jf["file"] = file.string();
+    jf["width"] = cam.width;
+    jf["height"] = cam.height;
+    jf["wall_ms"] = fr.wall_ms;
+    if (!args.reference) {
+      jf["gpu_ms"] = fr.gpu_ms;
+      jf["readback_ms"] = fr.readback_ms;
+      for (const PassTiming& p : fr.passes) jf["passes"].push_back({{"name", p.name}, {"gpu_ms", p.gpu_ms}});
+    }
+    if (args.hdr) {
+      const fs::path raw = fs::path(args.out) / (frame_stem(cam, i) + ".rgb32f");
+      write_hdr(raw, fr.hdr);
+      jf["hdr_file"] = raw.string();
+    }
+    summary["frames"].push_back(jf);
+    if (!args.json) {
+      std::printf("%-24s %4dx%-4d wall %8.2f ms", file.filename().c_str(), cam.width, cam.height,
+                  fr.wall_ms);
+      if (!args.reference) {
+        std::printf("  gpu %7.3f ms (", fr.gpu_ms);
+        for (std::size_t k = 0; k < fr.passes.size(); ++k) {
+          std::printf("%s%s %.3f", k ? ", " : "", fr.passes[k].name.c_str(), fr.passes[k].gpu_ms);
+        }
+        std::printf(")  read-back %.2f ms", fr.readback_ms);
+      }
+      std::printf("\n");
+    }
+  }
+  if (args.json) std::printf("%s\n", summary.dump(2).c_str());
+  return 0;
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* cmd = app.add_subcommand("render", "Render a scene file to one PNG per camera");
+  cmd->add_option("scene", args->scene, "Scene JSON file (docs/scene-format.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out,-o", args->out, "Output directory (created if missing)");
+  cmd->add_option("--assets", args->assets,
+                  "Directory mesh files are read from (default: the scene file's directory)");
+  cmd->add_flag("--reference", args->reference,
+                "Render with the double-precision CPU reference instead of the GPU");
+  cmd->add_flag("--json", args->json, "Print a machine-readable summary on stdout");
+  cmd->add_flag("--hdr", args->hdr, "Also write the linear HDR buffer (.rgb32f, float32 RGB)");
+  cmd->add_option("--device", args->device,
+                  "EGL device index (default: $BEAMCAST_EGL_DEVICE, else the first that works)");
+  cmd->add_option("--platform", args->platform, "EGL platform: auto, device or surfaceless")
+      ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
+  cmd->add_option("--threads", args->threads, "CPU reference threads (0: all cores)");
+  cmd->callback([args] {
+    const int rc = run_render(*args);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+}
+
+void add_info_command(CLI::App& app) {
+  auto egl = std::make_shared<EglOptions>();
+  CLI::App* cmd = app.add_subcommand("info", "Create the headless GL context and report it");
+  cmd->add_option("--device", egl->device_index, "EGL device index");
+  cmd->add_option("--platform", egl->platform, "EGL platform: auto, device or surfaceless")
+      ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
+  cmd->callback([egl] {
+    RendererOptions opts;
+    opts.egl = *egl;
+    Renderer renderer(opts);
+    std::printf("%s\n", renderer.description().c_str());
+  });
+}
+
+}  // namespace beamcast::cli

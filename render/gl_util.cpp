@@ -1,0 +1,119 @@
+#include "render/gl_util.hpp"
+
+#include <cstdio>
+#include <sstream>
+
+namespace beamcast {
+
+namespace {
+const char* gl_error_name(GLenum e) {
+  switch (e) {
+    case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
+    default: return "unknown GL error";
+  }
+}
+
+std::string numbered(const std::string& src) {
+  std::ostringstream out;
+  std::istringstream in(src);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "%4d | ", n);
+    out << buf << line << '\n';
+  }
+  return out.str();
+}
+
+GLuint compile_stage(std::string_view program, GLenum stage, const char* stage_name,
+                     const std::string& src) {
+  GLuint s = glCreateShader(stage);
+  const char* text = src.c_str();
+  glShaderSource(s, 1, &text, nullptr);
+  glCompileShader(s);
+  GLint ok = GL_FALSE;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    GLint len = 0;
+    glGetShaderiv(s, GL_INFO_LOG_LENGTH, &len);
+    std::string log(static_cast<std::size_t>(len > 0 ? len : 1), '\0');
+    glGetShaderInfoLog(s, len, nullptr, log.data());
+    glDeleteShader(s);
+    throw GlError("compiling " + std::string(stage_name) + " shader of program '" +
+                  std::string(program) + "' failed:\n" + log + "\n" + numbered(src));
+  }
+  return s;
+}
+}  // namespace
+
+void gl_check(const char* call) {
+  GLenum e = glGetError();
+  if (e == GL_NO_ERROR) return;
+  std::string msg = std::string(call) + ": " + gl_error_name(e);
+  while ((e = glGetError()) != GL_NO_ERROR) msg += std::string(", ") + gl_error_name(e);
+  throw GlError(msg);
+}
+
+void delete_texture(GLuint id) { glDeleteTextures(1, &id); }
+void delete_buffer(GLuint id) { glDeleteBuffers(1, &id); }
+void delete_framebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
+void delete_vertex_array(GLuint id) { glDeleteVertexArrays(1, &id); }
+void delete_program(GLuint id) { glDeleteProgram(id); }
+void delete_query(GLuint id) { glDeleteQueries(1, &id); }
+
+GlProgram build_program(std::string_view name, const std::string& vertex_src,
+                        const std::string& fragment_src) {
+  GLuint vs = compile_stage(name, GL_VERTEX_SHADER, "vertex", vertex_src);
+  GLuint fs = 0;
+  try {
+    fs = compile_stage(name, GL_FRAGMENT_SHADER, "fragment", fragment_src);
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  GlProgram prog(glCreateProgram());
+  glAttachShader(prog.get(), vs);
+  glAttachShader(prog.get(), fs);
+  glLinkProgram(prog.get());
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = GL_FALSE;
+  glGetProgramiv(prog.get(), GL_LINK_STATUS, &ok);
+  if (!ok) {
+    GLint len = 0;
+    glGetProgramiv(prog.get(), GL_INFO_LOG_LENGTH, &len);
+    std::string log(static_cast<std::size_t>(len > 0 ? len : 1), '\0');
+    glGetProgramInfoLog(prog.get(), len, nullptr, log.data());
+    throw GlError("linking program '" + std::string(name) + "' failed:\n" + log);
+  }
+  gl_check("build_program");
+  return prog;
+}
+
+GlTexture make_texture_2d(GLenum internal_format, int width, int height) {
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &id);
+  GlTexture tex(id);
+  glTextureStorage2D(id, 1, internal_format, width, height);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  gl_check("glTextureStorage2D");
+  return tex;
+}
+
+void check_framebuffer(GLuint fbo, const char* what) {
+  const GLenum status = glCheckNamedFramebufferStatus(fbo, GL_DRAW_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "0x%x", status);
+    throw GlError(std::string(what) + ": framebuffer incomplete, status " + buf);
+  }
+}
+
+}  // namespace beamcast

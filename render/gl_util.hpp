@@ -1,0 +1,77 @@
+// Small RAII wrappers and checks for GL objects. Every failure names the GL call
+// (or the shader stage, program and log) and throws GlError: a broken GL state
+// is an internal failure of this process, never a client's fault.
+#pragma once
+
+#include <GL/glcorearb.h>
+
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace beamcast {
+
+class GlError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Throws GlError naming `call` if glGetError reports anything.
+void gl_check(const char* call);
+
+// Owns one GL object name; `Deleter` frees it.
+template <void (*Deleter)(GLuint)>
+class GlHandle {
+ public:
+  GlHandle() = default;
+  explicit GlHandle(GLuint id) : id_(id) {}
+  ~GlHandle() { reset(); }
+  GlHandle(GlHandle&& o) noexcept : id_(std::exchange(o.id_, 0)) {}
+  GlHandle& operator=(GlHandle&& o) noexcept {
+    if (this != &o) {
+      reset();
+      id_ = std::exchange(o.id_, 0);
+    }
+    return *this;
+  }
+  GlHandle(const GlHandle&) = delete;
+  GlHandle& operator=(const GlHandle&) = delete;
+  GLuint get() const { return id_; }
+  explicit operator bool() const { return id_ != 0; }
+  void reset() {
+    if (id_) Deleter(id_);
+    id_ = 0;
+  }
+
+ private:
+  GLuint id_ = 0;
+};
+
+void delete_texture(GLuint id);
+void delete_buffer(GLuint id);
+void delete_framebuffer(GLuint id);
+void delete_vertex_array(GLuint id);
+void delete_program(GLuint id);
+void delete_query(GLuint id);
+
+using GlTexture = GlHandle<delete_texture>;
+using GlBuffer = GlHandle<delete_buffer>;
+using GlFramebuffer = GlHandle<delete_framebuffer>;
+using GlVertexArray = GlHandle<delete_vertex_array>;
+using GlProgram = GlHandle<delete_program>;
+using GlQuery = GlHandle<delete_query>;
+
+// Compiles and links a program from assembled stage sources. On failure throws
+// GlError with the program name, the stage, the info log and numbered source.
+GlProgram build_program(std::string_view name, const std::string& vertex_src,
+                        const std::string& fragment_src);
+
+// Creates an immutable 2D texture with the given internal format.
+GlTexture make_texture_2d(GLenum internal_format, int width, int height);
+
+// Checks the bound draw framebuffer; throws GlError naming its status.
+void check_framebuffer(GLuint fbo, const char* what);
+
+}  // namespace beamcast

@@ -1,0 +1,61 @@
+// The GPU renderer: owns one headless GL context and turns a validated Scene
+// into frames. The passes that run are chosen from the scene's content.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "protocol/scene.hpp"
+#include "render/egl_context.hpp"
+#include "render/image.hpp"
+#include "render/pass_plan.hpp"
+
+namespace beamcast {
+
+struct RendererOptions {
+  EglOptions egl;
+  std::size_t table_cache_entries = 64;  // CPU-side line-integral tables kept
+};
+
+struct PassTiming {
+  std::string name;
+  double gpu_ms = 0.0;  // GL timestamp queries around the pass
+};
+
+struct FrameOptions {
+  bool read_hdr = false;  // also read back the linear HDR buffer
+};
+
+struct FrameResult {
+  Image image;            // tone-mapped, rows top-down
+  HdrImage hdr;           // only with FrameOptions::read_hdr
+  std::vector<PassTiming> passes;
+  double gpu_ms = 0.0;       // whole frame on the GPU
+  double readback_ms = 0.0;  // glReadPixels, wall clock
+  double wall_ms = 0.0;      // the whole call for this camera, wall clock
+};
+
+class Renderer {
+ public:
+  // Creates the EGL context (throws std::runtime_error if none can be had).
+  explicit Renderer(const RendererOptions& opts = {});
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  const std::string& description() const;
+
+  // Renders every camera of the scene; scene resources (tables, occluder
+  // geometry) are uploaded once and shared by the cameras.
+  std::vector<FrameResult> render(const Scene& scene, const FrameOptions& opts = {});
+  // Renders the given cameras (which need not be the scene's own).
+  std::vector<FrameResult> render(const Scene& scene, const std::vector<Camera>& cameras,
+                                  const FrameOptions& opts = {});
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace beamcast

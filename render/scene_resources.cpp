@@ -1,0 +1,328 @@
+#include "render/scene_resources.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace beamcast {
+
+std::shared_ptr<const LineIntegralTable> TableCache::get(const Density& density, int nd, int ns,
+                                                         int nf) {
+  const std::string key = density.key() + "|" + std::to_string(nd) + "x" + std::to_string(ns) +
+                          "|" + std::to_string(nf);
+  for (auto it = entries_.begin(); it != entries_.end(); ++it) {
+    if (it->first == key) {
+      entries_.splice(entries_.begin(), entries_, it);  // most recently used first
+      return entries_.front().second;
+    }
+  }
+  auto table = std::make_shared<const LineIntegralTable>(build_table(density, nd, ns, nf));
+  entries_.emplace_front(key, table);
+  while (entries_.size() > max_entries_) entries_.pop_back();
+  return table;
+}
+
+namespace {
+
+struct alignas(16) CameraBlock {
+  float view_proj[16];  // column-major
+  float right[4];
+  float up[4];
+  float forward[4];
+  float viewport[4];
+  float light_dir[4];
+  float light_color[4];
+  float mesh_offset[4];
+};
+
+struct alignas(16) BeamData {
+  float p0_radius[4];
+  float axis_length[4];
+  float color_layer[4];
+  float caps_kind[4];
+};
+
+struct alignas(16) AnalyticData {
+  float a[4];
+  float b[4];
+  float albedo[4];
+};
+
+struct Vertex {
+  float position[3];
+  float normal[3];
+  float albedo[3];
+};
+
+void set3(float* dst, const Vec3& v, float w) {
+  dst[0] = static_cast<float>(v[0]);
+  dst[1] = static_cast<float>(v[1]);
+  dst[2] = static_cast<float>(v[2]);
+  dst[3] = w;
+}
+
+// Camera-relative view-projection with reversed Z (near -> 1, far -> 0), in
+// double, column-major. View rows are right, up, -forward (no translation: the
+// eye is the origin of camera-relative space).
+void view_projection(const Camera& cam, const CameraBasis& b, float out[16]) {
+  double p[4][4] = {};  // p[row][col] of projection
+  const double n = cam.near_plane, f = cam.far_plane;
+  if (cam.projection == Projection::kPerspective) {
+    p[0][0] = 1.0 / (b.tan_half_fov * b.aspect);
+    p[1][1] = 1.0 / b.tan_half_fov;
+    p[2][2] = n / (f - n);
+    p[2][3] = n * f / (f - n);
+    p[3][2] = -1.0;
+  } else {
+    p[0][0] = 1.0 / (b.half_height * b.aspect);
+    p[1][1] = 1.0 / b.half_height;
+    p[2][2] = 1.0 / (f - n);
+    p[2][3] = f / (f - n);
+    p[3][3] = 1.0;
+  }
+  const Vec3 rows[3] = {b.right, b.up, -1.0 * b.forward};
+  double view[4][4] = {};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) view[r][c] = rows[r][c];
+  view[3][3] = 1.0;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      double s = 0.0;
+      for (int k = 0; k < 4; ++k) s += p[r][k] * view[k][c];
+      out[c * 4 + r] = static_cast<float>(s);
+    }
+  }
+}
+
+// Appends the 12 triangles of a box occluder in world space.
+void box_triangles(const BoxOccluder& box, const Color& albedo, const Vec3& anchor,
+                   std::vector<Vertex>* out) {
+  static const int kIndex[36] = {4, 6, 2, 4, 2, 0, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
+                                 6, 7, 3, 6, 3, 2, 2, 3, 1, 2, 1, 0, 4, 5, 7, 4, 7, 6};
+  Vec3 corners[8];
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 local{(i & 1 ? 0.5 : -0.5) * box.size[0], (i & 2 ? 0.5 : -0.5) * box.size[1],
+                     (i & 4 ? 0.5 : -0.5) * box.size[2]};
+    corners[i] = box.center + rotate(box.rotation, local) - anchor;
+  }
+  for (int t = 0; t < 12; ++t) {
+    const Vec3& a = corners[kIndex[3 * t]];
+    const Vec3& b = corners[kIndex[3 * t + 1]];
+    const Vec3& c = corners[kIndex[3 * t + 2]];
+    const Vec3 n = normalize(cross(b - a, c - a));
+    for (const Vec3* p : {&a, &b, &c}) {
+      Vertex v;
+      for (int k = 0; k < 3; ++k) {
+        v.position[k] = static_cast<float>((*p)[k]);
+        v.normal[k] = static_cast<float>(n[k]);
+        v.albedo[k] = static_cast<float>(albedo[k]);
+      }
+      out->push_back(v);
+    }
+  }
+}
+
+void mesh_triangles(const MeshOccluder& mesh, const Color& albedo, const Vec3& anchor,
+                    std::vector<Vertex>* out) {
+  for (const auto& tri : mesh.triangles) {
+    const Vec3 a = mesh.vertices[tri[0]] - anchor;
+    const Vec3 b = mesh.vertices[tri[1]] - anchor;
+    const Vec3 c = mesh.vertices[tri[2]] - anchor;
+    const Vec3 cr = cross(b - a, c - a);
+    const double len = length(cr);
+    if (!(len > 0.0)) continue;  // degenerate triangle: covers no pixel
+    const Vec3 n = (1.0 / len) * cr;
+    for (const Vec3* p : {&a, &b, &c}) {
+      Vertex v;
+      for (int k = 0; k < 3; ++k) {
+        v.position[k] = static_cast<float>((*p)[k]);
+        v.normal[k] = static_cast<float>(n[k]);
+        v.albedo[k] = static_cast<float>(albedo[k]);
+      }
+      out->push_back(v);
+    }
+  }
+}
+
+}  // namespace
+
+SceneResources::SceneResources(const Scene& scene, TableCache& tables) : scene_(scene) {
+  nd_ = scene.render.table_d;
+  ns_ = scene.render.table_s;
+  nf_ = scene.render.f_table;
+
+  // One table layer per distinct density.
+  std::vector<std::shared_ptr<const LineIntegralTable>> layers;
+  std::vector<std::string> keys;
+  for (const Beam& beam : scene.beams) {
+    const std::string key = beam.density.key();
+    auto it = std::find(keys.begin(), keys.end(), key);
+    if (it == keys.end()) {
+      keys.push_back(key);
+      layers.push_back(tables.get(beam.density, nd_, ns_, nf_));
+      it = keys.end() - 1;
+    }
+    beam_layers_.push_back(static_cast<float>(it - keys.begin()));
+  }
+  if (!layers.empty()) {
+    const auto count = static_cast<GLsizei>(layers.size());
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+    g_tex_ = GlTexture(id);
+    glTextureStorage3D(id, 1, GL_R32F, ns_, nd_, count);
+    glCreateTextures(GL_TEXTURE_1D_ARRAY, 1, &id);
+    f_tex_ = GlTexture(id);
+    glTextureStorage2D(id, 1, GL_R32F, nf_, count);
+    for (GLsizei i = 0; i < count; ++i) {
+      glTextureSubImage3D(g_tex_.get(), 0, 0, 0, i, ns_, nd_, 1, GL_RED, GL_FLOAT,
+                          layers[i]->g.data());
+      glTextureSubImage2D(f_tex_.get(), 0, 0, i, nf_, 1, GL_RED, GL_FLOAT, layers[i]->f.data());
+    }
+    for (GLuint tex : {g_tex_.get(), f_tex_.get()}) {
+      glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    gl_check("upload line-integral tables");
+    glCreateBuffers(1, &id);
+    beam_ssbo_ = GlBuffer(id);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(sizeof(BeamData) * scene.beams.size()),
+                         nullptr, GL_DYNAMIC_STORAGE_BIT);
+  }
+
+  // Rasterized occluders go into one vertex buffer, stored relative to an
+  // anchor (their bounding-box centre) so float precision follows the geometry.
+  std::vector<Vertex> verts;
+  double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+                  std::numeric_limits<double>::max()};
+  double hi[3] = {-lo[0], -lo[1], -lo[2]};
+  auto grow = [&](const Vec3& p) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  };
+  bool any_raster = false;
+  for (const Occluder& occ : scene.occluders) {
+    if (const auto* box = std::get_if<BoxOccluder>(&occ.shape)) {
+      grow(box->center);
+      any_raster = true;
+    } else if (const auto* mesh = std::get_if<MeshOccluder>(&occ.shape)) {
+      for (const Vec3& v : mesh->vertices) grow(v);
+      any_raster = true;
+    } else {
+      analytic_.push_back(&occ);
+    }
+  }
+  if (any_raster) {
+    for (int k = 0; k < 3; ++k) mesh_anchor_[k] = 0.5 * (lo[k] + hi[k]);
+    for (const Occluder& occ : scene.occluders) {
+      if (const auto* box = std::get_if<BoxOccluder>(&occ.shape)) {
+        box_triangles(*box, occ.albedo, mesh_anchor_, &verts);
+      } else if (const auto* mesh = std::get_if<MeshOccluder>(&occ.shape)) {
+        mesh_triangles(*mesh, occ.albedo, mesh_anchor_, &verts);
+      }
+    }
+  }
+  if (!verts.empty()) {
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    tri_vbo_ = GlBuffer(id);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(verts.size() * sizeof(Vertex)),
+                         verts.data(), 0);
+    glCreateVertexArrays(1, &id);
+    tri_vao_ = GlVertexArray(id);
+    glVertexArrayVertexBuffer(id, 0, tri_vbo_.get(), 0, sizeof(Vertex));
+    for (GLuint a = 0; a < 3; ++a) {
+      glEnableVertexArrayAttrib(id, a);
+      glVertexArrayAttribFormat(id, a, 3, GL_FLOAT, GL_FALSE,
+                                static_cast<GLuint>(a * 3 * sizeof(float)));
+      glVertexArrayAttribBinding(id, a, 0);
+    }
+    tri_vertices_ = static_cast<GLsizei>(verts.size());
+    gl_check("upload occluder triangles");
+  }
+  if (!analytic_.empty()) {
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    analytic_ssbo_ = GlBuffer(id);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(sizeof(AnalyticData) * analytic_.size()),
+                         nullptr, GL_DYNAMIC_STORAGE_BIT);
+  }
+  GLuint id = 0;
+  glCreateBuffers(1, &id);
+  camera_ubo_ = GlBuffer(id);
+  glNamedBufferStorage(id, sizeof(CameraBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  gl_check("create scene buffers");
+}
+
+void SceneResources::bind_camera(const Camera& cam, const CameraBasis& basis) {
+  const Vec3& eye = basis.eye;
+  CameraBlock cb{};
+  view_projection(cam, basis, cb.view_proj);
+  const bool ortho = cam.projection == Projection::kOrthographic;
+  set3(cb.right, basis.right,
+       static_cast<float>(ortho ? basis.half_height : basis.tan_half_fov));
+  set3(cb.up, basis.up, static_cast<float>(basis.aspect));
+  set3(cb.forward, basis.forward, ortho ? 1.0f : 0.0f);
+  cb.viewport[0] = static_cast<float>(cam.width);
+  cb.viewport[1] = static_cast<float>(cam.height);
+  cb.viewport[2] = static_cast<float>(cam.near_plane);
+  cb.viewport[3] = static_cast<float>(cam.far_plane);
+  const DirectionalLight& light = scene_.light;
+  set3(cb.light_dir, normalize(-1.0 * light.direction), static_cast<float>(light.ambient));
+  set3(cb.light_color, light.color, static_cast<float>(light.intensity));
+  set3(cb.mesh_offset, mesh_anchor_ - eye, 0.0f);
+  glNamedBufferSubData(camera_ubo_.get(), 0, sizeof cb, &cb);
+
+  if (beam_ssbo_) {
+    std::vector<BeamData> data(scene_.beams.size());
+    for (std::size_t i = 0; i < scene_.beams.size(); ++i) {
+      const Beam& beam = scene_.beams[i];
+      BeamData& d = data[i];
+      const auto r = static_cast<float>(beam.radius);
+      const Color c = (beam.intensity) * beam.color;
+      set3(d.color_layer, c, beam_layers_[i]);
+      if (const auto* s = std::get_if<SphereBeam>(&beam.shape)) {
+        set3(d.p0_radius, s->center - eye, r);
+        set3(d.axis_length, {0.0, 0.0, 1.0}, 0.0f);
+        set3(d.caps_kind, {0.0, 0.0, 0.0}, 0.0f);
+      } else {
+        const auto& cap = std::get<CapsuleBeam>(beam.shape);
+        const Vec3 axis = cap.p1 - cap.p0;
+        const double len = length(axis);
+        set3(d.p0_radius, cap.p0 - eye, r);
+        set3(d.axis_length, (1.0 / len) * axis, static_cast<float>(len));
+        set3(d.caps_kind, {cap.cap0 ? 1.0 : 0.0, cap.cap1 ? 1.0 : 0.0, 1.0}, 0.0f);
+      }
+    }
+    glNamedBufferSubData(beam_ssbo_.get(), 0,
+                         static_cast<GLsizeiptr>(data.size() * sizeof(BeamData)), data.data());
+  }
+  if (analytic_ssbo_) {
+    std::vector<AnalyticData> data(analytic_.size());
+    for (std::size_t i = 0; i < analytic_.size(); ++i) {
+      const Occluder& occ = *analytic_[i];
+      AnalyticData& d = data[i];
+      set3(d.albedo, occ.albedo, 1.0f);
+      if (const auto* plane = std::get_if<PlaneOccluder>(&occ.shape)) {
+        // The plane's point nearest the eye, computed in double, keeps the
+        // plane exact near the camera whatever point the scene gave.
+        const Vec3 n = normalize(plane->normal);
+        set3(d.a, dot(plane->point - eye, n) * n, 0.0f);
+        set3(d.b, n, 0.0f);
+      } else {
+        const auto& sphere = std::get<SphereOccluder>(occ.shape);
+        set3(d.a, sphere.center - eye, static_cast<float>(sphere.radius));
+        set3(d.b, {0.0, 0.0, 0.0}, 1.0f);
+      }
+    }
+    glNamedBufferSubData(analytic_ssbo_.get(), 0,
+                         static_cast<GLsizeiptr>(data.size() * sizeof(AnalyticData)),
+                         data.data());
+  }
+  gl_check("bind_camera");
+}
+
+}  // namespace beamcast

@@ -1,0 +1,63 @@
+// GPU resources of one scene: line-integral tables (one texture layer per
+// distinct density), beam instance data and occluder geometry. Built once per
+// scene and shared by all its cameras; per-camera data (camera-relative
+// positions, the camera block) is refreshed by `bind_camera`.
+#pragma once
+
+#include <cstddef>
+#include <list>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "protocol/camera.hpp"
+#include "protocol/scene.hpp"
+#include "render/gl_util.hpp"
+#include "render/lut.hpp"
+
+namespace beamcast {
+
+// CPU tables by (density, size), least recently used evicted first.
+class TableCache {
+ public:
+  explicit TableCache(std::size_t max_entries) : max_entries_(max_entries) {}
+  std::shared_ptr<const LineIntegralTable> get(const Density& density, int nd, int ns, int nf);
+
+ private:
+  std::size_t max_entries_;
+  std::list<std::pair<std::string, std::shared_ptr<const LineIntegralTable>>> entries_;
+};
+
+class SceneResources {
+ public:
+  SceneResources(const Scene& scene, TableCache& tables);
+  // Uploads the camera block and camera-relative beam and occluder data.
+  void bind_camera(const Camera& cam, const CameraBasis& basis);
+
+  int table_d() const { return nd_; }
+  int table_s() const { return ns_; }
+  int table_f() const { return nf_; }
+  GLuint g_texture() const { return g_tex_.get(); }
+  GLuint f_texture() const { return f_tex_.get(); }
+  GLuint beam_buffer() const { return beam_ssbo_.get(); }
+  GLsizei beam_count() const { return static_cast<GLsizei>(beam_layers_.size()); }
+  GLuint camera_buffer() const { return camera_ubo_.get(); }
+  GLuint triangle_vao() const { return tri_vao_.get(); }
+  GLsizei triangle_vertex_count() const { return tri_vertices_; }
+  GLuint analytic_buffer() const { return analytic_ssbo_.get(); }
+  GLsizei analytic_count() const { return static_cast<GLsizei>(analytic_.size()); }
+
+ private:
+  const Scene& scene_;
+  int nd_ = 0, ns_ = 0, nf_ = 0;
+  std::vector<float> beam_layers_;  // table layer of each beam
+  GlTexture g_tex_, f_tex_;
+  GlBuffer beam_ssbo_, camera_ubo_, analytic_ssbo_, tri_vbo_;
+  GlVertexArray tri_vao_;
+  GLsizei tri_vertices_ = 0;
+  Vec3 mesh_anchor_{};
+  std::vector<const Occluder*> analytic_;  // planes and spheres
+};
+
+}  // namespace beamcast

@@ -1,0 +1,52 @@
+// Planes and spheres, ray-traced per pixel in one full-screen draw; the nearest
+// hit writes colour, view depth and window depth, so the depth test merges it
+// with the rasterized occluders.
+
+struct AnalyticOccluder {
+  vec4 a;       // plane: point; sphere: centre (camera-relative); w: sphere radius
+  vec4 b;       // plane: unit normal; w: 0 plane, 1 sphere
+  vec4 albedo;  // rgb
+};
+layout(std430, binding = 2) readonly buffer Analytic { AnalyticOccluder occ[]; };
+uniform int u_count;
+
+layout(location = 0) out vec4 out_color;
+layout(location = 1) out float out_view_depth;
+
+void main() {
+  ViewRay ray = view_ray(gl_FragCoord.xy);
+  float best = ray.t_max;
+  int hit = -1;
+  vec3 normal = vec3(0.0);
+  for (int i = 0; i < u_count; ++i) {
+    AnalyticOccluder o = occ[i];
+    if (o.b.w < 0.5) {
+      float denom = dot(o.b.xyz, ray.dir);
+      if (denom == 0.0) continue;
+      float t = dot(o.a.xyz - ray.origin, o.b.xyz) / denom;
+      if (t >= ray.t_min && t < best) {
+        best = t;
+        hit = i;
+        normal = o.b.xyz;
+      }
+    } else {
+      vec3 to_c = o.a.xyz - ray.origin;
+      float tc = dot(to_c, ray.dir);
+      vec3 perp = to_c - tc * ray.dir;
+      float h2 = o.a.w * o.a.w - dot(perp, perp);
+      if (h2 < 0.0) continue;
+      float h = sqrt(h2);
+      float t = tc - h >= ray.t_min ? tc - h : tc + h;
+      if (t >= ray.t_min && t < best) {
+        best = t;
+        hit = i;
+        normal = normalize(ray.origin + t * ray.dir - o.a.xyz);
+      }
+    }
+  }
+  if (hit < 0) discard;
+  out_color = vec4(lambert(occ[hit].albedo.rgb, normal, ray.dir), 0.0);
+  float z = best * ray.cos_axis;
+  out_view_depth = z;
+  gl_FragDepth = window_depth(z);
+}

@@ -1,0 +1,42 @@
+// Proxy geometry of one beam per instance: the back faces of the box around it.
+// Drawn with front faces culled and depth clamping on, every pixel whose ray
+// meets the box gets exactly one fragment, also when the camera is inside the
+// box and when the box reaches past the near or far plane.
+
+struct BeamData {
+  vec4 p0_radius;    // xyz: centre (sphere) or p0 (capsule), camera-relative; w: radius
+  vec4 axis_length;  // xyz: unit axis p0 -> p1; w: length (0 for a sphere)
+  vec4 color_layer;  // rgb: color * intensity; w: table layer of the density
+  vec4 caps_kind;    // x: cap at p0, y: cap at p1 (1 or 0); z: 0 sphere, 1 capsule
+};
+layout(std430, binding = 1) readonly buffer Beams { BeamData beams[]; };
+
+flat out int v_beam;
+
+// Cube corners (bit 0: x, bit 1: y, bit 2: z) of 12 triangles, counter-clockwise
+// seen from outside.
+const int kCubeIndex[36] = int[36](4, 6, 2, 4, 2, 0, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
+                                   6, 7, 3, 6, 3, 2, 2, 3, 1, 2, 1, 0, 4, 5, 7, 4, 7, 6);
+
+void main() {
+  BeamData b = beams[gl_InstanceID];
+  int ci = kCubeIndex[gl_VertexID];
+  vec3 c = vec3((ci & 1) != 0 ? 1.0 : -1.0, (ci & 2) != 0 ? 1.0 : -1.0, (ci & 4) != 0 ? 1.0 : -1.0);
+  float r = b.p0_radius.w;
+  vec3 pos;
+  if (b.caps_kind.z < 0.5) {
+    pos = b.p0_radius.xyz + r * c;
+  } else {
+    // Right-handed frame (u1, u2, w) keeps the cube's winding.
+    vec3 w = b.axis_length.xyz;
+    vec3 helper = abs(w.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+    vec3 u1 = normalize(cross(helper, w));
+    vec3 u2 = cross(w, u1);
+    float lo = b.caps_kind.x > 0.5 ? -r : 0.0;
+    float hi = b.axis_length.w + (b.caps_kind.y > 0.5 ? r : 0.0);
+    float along = mix(lo, hi, 0.5 * (c.z + 1.0));
+    pos = b.p0_radius.xyz + along * w + r * (c.x * u1 + c.y * u2);
+  }
+  v_beam = gl_InstanceID;
+  gl_Position = cam.view_proj * vec4(pos, 1.0);
+}
