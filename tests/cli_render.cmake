@@ -1,0 +1,27 @@
+# Runs `beamcast render` on the GPU and with --reference and checks that each
+# writes its PNG and a JSON summary naming the passes that ran.
+file(REMOVE_RECURSE ${OUT})
+foreach(mode gpu reference)
+  set(args render ${SCENE} --out ${OUT}/${mode} --json)
+  if(mode STREQUAL "reference")
+    list(APPEND args --reference)
+  endif()
+  execute_process(COMMAND ${BEAMCAST} ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "beamcast ${args} exited ${rc}")
+  endif()
+  if(NOT EXISTS ${OUT}/${mode}/view.png)
+    message(FATAL_ERROR "beamcast ${args} wrote no ${OUT}/${mode}/view.png")
+  endif()
+  string(JSON first_pass GET "${out}" passes 0)
+  if(NOT first_pass STREQUAL "beams")
+    message(FATAL_ERROR "a beam-only scene should run 'beams' first, summary says ${first_pass}")
+  endif()
+endforeach()
+# A bad scene fails with a message naming the JSON path.
+file(WRITE ${OUT}/bad.json "{\"beams\":[{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":-1}],\"cameras\":[{}]}")
+execute_process(COMMAND ${BEAMCAST} render ${OUT}/bad.json --out ${OUT}/bad
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT err MATCHES "/beams/0/radius")
+  message(FATAL_ERROR "bad scene: expected failure naming /beams/0/radius, got rc=${rc}: ${err}")
+endif()
