@@ -1,0 +1,452 @@
+#include "render/reference.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include "protocol/camera.hpp"
+#include "render/quadrature.hpp"
+
+namespace beamcast {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ---------------------------------------------------------------------------
+// Beams
+//
+// All beam geometry is expressed relative to the centre C of the beam's
+// bounding sphere and in units of the radius r, and the ray parameter is
+// sigma = (t - t_ref) / r with t_ref the ray's closest approach to C. The
+// integral (1/r) * int f(dist/r) dt is then int f(rho(sigma)) dsigma with
+// rho = dist / r, all quantities of order one near the beam: exactly invariant
+// under scaling the scene, and free of cancellation for far-away cameras.
+
+struct PreparedBeam {
+  Vec3 c{};               // bounding-sphere centre (world)
+  double r = 1.0;
+  double inv_r = 1.0;
+  double bound2 = 1.0;    // squared bounding radius, in units of r
+  bool capsule = false;
+  Vec3 w{0.0, 0.0, 1.0};  // unit axis (capsule)
+  double half_len = 0.0;  // L / (2 r)
+  bool cap0 = true;
+  bool cap1 = true;
+  const Density* density = nullptr;
+  std::vector<double> xb;  // density breakpoints strictly inside (0, 1)
+  double fmax = 1.0;
+};
+
+PreparedBeam prepare_beam(const Beam& beam) {
+  PreparedBeam pb;
+  pb.r = beam.radius;
+  pb.inv_r = 1.0 / beam.radius;
+  pb.density = &beam.density;
+  for (double x : beam.density.breakpoints()) {
+    if (x > 0.0 && x < 1.0) pb.xb.push_back(x);
+  }
+  pb.fmax = std::max(1e-300, std::abs(beam.density.max_value()));
+  if (const auto* s = std::get_if<SphereBeam>(&beam.shape)) {
+    pb.c = s->center;
+    pb.bound2 = 1.0;
+  } else {
+    const auto& cap = std::get<CapsuleBeam>(beam.shape);
+    pb.capsule = true;
+    pb.cap0 = cap.cap0;
+    pb.cap1 = cap.cap1;
+    const Vec3 axis = cap.p1 - cap.p0;
+    const double len = length(axis);
+    pb.c = 0.5 * (cap.p0 + cap.p1);
+    if (len > 0.0) pb.w = (1.0 / len) * axis;  // else: degenerate, any axis will do
+    pb.half_len = 0.5 * len * pb.inv_r;
+    pb.bound2 = (pb.half_len + 1.0) * (pb.half_len + 1.0);
+  }
+  return pb;
+}
+
+// Small sorted list of integration points; on the stack unless a tabulated
+// density brings thousands of breakpoints.
+class Points {
+ public:
+  explicit Points(std::size_t cap) {
+    if (cap > kStack) {
+      heap_.resize(cap);
+      p_ = heap_.data();
+    }
+  }
+  void push(double x) { p_[n_++] = x; }
+  // Keeps x only if it lies strictly inside (lo, hi).
+  void push_inside(double x, double lo, double hi) {
+    if (x > lo && x < hi) p_[n_++] = x;
+  }
+  void sort() { std::sort(p_, p_ + n_); }
+  const double* data() const { return p_; }
+  std::size_t size() const { return n_; }
+
+ private:
+  static constexpr std::size_t kStack = 64;
+  double buf_[kStack];
+  std::vector<double> heap_;
+  double* p_ = buf_;
+  std::size_t n_ = 0;
+};
+
+constexpr int kMaxGrading = 16;  // 4^14 > 0.25 / 1e-8: enough levels
+
+// Integral of f(sqrt(d2 + k2 * (sigma - sc)^2)) over [lo, hi], split at the
+// closest approach sc and where the distance crosses each density breakpoint.
+// k2 = 1 for a sphere, sin^2(theta) for the cylinder; inv_k = 1 / sqrt(k2).
+double integrate_radial(const PreparedBeam& pb, double d2, double k2, double inv_k, double sc,
+                        double lo, double hi, double rel_tol) {
+  if (!(hi > lo)) return 0.0;
+  const double d = std::sqrt(d2);
+  Points pts(pb.xb.size() * 2 + 3 + 2 * kMaxGrading);
+  pts.push(lo);
+  pts.push_inside(sc, lo, hi);
+  // Graded points |tau| = d 4^k (tau = k (sigma - sc)): for d << 1 the distance
+  // bends on the scale d near the closest approach, which one 15-point rule
+  // over the whole chord can miss without its error estimate noticing. Below
+  // d = 1e-8 that bend is worth < d^2 ln(1/d) ~ 1e-15 of the integral.
+  const double chord = std::sqrt((1.0 - d) * (1.0 + d));
+  int graded = 0;
+  for (double g = std::max(d, 1e-8); d > 0.0 && g < 0.25 * chord && graded < kMaxGrading;
+       g *= 4.0, ++graded) {
+    pts.push_inside(sc - g * inv_k, lo, hi);
+    pts.push_inside(sc + g * inv_k, lo, hi);
+  }
+  for (double x : pb.xb) {
+    if (x > d) {
+      const double h = std::sqrt((x - d) * (x + d)) * inv_k;  // no cancellation near x = d
+      pts.push_inside(sc - h, lo, hi);
+      pts.push_inside(sc + h, lo, hi);
+    }
+  }
+  pts.push(hi);
+  pts.sort();
+  const Density& f = *pb.density;
+  auto integrand = [&f, d2, k2, sc](double s) {
+    const double ds = s - sc;
+    return f(std::sqrt(d2 + k2 * ds * ds));
+  };
+  quad::Options opt;
+  opt.rel_tol = rel_tol;
+  // Absolute floor, relative to the density's scale: an energy 1e4 times below
+  // the requested relative accuracy of a unit-size integral is not refined.
+  opt.abs_tol = 1e-4 * rel_tol * pb.fmax;
+  return quad::integrate_pieces(integrand, pts.data(), pts.size(), opt).value;
+}
+
+// Region where the distance is measured to a point `a` (relative, units of r):
+// a sphere beam or one end cap of a capsule, restricted to sigma in [lo, hi].
+double integrate_point(const PreparedBeam& pb, const Vec3& q, const Vec3& v, const Vec3& a,
+                       double lo, double hi, double rel_tol) {
+  if (!(hi > lo)) return 0.0;
+  const Vec3 e = a - q;
+  const double sc = dot(e, v);  // closest approach (dot product, never sqrt(|e|^2 - d^2))
+  const Vec3 perp = e - sc * v;
+  const double d2 = dot(perp, perp);
+  if (!(d2 < 1.0)) return 0.0;
+  const double c = std::sqrt((1.0 - std::sqrt(d2)) * (1.0 + std::sqrt(d2)));
+  return integrate_radial(pb, d2, 1.0, 1.0, sc, std::max(lo, sc - c), std::min(hi, sc + c),
+                          rel_tol);
+}
+
+// Region where the distance is measured to the axis line through `a0` with unit
+// direction w, restricted to sigma in [lo, hi].
+double integrate_line(const PreparedBeam& pb, const Vec3& q, const Vec3& v, const Vec3& a0,
+                      double lo, double hi, double rel_tol) {
+  if (!(hi > lo)) return 0.0;
+  const Vec3& w = pb.w;
+  const Vec3 m = q - a0;
+  const Vec3 mp = m - dot(m, w) * w;        // ray point at sigma = 0, radial part
+  const Vec3 vp = v - dot(v, w) * w;        // direction, radial part; |vp| = sin(theta)
+  const double k2 = dot(vp, vp);
+  // Rays (almost) exactly parallel to the axis: the radial distance is constant
+  // to within rounding over the whole interval; no division by sin(theta).
+  const double span = std::max(std::abs(lo), std::abs(hi));
+  if (k2 * span * span <= 1e-32 * std::max(dot(mp, mp), 1e-300) || k2 < 1e-200) {
+    const double rho2 = dot(mp, mp);
+    if (!(rho2 < 1.0)) return 0.0;
+    return (hi - lo) * (*pb.density)(std::sqrt(rho2));
+  }
+  const double sc = -dot(mp, vp) / k2;  // closest approach to the axis line
+  const Vec3 perp = mp + sc * vp;
+  const double d2 = dot(perp, perp);
+  if (!(d2 < 1.0)) return 0.0;
+  const double inv_k = 1.0 / std::sqrt(k2);
+  const double d = std::sqrt(d2);
+  const double c = std::sqrt((1.0 - d) * (1.0 + d)) * inv_k;
+  return integrate_radial(pb, d2, k2, inv_k, sc, std::max(lo, sc - c), std::min(hi, sc + c),
+                          rel_tol);
+}
+
+// (1/r) * integral of f along o + t v, t in [t0, t1], |v| = 1.
+double beam_energy_prepared(const PreparedBeam& pb, const Vec3& o, const Vec3& v, double t0,
+                            double t1, double rel_tol) {
+  if (!(t1 > t0)) return 0.0;
+  const Vec3 oc = o - pb.c;
+  const double t_ref = -dot(oc, v);
+  const Vec3 q = pb.inv_r * (oc + t_ref * v);
+  const double q2 = dot(q, q);
+  if (!(q2 < pb.bound2)) return 0.0;  // misses the bounding sphere
+  const double h = std::sqrt(pb.bound2 - q2);
+  const double s0 = std::max((t0 - t_ref) * pb.inv_r, -h);
+  const double s1 = std::min((t1 - t_ref) * pb.inv_r, h);
+  if (!(s1 > s0)) return 0.0;
+
+  if (!pb.capsule) return integrate_point(pb, q, v, Vec3{0.0, 0.0, 0.0}, s0, s1, rel_tol);
+
+  // Capsule: u(sigma) = (p - p0) . w = u_q + sigma * vw, slab 0 <= u <= L.
+  const Vec3 a0 = (-pb.half_len) * pb.w;
+  const Vec3 a1 = pb.half_len * pb.w;
+  const double len = 2.0 * pb.half_len;
+  const double uq = dot(q - a0, pb.w);
+  const double vw = dot(v, pb.w);
+  // Sigma intervals of the three regions (before cap0 / in the slab / beyond cap1).
+  double r0lo, r0hi, slo, shi, r1lo, r1hi;
+  if (vw > 0.0) {
+    const double su0 = -uq / vw;
+    const double suL = (len - uq) / vw;
+    r0lo = -kInf, r0hi = su0, slo = su0, shi = suL, r1lo = suL, r1hi = kInf;
+  } else if (vw < 0.0) {
+    const double su0 = -uq / vw;
+    const double suL = (len - uq) / vw;
+    r1lo = -kInf, r1hi = suL, slo = suL, shi = su0, r0lo = su0, r0hi = kInf;
+  } else {  // perpendicular to the axis: one region for the whole ray
+    r0lo = r0hi = slo = shi = r1lo = r1hi = 0.0;
+    if (uq < 0.0) {
+      r0lo = -kInf, r0hi = kInf;
+    } else if (uq > len) {
+      r1lo = -kInf, r1hi = kInf;
+    } else {
+      slo = -kInf, shi = kInf;
+    }
+  }
+  double e = integrate_line(pb, q, v, a0, std::max(s0, slo), std::min(s1, shi), rel_tol);
+  if (pb.cap0) e += integrate_point(pb, q, v, a0, std::max(s0, r0lo), std::min(s1, r0hi), rel_tol);
+  if (pb.cap1) e += integrate_point(pb, q, v, a1, std::max(s0, r1lo), std::min(s1, r1hi), rel_tol);
+  return e;
+}
+
+// ---------------------------------------------------------------------------
+// Occluders
+
+struct Hit {
+  double t = kInf;
+  Vec3 n{};                       // unit geometric normal, not yet oriented
+  const Color* albedo = nullptr;  // null: no hit
+};
+
+struct PreparedOccluder {
+  const Occluder* occ = nullptr;
+  Vec3 normal{};                        // plane: unit normal
+  std::array<double, 4> q{1, 0, 0, 0};  // box: unit rotation
+  std::array<double, 4> qc{1, 0, 0, 0}; // box: inverse rotation
+  Vec3 half{};                          // box: half extents
+  Vec3 lo{}, hi{};                      // mesh: bounding box
+  bool empty = false;
+};
+
+PreparedOccluder prepare_occluder(const Occluder& o) {
+  PreparedOccluder p;
+  p.occ = &o;
+  if (const auto* pl = std::get_if<PlaneOccluder>(&o.shape)) {
+    p.normal = normalize(pl->normal);
+  } else if (const auto* b = std::get_if<BoxOccluder>(&o.shape)) {
+    const auto& r = b->rotation;
+    const double n = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]);
+    p.q = {r[0] / n, r[1] / n, r[2] / n, r[3] / n};
+    p.qc = {p.q[0], -p.q[1], -p.q[2], -p.q[3]};
+    p.half = 0.5 * b->size;
+  } else if (const auto* m = std::get_if<MeshOccluder>(&o.shape)) {
+    p.empty = m->vertices.empty() || m->triangles.empty();
+    p.lo = {kInf, kInf, kInf};
+    p.hi = {-kInf, -kInf, -kInf};
+    for (const auto& v : m->vertices) {
+      for (int k = 0; k < 3; ++k) {
+        p.lo[k] = std::min(p.lo[k], v[k]);
+        p.hi[k] = std::max(p.hi[k], v[k]);
+      }
+    }
+  }
+  return p;
+}
+
+// Slab test of an axis-aligned box [lo, hi]; returns the entry/exit parameters
+// and the axes that produced them. False when the ray misses the box.
+bool slab(const Vec3& o, const Vec3& v, const Vec3& lo, const Vec3& hi, double* tn, double* tf,
+          int* an, int* af) {
+  *tn = -kInf;
+  *tf = kInf;
+  *an = *af = -1;
+  for (int k = 0; k < 3; ++k) {
+    if (v[k] == 0.0) {
+      if (o[k] < lo[k] || o[k] > hi[k]) return false;
+      continue;
+    }
+    const double inv = 1.0 / v[k];
+    double ta = (lo[k] - o[k]) * inv;
+    double tb = (hi[k] - o[k]) * inv;
+    if (ta > tb) std::swap(ta, tb);
+    if (ta > *tn) *tn = ta, *an = k;
+    if (tb < *tf) *tf = tb, *af = k;
+  }
+  return *tn <= *tf;
+}
+
+// Nearest hit of one occluder with t in [tmin, tmax]; updates `best` if closer.
+void intersect(const PreparedOccluder& p, const Vec3& o, const Vec3& v, double tmin, double tmax,
+               Hit* best) {
+  tmax = std::min(tmax, best->t);
+  const Occluder& occ = *p.occ;
+  if (const auto* pl = std::get_if<PlaneOccluder>(&occ.shape)) {
+    const double denom = dot(v, p.normal);
+    if (denom == 0.0) return;
+    const double t = dot(pl->point - o, p.normal) / denom;
+    if (t >= tmin && t <= tmax) *best = {t, p.normal, &occ.albedo};
+  } else if (const auto* b = std::get_if<BoxOccluder>(&occ.shape)) {
+    const Vec3 ol = rotate(p.qc, o - b->center);
+    const Vec3 vl = rotate(p.qc, v);
+    const Vec3 lo = -1.0 * p.half;
+    double tn, tf;
+    int an, af;
+    if (!slab(ol, vl, lo, p.half, &tn, &tf, &an, &af)) return;
+    double t = kInf;
+    int axis = -1;
+    if (tn >= tmin && tn <= tmax) {
+      t = tn, axis = an;
+    } else if (tf >= tmin && tf <= tmax) {  // ray starts inside the box
+      t = tf, axis = af;
+    }
+    if (axis < 0) return;
+    Vec3 nl{0.0, 0.0, 0.0};
+    nl[axis] = 1.0;
+    *best = {t, rotate(p.q, nl), &occ.albedo};
+  } else if (const auto* s = std::get_if<SphereOccluder>(&occ.shape)) {
+    const Vec3 e = s->center - o;
+    const double tc = dot(e, v);
+    const Vec3 perp = e - tc * v;
+    const double d = length(perp);
+    if (!(d <= s->radius)) return;
+    const double h = std::sqrt((s->radius - d) * (s->radius + d));
+    double t = tc - h;
+    if (!(t >= tmin && t <= tmax)) t = tc + h;
+    if (!(t >= tmin && t <= tmax)) return;
+    *best = {t, (1.0 / s->radius) * ((o + t * v) - s->center), &occ.albedo};
+  } else if (const auto* m = std::get_if<MeshOccluder>(&occ.shape)) {
+    if (p.empty) return;
+    double tn, tf;
+    int an, af;
+    if (!slab(o, v, p.lo, p.hi, &tn, &tf, &an, &af)) return;
+    if (tf < tmin || tn > tmax) return;
+    const std::size_t nv = m->vertices.size();
+    for (const auto& tri : m->triangles) {
+      if (tri[0] >= nv || tri[1] >= nv || tri[2] >= nv) continue;
+      const Vec3& p0 = m->vertices[tri[0]];
+      const Vec3 e1 = m->vertices[tri[1]] - p0;
+      const Vec3 e2 = m->vertices[tri[2]] - p0;
+      const Vec3 pv = cross(v, e2);
+      const double det = dot(e1, pv);
+      if (det == 0.0) continue;
+      const double inv = 1.0 / det;
+      const Vec3 tv = o - p0;
+      const double bu = dot(tv, pv) * inv;
+      if (bu < 0.0 || bu > 1.0) continue;
+      const Vec3 qv = cross(tv, e1);
+      const double bv = dot(v, qv) * inv;
+      if (bv < 0.0 || bu + bv > 1.0) continue;
+      const double t = dot(e2, qv) * inv;
+      if (t >= tmin && t <= tmax) {
+        tmax = t;
+        *best = {t, normalize(cross(e1, e2)), &occ.albedo};
+      }
+    }
+  }
+}
+
+}  // namespace
+
+double beam_energy_reference(const Beam& beam, const Vec3& origin, const Vec3& dir, double t0,
+                             double t1, double rel_tol) {
+  if (!(t1 > t0) || !(beam.radius > 0.0)) return 0.0;
+  const double len = length(dir);
+  if (!(len > 0.0)) return 0.0;
+  const PreparedBeam pb = prepare_beam(beam);
+  // The integral is over the parameter t; with a non-unit direction the world
+  // distance is t * |dir|, hence the rescaling.
+  return beam_energy_prepared(pb, origin, (1.0 / len) * dir, t0 * len, t1 * len, rel_tol) / len;
+}
+
+HdrImage render_reference(const Scene& scene, const Camera& cam, const ReferenceOptions& opts) {
+  HdrImage img;
+  img.width = cam.width;
+  img.height = cam.height;
+  img.rgb.assign(3 * static_cast<std::size_t>(std::max(cam.width, 0)) * std::max(cam.height, 0),
+                 0.0f);
+  if (cam.width <= 0 || cam.height <= 0) return img;
+
+  const CameraBasis basis = camera_basis(cam);
+  std::vector<PreparedBeam> beams;
+  std::vector<const Beam*> beam_src;
+  for (const Beam& b : scene.beams) {
+    if (!(b.radius > 0.0)) continue;
+    beams.push_back(prepare_beam(b));
+    beam_src.push_back(&b);
+  }
+  std::vector<PreparedOccluder> occs;
+  for (const Occluder& o : scene.occluders) occs.push_back(prepare_occluder(o));
+
+  const DirectionalLight& light = scene.light;
+  const double llen = length(light.direction);
+  const Vec3 to_light = llen > 0.0 ? (-1.0 / llen) * light.direction : Vec3{0.0, 0.0, 0.0};
+
+  auto shade_row = [&](int y) {
+    const int py = cam.height - 1 - y;  // GL pixel rows count from the bottom
+    for (int x = 0; x < cam.width; ++x) {
+      const Ray ray = camera_ray(cam, basis, x, py);
+      Hit hit;
+      for (const auto& o : occs) intersect(o, ray.origin, ray.dir, ray.t_min, ray.t_max, &hit);
+      Color c = scene.background;
+      double t_end = ray.t_max;
+      if (hit.albedo) {
+        t_end = hit.t;
+        Vec3 n = hit.n;
+        if (dot(n, ray.dir) > 0.0) n = -1.0 * n;  // two-sided
+        const double lambert = light.ambient + light.intensity * std::max(0.0, dot(n, to_light));
+        for (int k = 0; k < 3; ++k) c[k] = (*hit.albedo)[k] * light.color[k] * lambert;
+      }
+      for (std::size_t b = 0; b < beams.size(); ++b) {
+        const double e =
+            beam_energy_prepared(beams[b], ray.origin, ray.dir, ray.t_min, t_end, opts.rel_tol);
+        if (e == 0.0) continue;
+        const Beam& src = *beam_src[b];
+        for (int k = 0; k < 3; ++k) c[k] += src.color[k] * src.intensity * e;
+      }
+      float* px = img.at(x, y);
+      for (int k = 0; k < 3; ++k) px[k] = static_cast<float>(c[k]);
+    }
+  };
+
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const int nthreads =
+      std::min(cam.height, opts.threads > 0 ? opts.threads : static_cast<int>(hw));
+  std::atomic<int> next{0};
+  auto worker = [&] {
+    for (int y = next.fetch_add(1); y < cam.height; y = next.fetch_add(1)) shade_row(y);
+  };
+  if (nthreads <= 1) {
+    worker();
+  } else {
+    std::vector<std::thread> pool;
+    pool.reserve(nthreads);
+    for (int k = 0; k < nthreads; ++k) pool.emplace_back(worker);
+    for (auto& th : pool) th.join();
+  }
+  return img;
+}
+
+}  // namespace beamcast
