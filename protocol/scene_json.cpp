@@ -1,0 +1,517 @@
+// Scene JSON -> Scene, validating every field. The format is documented in
+// docs/scene-format.md; keep the two in step.
+#include "protocol/scene_json.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "protocol/camera.hpp"
+#include "protocol/json_reader.hpp"
+#include "protocol/mesh_obj.hpp"
+
+namespace beamcast {
+
+using nlohmann::json;
+using namespace json_read;
+
+namespace {
+
+// ---- Small typed readers shared by the scene parts ----------------------------------
+
+Vec3 read_point(const Node& n, const SceneLimits& limits) {
+  return check_coordinates(n, read_vec3(n), limits.max_abs_coordinate);
+}
+
+// A length: > 0, finite, at most max_abs_coordinate.
+double read_size(const Node& n, const SceneLimits& limits) {
+  const double v = check_positive(n, read_number(n));
+  if (v > limits.max_abs_coordinate) {
+    fail("out_of_range", n.path,
+         n.name() + " must be <= " + format_number(limits.max_abs_coordinate) +
+             " (limit max_abs_coordinate), got " + format_number(v));
+  }
+  return v;
+}
+
+// A direction: finite, not the zero vector (need not be unit).
+Vec3 read_direction(const Node& n) {
+  const Vec3 v = read_vec3(n);
+  const double len = length(v);
+  if (!(len > 0.0) || !std::isfinite(len)) {
+    fail("invalid_value", n.path, n.name() + " must be a nonzero direction vector, got [0, 0, 0]");
+  }
+  return v;
+}
+
+Color read_color(const Node& n) {
+  Color c = read_vec3(n);
+  for (std::size_t i = 0; i < 3; ++i)
+    check_non_negative(Node{&n.json()[i], child_path(n.path, i)}, c[i]);
+  return c;
+}
+
+Color read_albedo(const Node& n) {
+  Color c = read_vec3(n);
+  for (std::size_t i = 0; i < 3; ++i)
+    check_closed(Node{&n.json()[i], child_path(n.path, i)}, c[i], 0.0, 1.0);
+  return c;
+}
+
+// [w, x, y, z] with finite nonzero norm, returned normalized.
+std::array<double, 4> read_quaternion(const Node& n) {
+  auto q = read_numbers<4>(n);
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(norm > 0.0) || !std::isfinite(norm)) {
+    fail("invalid_value", n.path,
+         n.name() + " must be a quaternion [w, x, y, z] with finite nonzero norm, got norm " +
+             format_number(norm));
+  }
+  for (double& c : q) c /= norm;
+  return q;
+}
+
+int read_int_in(const Node& n, std::int64_t lo, std::int64_t hi) {
+  const std::int64_t v = read_integer(n);
+  if (v < lo || v > hi) {
+    fail("out_of_range", n.path,
+         n.name() + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+             "], got " + std::to_string(v));
+  }
+  return static_cast<int>(v);
+}
+
+// An integer in [lo, hi] where hi is a named limit: above it is "limit_exceeded".
+int read_int_limited(const Node& n, std::int64_t lo, std::int64_t hi, const char* limit_name) {
+  const std::int64_t v = read_integer(n);
+  if (v > hi) {
+    fail("limit_exceeded", n.path,
+         n.name() + " is " + std::to_string(v) + ", over the limit " + limit_name + " = " +
+             std::to_string(hi));
+  }
+  if (v < lo) {
+    fail("out_of_range", n.path,
+         n.name() + " must be >= " + std::to_string(lo) + ", got " + std::to_string(v));
+  }
+  return static_cast<int>(v);
+}
+
+// ---- Beams --------------------------------------------------------------------------
+
+Density parse_density(const Node& n, const SceneLimits& limits) {
+  static constexpr std::string_view kNames = R"("abe", "shell", "linear", "quadratic", "gaussian")";
+  Density d;
+  if (n.json().is_string()) {
+    if (!density_from_name(n.json().get<std::string>(), &d)) {
+      fail("invalid_value", n.path,
+           "density must be one of " + std::string(kNames) + " or an object, got " +
+               describe(n.json()));
+    }
+    return d;
+  }
+  if (!n.json().is_object()) {
+    fail("wrong_type", n.path,
+         "density must be a string (a built-in name) or an object, got " + describe(n.json()));
+  }
+  ObjectReader o(n, "a density");
+  const Node type = o.required("type");
+  const std::string t = read_string(type);
+  if (t == "table") {
+    o.allow_only({"type", "samples"});
+    const Node samples = o.required("samples");
+    const auto items = read_array(samples, limits.max_density_samples, "max_density_samples");
+    if (items.size() < 2) {
+      fail("invalid_value", samples.path,
+           "samples must hold at least 2 values, got " + std::to_string(items.size()));
+    }
+    d.kind = DensityKind::kTable;
+    bool any_positive = false;
+    for (const Node& item : items) {
+      d.samples.push_back(check_non_negative(item, read_number(item)));
+      any_positive = any_positive || d.samples.back() > 0.0;
+    }
+    if (!any_positive) {
+      fail("invalid_value", samples.path,
+           "samples must not all be zero (the beam would be invisible)");
+    }
+    return d;
+  }
+  if (!density_from_name(t, &d)) {
+    fail("invalid_value", type.path,
+         "density type must be one of " + std::string(kNames) + ", \"table\", got " +
+             describe(type.json()));
+  }
+  if (d.kind == DensityKind::kGaussian) {
+    o.allow_only({"type", "sigma"});
+    if (auto s = o.optional("sigma")) {
+      d.sigma = read_number(*s);
+      if (!(d.sigma > 0.0 && d.sigma <= 10.0)) {
+        fail("out_of_range", s->path, "sigma must be in (0, 10], got " + format_number(d.sigma));
+      }
+    }
+  } else {
+    o.allow_only({"type"});
+  }
+  return d;
+}
+
+Beam parse_beam(const Node& n, const SceneLimits& limits) {
+  ObjectReader o(n, "a beam");
+  const Node type = o.required("type");
+  enum class Kind { kSphere, kCapsule };
+  const Kind kind = read_enum<Kind>(type, {{"sphere", Kind::kSphere}, {"capsule", Kind::kCapsule}});
+  Beam b;
+  if (kind == Kind::kSphere) {
+    o.allow_only({"type", "center", "radius", "color", "intensity", "density"});
+  } else {
+    o.allow_only({"type", "p0", "p1", "caps", "radius", "color", "intensity", "density"});
+  }
+  b.radius = read_size(o.required("radius"), limits);
+  if (auto c = o.optional("color")) b.color = read_color(*c);
+  if (auto i = o.optional("intensity")) b.intensity = check_non_negative(*i, read_number(*i));
+  if (auto d = o.optional("density")) b.density = parse_density(*d, limits);
+
+  if (kind == Kind::kSphere) {
+    b.shape = SphereBeam{read_point(o.required("center"), limits)};
+    return b;
+  }
+  CapsuleBeam c;
+  c.p0 = read_point(o.required("p0"), limits);
+  const Node p1 = o.required("p1");
+  c.p1 = read_point(p1, limits);
+  if (auto caps = o.optional("caps")) {
+    if (!caps->json().is_array() || caps->json().size() != 2) {
+      fail("wrong_type", caps->path,
+           "caps must be an array of 2 booleans, got " + describe(caps->json()));
+    }
+    c.cap0 = read_bool(Node{&caps->json()[0], child_path(caps->path, 0)});
+    c.cap1 = read_bool(Node{&caps->json()[1], child_path(caps->path, 1)});
+  }
+  const double len = length(c.p1 - c.p0);
+  if (len <= 1e-9 * std::max(1.0, b.radius)) {
+    fail("degenerate_capsule", p1.path,
+         "capsule axis length |p1 - p0| = " + format_number(len) +
+             " is zero or too small for radius " + format_number(b.radius) +
+             "; write a zero-length capsule as a sphere beam instead");
+  }
+  b.shape = c;
+  return b;
+}
+
+// ---- Occluders ----------------------------------------------------------------------
+
+MeshTransform parse_mesh_transform(const ObjectReader& o, const SceneLimits& limits) {
+  MeshTransform xf;
+  if (auto t = o.optional("translate")) xf.translate = read_point(*t, limits);
+  if (auto s = o.optional("scale")) {
+    if (s->json().is_number()) {
+      const double v = read_number(*s);
+      xf.scale = {v, v, v};
+    } else {
+      xf.scale = read_vec3(*s);
+    }
+    // Negative factors mirror the mesh (allowed); zero flattens it (refused).
+    for (double v : xf.scale) {
+      if (!(std::abs(v) > 0.0) || std::abs(v) > limits.max_abs_coordinate) {
+        fail("out_of_range", s->path,
+             "scale factors must be nonzero with magnitude <= max_abs_coordinate, got " +
+                 format_number(v));
+      }
+    }
+  }
+  if (auto r = o.optional("rotation")) xf.rotation = read_quaternion(*r);
+  return xf;
+}
+
+Occluder parse_occluder(const Node& n, const SceneLoadOptions& opts, std::int64_t* mesh_triangles) {
+  const SceneLimits& limits = opts.limits;
+  ObjectReader o(n, "an occluder");
+  const Node type = o.required("type");
+  enum class Kind { kPlane, kBox, kSphere, kMesh };
+  const Kind kind = read_enum<Kind>(type, {{"plane", Kind::kPlane},
+                                           {"box", Kind::kBox},
+                                           {"sphere", Kind::kSphere},
+                                           {"mesh", Kind::kMesh}});
+  Occluder occ;
+  switch (kind) {
+    case Kind::kPlane: {
+      o.allow_only({"type", "point", "normal", "albedo"});
+      PlaneOccluder p;
+      p.point = read_point(o.required("point"), limits);
+      p.normal = read_direction(o.required("normal"));
+      occ.shape = p;
+      break;
+    }
+    case Kind::kBox: {
+      o.allow_only({"type", "center", "size", "rotation", "albedo"});
+      BoxOccluder b;
+      b.center = read_point(o.required("center"), limits);
+      const Node size = o.required("size");
+      b.size = read_vec3(size);
+      for (std::size_t i = 0; i < 3; ++i) {
+        b.size[i] = read_size(Node{&size.json()[i], child_path(size.path, i)}, limits);
+      }
+      if (auto r = o.optional("rotation")) b.rotation = read_quaternion(*r);
+      occ.shape = b;
+      break;
+    }
+    case Kind::kSphere: {
+      o.allow_only({"type", "center", "radius", "albedo"});
+      SphereOccluder s;
+      s.center = read_point(o.required("center"), limits);
+      s.radius = read_size(o.required("radius"), limits);
+      occ.shape = s;
+      break;
+    }
+    case Kind::kMesh: {
+      o.allow_only({"type", "file", "translate", "scale", "rotation", "albedo"});
+      const Node file = o.required("file");
+      const std::string name = read_string(file);
+      if (name.empty()) fail("invalid_value", file.path, "file must be a non-empty relative path");
+      const MeshTransform xf = parse_mesh_transform(o, limits);
+      const MeshLoadLimits mesh_limits{limits.max_mesh_triangles, *mesh_triangles,
+                                       limits.max_abs_coordinate};
+      MeshOccluder mesh = load_obj_mesh(opts.assets_dir, name, xf, mesh_limits, file.path);
+      *mesh_triangles += static_cast<std::int64_t>(mesh.triangles.size());
+      occ.shape = std::move(mesh);
+      break;
+    }
+  }
+  if (auto a = o.optional("albedo")) occ.albedo = read_albedo(*a);
+  return occ;
+}
+
+// ---- Scene-wide settings ------------------------------------------------------------
+
+DirectionalLight parse_light(const Node& n) {
+  ObjectReader o(n, "a light");
+  o.allow_only({"direction", "color", "intensity", "ambient"});
+  DirectionalLight l;
+  if (auto d = o.optional("direction")) l.direction = read_direction(*d);
+  if (auto c = o.optional("color")) l.color = read_color(*c);
+  if (auto i = o.optional("intensity")) l.intensity = check_non_negative(*i, read_number(*i));
+  if (auto a = o.optional("ambient")) l.ambient = check_closed(*a, read_number(*a), 0.0, 1.0);
+  return l;
+}
+
+OutputSettings parse_output(const Node& n) {
+  ObjectReader o(n, "output settings");
+  o.allow_only({"exposure", "tone", "bit_depth"});
+  OutputSettings out;
+  if (auto e = o.optional("exposure")) out.exposure = check_positive(*e, read_number(*e));
+  if (auto t = o.optional("tone")) {
+    out.tone = read_enum<ToneCurve>(*t, {{"exponential", ToneCurve::kExponential},
+                                         {"reinhard", ToneCurve::kReinhard},
+                                         {"clamp", ToneCurve::kClamp}});
+  }
+  if (auto b = o.optional("bit_depth")) {
+    const std::int64_t v = read_integer(*b);
+    if (v != 8 && v != 16) {
+      fail("invalid_value", b->path, "bit_depth must be 8 or 16, got " + std::to_string(v));
+    }
+    out.bit_depth = static_cast<int>(v);
+  }
+  return out;
+}
+
+RenderSettings parse_render(const Node& n, const SceneLimits& limits) {
+  ObjectReader o(n, "render settings");
+  o.allow_only({"table_size", "f_table"});
+  RenderSettings r;
+  if (auto t = o.optional("table_size")) {
+    if (t->json().is_array()) {
+      if (t->json().size() != 2) {
+        fail("wrong_type", t->path,
+             "table_size must be an integer or an array of 2 integers, got " + describe(t->json()));
+      }
+      r.table_d = read_int_limited(Node{&t->json()[0], child_path(t->path, 0)}, limits.min_table,
+                                   limits.max_table, "max_table");
+      r.table_s = read_int_limited(Node{&t->json()[1], child_path(t->path, 1)}, limits.min_table,
+                                   limits.max_table, "max_table");
+    } else {
+      r.table_d = r.table_s = read_int_limited(*t, limits.min_table, limits.max_table, "max_table");
+    }
+  }
+  if (auto f = o.optional("f_table")) r.f_table = read_int_in(*f, 16, 65536);
+  return r;
+}
+
+// ---- Cameras ------------------------------------------------------------------------
+
+std::string read_camera_name(const Node& n) {
+  const std::string s = read_string(n);
+  bool ok = !s.empty() && s.size() <= 64 && s != "." && s != "..";
+  for (char c : s) {
+    ok = ok && ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+                c == '_' || c == '.' || c == '-');
+  }
+  if (!ok) {
+    fail("invalid_value", n.path,
+         "name must be 1 to 64 characters from [A-Za-z0-9_.-] (and not \".\" or \"..\"), got " +
+             describe(n.json()));
+  }
+  return s;
+}
+
+// Checks that the look-at frame is well defined (camera_basis relies on it).
+void check_look_at(const Camera& c, const Node* target, const Node* up) {
+  Vec3 forward{0.0, 0.0, -1.0};
+  if (target) {
+    const Vec3 d = *c.target - c.position;
+    const double scale = std::max({1.0, length(c.position), length(*c.target)});
+    if (!(length(d) > 1e-12 * scale)) {
+      fail("invalid_value", target->path,
+           "target must differ from position (the view direction is undefined)");
+    }
+    forward = normalize(d);
+  }
+  const double up_len = length(c.up);
+  if (!(up_len > 0.0)) {
+    fail("invalid_value", up ? up->path : std::string(), "up must be a nonzero vector");
+  }
+  const Vec3 u = (1.0 / up_len) * c.up;
+  if (length(cross(forward, u)) < 1e-6) {
+    fail("invalid_value", up ? up->path : (target ? target->path : std::string()),
+         "up must not be parallel to the view direction (target - position)");
+  }
+}
+
+}  // namespace
+
+Camera parse_camera(const json& j, const std::string& path, const SceneLimits& limits) {
+  const Node n{&j, path};
+  ObjectReader o(n, "a camera");
+  o.allow_only({"name", "position", "target", "rotation", "up", "projection", "fov_y",
+                "ortho_height", "near", "far", "width", "height"});
+  Camera c;
+  if (auto v = o.optional("name")) c.name = read_camera_name(*v);
+  if (auto v = o.optional("position")) c.position = read_point(*v, limits);
+
+  const auto target = o.optional("target");
+  const auto rotation = o.optional("rotation");
+  const auto up = o.optional("up");
+  if (target && rotation) {
+    fail("conflicting_fields", rotation->path,
+         "a camera takes either \"target\" or \"rotation\", not both");
+  }
+  if (rotation && up) {
+    fail("conflicting_fields", up->path,
+         "\"up\" is only used with \"target\"; \"rotation\" already fixes the up direction");
+  }
+  if (target) c.target = read_point(*target, limits);
+  if (rotation) c.rotation = read_quaternion(*rotation);
+  if (up) c.up = read_vec3(*up);
+  if (!rotation) check_look_at(c, target ? &*target : nullptr, up ? &*up : nullptr);
+
+  if (auto v = o.optional("projection")) {
+    c.projection = read_enum<Projection>(*v, {{"perspective", Projection::kPerspective},
+                                              {"orthographic", Projection::kOrthographic}});
+  }
+  if (auto v = o.optional("fov_y")) c.fov_y_deg = check_open(*v, read_number(*v), 0.0, 180.0);
+  if (auto v = o.optional("ortho_height")) c.ortho_height = read_size(*v, limits);
+  if (auto v = o.optional("near")) c.near_plane = check_positive(*v, read_number(*v));
+  const auto far = o.optional("far");
+  if (far) c.far_plane = read_number(*far);
+  if (!(c.far_plane > c.near_plane) || c.far_plane / c.near_plane > 1e15) {
+    const std::string where = far ? far->path : o.path_of("near");
+    fail("out_of_range", where,
+         "far must be > near and far / near <= 1e15, got near " + format_number(c.near_plane) +
+             " and far " + format_number(c.far_plane));
+  }
+
+  if (auto v = o.optional("width"))
+    c.width = read_int_limited(*v, 1, limits.max_width, "max_width");
+  if (auto v = o.optional("height")) {
+    c.height = read_int_limited(*v, 1, limits.max_height, "max_height");
+  }
+  const std::int64_t pixels = static_cast<std::int64_t>(c.width) * c.height;
+  if (pixels > limits.max_pixels) {
+    fail("limit_exceeded", o.path_of("width"),
+         "width * height = " + std::to_string(pixels) +
+             " pixels, over the limit max_pixels = " + std::to_string(limits.max_pixels));
+  }
+  return c;
+}
+
+Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
+  const SceneLimits& limits = opts.limits;
+  const Node root{&j, ""};
+  ObjectReader o(root, "a scene");
+  o.allow_only(
+      {"version", "background", "light", "beams", "occluders", "cameras", "output", "render"});
+  Scene scene;
+  if (auto v = o.optional("version")) {
+    const std::int64_t version = read_integer(*v);
+    if (version != 1) {
+      fail("invalid_value", v->path,
+           "version must be 1 (the only format version), got " + std::to_string(version));
+    }
+  }
+  if (auto v = o.optional("background")) scene.background = read_color(*v);
+  if (auto v = o.optional("light")) scene.light = parse_light(*v);
+  if (auto v = o.optional("output")) scene.output = parse_output(*v);
+  if (auto v = o.optional("render")) scene.render = parse_render(*v, limits);
+
+  if (auto v = o.optional("beams")) {
+    for (const Node& b : read_array(*v, limits.max_beams, "max_beams")) {
+      scene.beams.push_back(parse_beam(b, limits));
+    }
+  }
+  if (auto v = o.optional("occluders")) {
+    std::int64_t mesh_triangles = 0;
+    for (const Node& occ : read_array(*v, limits.max_occluders, "max_occluders")) {
+      scene.occluders.push_back(parse_occluder(occ, opts, &mesh_triangles));
+    }
+  }
+
+  const Node cameras = o.required("cameras");
+  const auto items = read_array(cameras, limits.max_cameras, "max_cameras");
+  if (items.empty()) {
+    fail("invalid_value", cameras.path, "cameras must hold at least one camera, got none");
+  }
+  std::set<std::string> names;
+  for (const Node& item : items) {
+    scene.cameras.push_back(parse_camera(item.json(), item.path, limits));
+    const std::string& name = scene.cameras.back().name;
+    if (!name.empty() && !names.insert(name).second) {
+      fail("duplicate_name", child_path(item.path, "name"),
+           "camera name \"" + name + "\" is used by more than one camera");
+    }
+  }
+  return scene;
+}
+
+Scene load_scene_file(const std::filesystem::path& file, const SceneLoadOptions& opts) {
+  std::error_code ec;
+  std::ifstream in;
+  if (std::filesystem::is_regular_file(file, ec)) in.open(file, std::ios::binary);
+  if (!in.is_open() || !in) {
+    throw ProtocolError(ErrorInfo{
+        "file_not_found", "scene file " + file.string() + " does not exist or cannot be read", ""});
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) {
+    throw ProtocolError(
+        ErrorInfo{"file_not_found", "scene file " + file.string() + " could not be read", ""});
+  }
+  json j;
+  try {
+    j = json::parse(text.str());
+  } catch (const json::parse_error& e) {
+    throw ProtocolError(ErrorInfo{"bad_json",
+                                  "scene file " + file.string() + " is not valid JSON (at byte " +
+                                      std::to_string(e.byte) + "): " + e.what(),
+                                  ""});
+  } catch (const json::out_of_range& e) {
+    // nlohmann refuses numbers that overflow a double (e.g. 1e999) while parsing (error 406).
+    throw ProtocolError(ErrorInfo{"not_finite",
+                                  "scene file " + file.string() +
+                                      " contains a number that is not a finite double: " + e.what(),
+                                  ""});
+  }
+  return parse_scene(j, opts);
+}
+
+}  // namespace beamcast
