@@ -61,6 +61,8 @@ struct Case {
   Tolerance tol;
 };
 
+void PrintTo(const Case& c, std::ostream* os) { *os << c.example; }
+
 class ExampleImage : public ::testing::TestWithParam<Case> {};
 
 TEST_P(ExampleImage, GpuMatchesCpuReference) {
