@@ -379,6 +379,10 @@ void check_look_at(const Camera& c, const Node* target, const Node* up) {
 
 }  // namespace
 
+OutputSettings parse_output_settings(const json& j, const std::string& path) {
+  return parse_output(Node{&j, path});
+}
+
 Camera parse_camera(const json& j, const std::string& path, const SceneLimits& limits) {
   const Node n{&j, path};
   ObjectReader o(n, "a camera");

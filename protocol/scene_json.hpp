@@ -41,6 +41,8 @@ Scene parse_scene(const nlohmann::json& j, const SceneLoadOptions& opts);
 // One camera object (used by requests that send only camera poses); `path` is
 // the JSON pointer of `j` for error messages.
 Camera parse_camera(const nlohmann::json& j, const std::string& path, const SceneLimits& limits);
+// An "output" object (exposure, tone, bit_depth); missing fields take defaults.
+OutputSettings parse_output_settings(const nlohmann::json& j, const std::string& path);
 // Reads and parses a scene file; JSON syntax errors become code "bad_json".
 Scene load_scene_file(const std::filesystem::path& file, const SceneLoadOptions& opts);
 

@@ -1,0 +1,134 @@
+#include "protocol/request.hpp"
+
+namespace beamcast {
+namespace {
+[[noreturn]] void fail(std::string code, std::string path, std::string message) {
+  throw ProtocolError(ErrorInfo{std::move(code), std::move(message), std::move(path)});
+}
+
+bool valid_id_char(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+         c == '-' || c == '.';
+}
+}  // namespace
+
+Request parse_request(std::string_view text, nlohmann::json* id_out) {
+  *id_out = nullptr;
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    fail("bad_json", "", std::string("request is not valid JSON: ") + e.what());
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number too large for a double (1e999): the parser stops before a path is known.
+    fail("not_finite", "", std::string("request contains a number that is not finite: ") + e.what());
+  } catch (const nlohmann::json::exception& e) {
+    fail("bad_json", "", std::string("request JSON is not acceptable: ") + e.what());
+  }
+  if (!j.is_object()) fail("bad_json", "", "request must be a JSON object");
+  Request r;
+  auto id = j.find("id");
+  if (id == j.end()) fail("bad_request", "/id", "request has no \"id\"");
+  if (id->is_string()) {
+    if (id->get_ref<const std::string&>().size() > 128) {
+      fail("bad_request", "/id", "id must be at most 128 characters");
+    }
+  } else if (!id->is_number_integer()) {
+    fail("bad_request", "/id", "id must be a string or an integer");
+  }
+  r.id = *id;
+  *id_out = r.id;
+  auto method = j.find("method");
+  if (method == j.end()) fail("bad_request", "/method", "request has no \"method\"");
+  if (!method->is_string()) fail("bad_request", "/method", "method must be a string");
+  r.method = method->get<std::string>();
+  if (auto p = j.find("params"); p != j.end()) {
+    if (!p->is_object()) fail("invalid_params", "/params", "params must be an object");
+    r.params = *p;
+  }
+  for (const auto& [key, value] : j.items()) {
+    (void)value;
+    if (key != "id" && key != "method" && key != "params") {
+      fail("bad_request", "/" + key, "unknown request field \"" + key + "\"");
+    }
+  }
+  return r;
+}
+
+nlohmann::json ok_response(const nlohmann::json& id, nlohmann::json result) {
+  return {{"id", id}, {"ok", true}, {"result", std::move(result)}};
+}
+
+nlohmann::json error_response(const nlohmann::json& id, const ErrorInfo& e) {
+  return {{"id", id},
+          {"ok", false},
+          {"error", {{"code", e.code}, {"message", e.message}, {"path", e.path}}}};
+}
+
+ErrorInfo with_path_prefix(ErrorInfo e, std::string_view prefix) {
+  e.path = std::string(prefix) + e.path;
+  return e;
+}
+
+std::string parse_scene_id(const nlohmann::json& params, const std::string& path) {
+  auto it = params.find("scene_id");
+  if (it == params.end()) fail("missing_field", path, "scene_id is required");
+  if (!it->is_string()) fail("wrong_type", path, "scene_id must be a string");
+  const auto& id = it->get_ref<const std::string&>();
+  bool ok = !id.empty() && id.size() <= 64;
+  for (char c : id) ok = ok && valid_id_char(c);
+  if (!ok) fail("invalid_value", path, "scene_id must match [A-Za-z0-9_.-]{1,64}");
+  return id;
+}
+
+RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits& limits) {
+  RenderParams rp;
+  for (const auto& [key, value] : params.items()) {
+    (void)value;
+    if (key != "scene" && key != "scene_id" && key != "cameras" && key != "output" &&
+        key != "encoding") {
+      fail("unknown_field", "/params/" + key,
+           "unknown render parameter \"" + key +
+               "\" (allowed: scene, scene_id, cameras, output, encoding)");
+    }
+  }
+  const bool has_scene = params.contains("scene");
+  const bool has_id = params.contains("scene_id");
+  if (has_scene == has_id) {
+    fail(has_scene ? "conflicting_fields" : "missing_field", "/params",
+         "render needs exactly one of \"scene\" (inline) and \"scene_id\" (stored)");
+  }
+  if (has_scene) {
+    if (!params["scene"].is_object()) fail("wrong_type", "/params/scene", "scene must be an object");
+    rp.scene = params["scene"];
+  } else {
+    rp.scene_id = parse_scene_id(params, "/params/scene_id");
+  }
+  if (auto c = params.find("cameras"); c != params.end()) {
+    if (!c->is_array()) fail("wrong_type", "/params/cameras", "cameras must be an array");
+    if (c->empty()) fail("invalid_value", "/params/cameras", "cameras must not be empty");
+    if (static_cast<int>(c->size()) > limits.max_cameras) {
+      fail("limit_exceeded", "/params/cameras",
+           "max_cameras is " + std::to_string(limits.max_cameras) + ", got " +
+               std::to_string(c->size()));
+    }
+    std::vector<Camera> cams;
+    for (std::size_t i = 0; i < c->size(); ++i) {
+      cams.push_back(parse_camera((*c)[i], "/params/cameras/" + std::to_string(i), limits));
+    }
+    rp.cameras = std::move(cams);
+  }
+  if (auto o = params.find("output"); o != params.end()) {
+    if (!o->is_object()) fail("wrong_type", "/params/output", "output must be an object");
+    rp.output = *o;
+  }
+  if (auto e = params.find("encoding"); e != params.end()) {
+    if (!e->is_string() || (*e != "binary" && *e != "base64")) {
+      fail("invalid_value", "/params/encoding", "encoding must be \"binary\" or \"base64\"");
+    }
+    rp.base64 = *e == "base64";
+  }
+  return rp;
+}
+
+}  // namespace beamcast

@@ -1,0 +1,51 @@
+// Requests and responses of the wire protocol (PROTOCOL.md), as JSON. Pure:
+// the server's sessions call these, tests and fuzzers call them directly.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "protocol/errors.hpp"
+#include "protocol/scene.hpp"
+#include "protocol/scene_json.hpp"
+
+namespace beamcast {
+
+inline constexpr int kProtocolVersion = 1;
+
+struct Request {
+  nlohmann::json id;  // string or integer, echoed in the response
+  std::string method;
+  nlohmann::json params = nlohmann::json::object();
+};
+
+// Parses one frame's JSON text. On failure throws ProtocolError (bad_json,
+// bad_request); `*id_out` is set to the request's id as soon as it is known, so
+// the error response can carry it (null otherwise).
+Request parse_request(std::string_view json_text, nlohmann::json* id_out);
+
+nlohmann::json ok_response(const nlohmann::json& id, nlohmann::json result);
+nlohmann::json error_response(const nlohmann::json& id, const ErrorInfo& error);
+
+// Re-roots an error raised while reading a nested document: "/beams/0" under
+// "/params/scene" becomes "/params/scene/beams/0".
+ErrorInfo with_path_prefix(ErrorInfo e, std::string_view prefix);
+
+// `render` params, validated except for the scene itself (which may be stored).
+struct RenderParams {
+  std::optional<nlohmann::json> scene;  // inline scene, unparsed
+  std::optional<std::string> scene_id;
+  std::optional<std::vector<Camera>> cameras;  // replaces the scene's cameras
+  std::optional<nlohmann::json> output;  // merged over the scene's "output"
+  bool base64 = false;
+};
+RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits& limits);
+
+// A scene id: [A-Za-z0-9_.-]{1,64}; throws invalid_value / wrong_type at `path`.
+std::string parse_scene_id(const nlohmann::json& params, const std::string& path);
+
+}  // namespace beamcast

@@ -1,0 +1,44 @@
+// Every limit and knob of the server, with defaults (documented in
+// protocol/PROTOCOL.md, "Limits"); each is a command-line option of beamcast-server.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "protocol/scene_json.hpp"
+
+namespace beamcast {
+
+struct ServerConfig {
+  std::string bind = "127.0.0.1";
+  unsigned short port = 7878;  // 0: any free port
+  int device_index = -1;       // EGL device; -1: automatic
+  std::string egl_platform = "auto";
+  int render_workers = 1;  // threads that each own a GL context
+  int encode_threads = 2;  // PNG encoding pool
+  int network_threads = 1;
+  int png_level = 1;  // zlib level; see docs/performance.md for the measurement
+  std::filesystem::path assets_dir;
+
+  SceneLimits scene_limits{.max_beams = 10000,
+                           .max_occluders = 1000,
+                           .max_cameras = 64,
+                           .max_width = 4096,
+                           .max_height = 4096,
+                           .max_pixels = 4096LL * 4096LL,
+                           .max_mesh_triangles = 1000000};
+  std::uint64_t max_message_bytes = 16u << 20;
+  int max_inflight_per_connection = 16;
+  int max_inflight_total = 64;
+  int max_connections = 256;
+  std::uint64_t max_write_queue_bytes = 64u << 20;
+  int max_scenes = 256;
+  std::uint64_t max_scene_store_bytes = 64u << 20;
+  int idle_timeout_ms = 300000;
+  int read_timeout_ms = 10000;
+  int write_timeout_ms = 30000;
+  int drain_timeout_ms = 10000;  // on SIGINT/SIGTERM: how long in-flight work may finish
+};
+
+}  // namespace beamcast

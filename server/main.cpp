@@ -1,0 +1,85 @@
+// beamcast-server: the Beamcast render service (protocol/PROTOCOL.md).
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "protocol/scene_json.hpp"
+#include "server/demo_scene.hpp"
+#include "server/server.hpp"
+
+int main(int argc, char** argv) {
+  using namespace beamcast;
+  ServerConfig c;
+  c.assets_dir = BEAMCAST_DEFAULT_ASSETS;
+  std::string assets = c.assets_dir.string();
+  bool no_demo = false;
+  SceneLimits& l = c.scene_limits;
+
+  CLI::App app{"beamcast-server: headless energy-beam render service (protocol/PROTOCOL.md)"};
+  app.add_option("--bind", c.bind, "Address to listen on")->capture_default_str();
+  app.add_option("--port", c.port, "TCP port; 0 picks a free one (printed on the first line)")
+      ->capture_default_str();
+  app.add_option("--device", c.device_index, "EGL device index (-1: automatic)")->capture_default_str();
+  app.add_option("--platform", c.egl_platform, "EGL platform: auto, device or surfaceless")
+      ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
+  app.add_option("--render-workers", c.render_workers, "Render threads, each with a GL context")
+      ->check(CLI::Range(1, 64))->capture_default_str();
+  app.add_option("--encode-threads", c.encode_threads, "PNG encoding threads")
+      ->check(CLI::Range(1, 256))->capture_default_str();
+  app.add_option("--network-threads", c.network_threads, "Threads running connections")
+      ->check(CLI::Range(1, 64))->capture_default_str();
+  app.add_option("--png-level", c.png_level, "zlib level of PNG frames (docs/performance.md)")
+      ->check(CLI::Range(0, 9))->capture_default_str();
+  app.add_option("--assets", assets, "Directory scenes' mesh files are read from")->capture_default_str();
+  app.add_flag("--no-demo", no_demo, "Do not preload the scene 'demo'");
+  app.add_option("--max-message-bytes", c.max_message_bytes)->capture_default_str();
+  app.add_option("--max-width", l.max_width)->capture_default_str();
+  app.add_option("--max-height", l.max_height)->capture_default_str();
+  app.add_option("--max-pixels", l.max_pixels)->capture_default_str();
+  app.add_option("--max-cameras", l.max_cameras)->capture_default_str();
+  app.add_option("--max-beams", l.max_beams)->capture_default_str();
+  app.add_option("--max-occluders", l.max_occluders)->capture_default_str();
+  app.add_option("--max-mesh-triangles", l.max_mesh_triangles)->capture_default_str();
+  app.add_option("--max-inflight-per-connection", c.max_inflight_per_connection)->capture_default_str();
+  app.add_option("--max-inflight-total", c.max_inflight_total)->capture_default_str();
+  app.add_option("--max-connections", c.max_connections)->capture_default_str();
+  app.add_option("--max-write-queue-bytes", c.max_write_queue_bytes)->capture_default_str();
+  app.add_option("--max-scenes", c.max_scenes)->capture_default_str();
+  app.add_option("--max-scene-store-bytes", c.max_scene_store_bytes)->capture_default_str();
+  app.add_option("--idle-timeout-ms", c.idle_timeout_ms)->capture_default_str();
+  app.add_option("--read-timeout-ms", c.read_timeout_ms)->capture_default_str();
+  app.add_option("--write-timeout-ms", c.write_timeout_ms)->capture_default_str();
+  app.add_option("--drain-timeout-ms", c.drain_timeout_ms)->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  c.assets_dir = assets;
+
+  try {
+    RendererOptions ropts;
+    ropts.egl.device_index = c.device_index;
+    ropts.egl.platform = c.egl_platform;
+    Server server(c, gl_renderer_factory(ropts));
+    const unsigned short port = server.start();
+    // First line of output: tools and tests read the port from it.
+    std::printf("beamcast-server listening on %s:%u\n", c.bind.c_str(), port);
+    std::fflush(stdout);
+    std::fprintf(stderr, "beamcast-server: renderer: %s\n",
+                 server.core().renderer_description.c_str());
+    if (!no_demo) {
+      const auto j = nlohmann::json::parse(kDemoSceneJson);
+      SceneLoadOptions opts{c.assets_dir, c.scene_limits};
+      auto stored = std::make_shared<StoredScene>();
+      stored->scene = parse_scene(j, opts);
+      stored->bytes = j.dump().size();
+      stored->json = j;
+      server.core().scenes.put("demo", std::move(stored));
+      std::fprintf(stderr, "beamcast-server: scene 'demo' preloaded (the paper's 10 beam sets)\n");
+    }
+    server.run(/*handle_signals=*/true);
+    std::fprintf(stderr, "beamcast-server: stopped\n");
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "beamcast-server: %s\n", e.what());
+    return 1;
+  }
+}

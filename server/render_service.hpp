@@ -1,0 +1,98 @@
+// Render work: a bounded queue, worker threads that each own a renderer (and
+// so a GL context), and a CPU pool that encodes frames to PNG in parallel.
+// Sockets never reach here; GL never leaves the renderer behind FrameRenderer.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <boost/asio/thread_pool.hpp>
+
+#include "protocol/errors.hpp"
+#include "protocol/scene.hpp"
+#include "render/renderer.hpp"
+
+namespace beamcast {
+
+// What the service needs of a renderer; the GL one is the real thing, tests
+// may substitute another.
+class FrameRenderer {
+ public:
+  virtual ~FrameRenderer() = default;
+  virtual std::string description() const = 0;
+  virtual std::vector<FrameResult> render(const Scene& scene, const std::vector<Camera>& cameras) = 0;
+};
+
+// Called on each worker thread, so a GL context is created on the thread that uses it.
+using RendererFactory = std::function<std::unique_ptr<FrameRenderer>()>;
+// The GPU renderer (render/) behind the interface.
+RendererFactory gl_renderer_factory(const RendererOptions& opts);
+
+struct RenderOutcome {
+  bool dropped = false;  // the client went away before the job reached the GPU
+  std::optional<ErrorInfo> error;
+  std::vector<FrameResult> frames;  // images released after encoding
+  std::vector<std::vector<std::uint8_t>> pngs;
+  std::vector<double> encode_ms;  // per frame
+  double queue_ms = 0.0;
+  double render_ms = 0.0;
+  double encode_wall_ms = 0.0;
+};
+
+struct RenderJob {
+  std::shared_ptr<const Scene> scene;
+  std::vector<Camera> cameras;
+  std::shared_ptr<const std::atomic<bool>> client_alive;
+  std::chrono::steady_clock::time_point arrived;
+  // Called exactly once, on a worker or encoder thread.
+  std::function<void(RenderOutcome&&)> done;
+};
+
+class RenderService {
+ public:
+  RenderService(RendererFactory factory, int workers, int encode_threads, int png_level,
+                int max_inflight);
+  ~RenderService();
+
+  // Blocks until every worker has a renderer (or failed to get one); returns
+  // the first renderer's description, throws if none could be created.
+  std::string wait_ready();
+
+  // False if `max_inflight` jobs are already accepted and unanswered (busy).
+  bool submit(RenderJob job);
+  int inflight() const { return inflight_.load(); }
+  int queued() const;
+  // Stops the workers; jobs still queued are dropped (their `done` is called
+  // with dropped = true).
+  void stop();
+
+ private:
+  void worker_main(int index);
+  void finish(RenderJob& job, RenderOutcome&& outcome);
+
+  RendererFactory factory_;
+  int png_level_;
+  int max_inflight_;
+  std::atomic<int> inflight_{0};
+  mutable std::mutex mu_;
+  std::condition_variable cv_;
+  std::deque<RenderJob> queue_;
+  bool stopping_ = false;
+  int ready_ = 0;
+  std::string description_;
+  std::string failure_;
+  std::condition_variable ready_cv_;
+  std::vector<std::thread> workers_;
+  boost::asio::thread_pool encoders_;
+};
+
+}  // namespace beamcast

@@ -1,0 +1,277 @@
+#include "server/request_handler.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "protocol/request.hpp"
+#include "protocol/scene_json.hpp"
+#include "render/pass_plan.hpp"
+#include "server/session.hpp"
+
+namespace beamcast {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using json = nlohmann::json;
+
+[[noreturn]] void fail(std::string code, std::string path, std::string message) {
+  throw ProtocolError(ErrorInfo{std::move(code), std::move(message), std::move(path)});
+}
+
+double ms_since(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+SceneLoadOptions load_options(const ServerCore& core) {
+  SceneLoadOptions opts;
+  opts.assets_dir = core.config.assets_dir;
+  opts.limits = core.config.scene_limits;
+  return opts;
+}
+
+// Parses a scene that sits at `prefix` within the request.
+Scene parse_scene_at(const ServerCore& core, const json& scene_json, std::string_view prefix) {
+  try {
+    return parse_scene(scene_json, load_options(core));
+  } catch (const ProtocolError& e) {
+    throw ProtocolError(with_path_prefix(e.info(), prefix));
+  }
+}
+
+const json& required_object(const json& params, const char* key) {
+  auto it = params.find(key);
+  if (it == params.end()) fail("missing_field", std::string("/params/") + key, std::string(key) + " is required");
+  if (!it->is_object()) fail("wrong_type", std::string("/params/") + key, std::string(key) + " must be an object");
+  return *it;
+}
+
+json limits_json(const ServerConfig& c) {
+  const SceneLimits& l = c.scene_limits;
+  return {{"max_message_bytes", c.max_message_bytes},
+          {"max_width", l.max_width},
+          {"max_height", l.max_height},
+          {"max_pixels", l.max_pixels},
+          {"max_cameras", l.max_cameras},
+          {"max_beams", l.max_beams},
+          {"max_occluders", l.max_occluders},
+          {"max_mesh_triangles", l.max_mesh_triangles},
+          {"max_inflight_per_connection", c.max_inflight_per_connection},
+          {"max_inflight_total", c.max_inflight_total},
+          {"max_connections", c.max_connections},
+          {"max_write_queue_bytes", c.max_write_queue_bytes},
+          {"max_scenes", c.max_scenes},
+          {"max_scene_store_bytes", c.max_scene_store_bytes},
+          {"idle_timeout_ms", c.idle_timeout_ms},
+          {"read_timeout_ms", c.read_timeout_ms},
+          {"write_timeout_ms", c.write_timeout_ms}};
+}
+
+json hello_result(const ServerCore& core, const json& params) {
+  if (auto p = params.find("protocol"); p != params.end()) {
+    if (!p->is_number_integer()) fail("wrong_type", "/params/protocol", "protocol must be an integer");
+    if (p->get<long long>() != kProtocolVersion) {
+      fail("unsupported_protocol", "/params/protocol",
+           "this server speaks protocol " + std::to_string(kProtocolVersion));
+    }
+  }
+  json passes = json::array();
+  for (const PassRule& rule : pass_catalog()) passes.push_back(rule.name);
+  return {{"protocol", kProtocolVersion},
+          {"server", "beamcast-server 0.1.0"},
+          {"renderer", core.renderer_description},
+          {"methods", {"hello", "ping", "render", "scene.put", "scene.update", "scene.delete", "stats"}},
+          {"capabilities",
+           {{"formats", {"png"}},
+            {"encodings", {"binary", "base64"}},
+            {"beam_types", {"sphere", "capsule"}},
+            {"densities", {"abe", "shell", "linear", "quadratic", "gaussian", "table"}},
+            {"occluder_types", {"plane", "box", "sphere", "mesh"}},
+            {"passes", passes}}},
+          {"limits", limits_json(core.config)}};
+}
+
+json store_scene(ServerCore& core, const std::string& id, json scene_json, Scene scene) {
+  auto stored = std::make_shared<StoredScene>();
+  stored->bytes = scene_json.dump().size();
+  stored->json = std::move(scene_json);
+  stored->scene = std::move(scene);
+  const std::uint64_t bytes = stored->bytes;
+  const auto evicted = core.scenes.put(id, std::move(stored));
+  return {{"scene_id", id}, {"bytes", bytes}, {"evicted", evicted}};
+}
+
+json frame_name(const Camera& cam, std::size_t i) {
+  return cam.name.empty() ? "camera_" + std::to_string(i) : cam.name;
+}
+
+void handle_render(ServerCore& core, const std::shared_ptr<Session>& session, const json& id,
+                   const json& params, Clock::time_point arrived) {
+  const RenderParams rp = parse_render_params(params, core.config.scene_limits);
+  std::shared_ptr<const Scene> scene;
+  const json* scene_json = nullptr;
+  std::shared_ptr<const StoredScene> stored;
+  if (rp.scene) {
+    scene = std::make_shared<const Scene>(parse_scene_at(core, *rp.scene, "/params/scene"));
+    scene_json = &*rp.scene;
+  } else {
+    stored = core.scenes.get(*rp.scene_id);
+    if (!stored) fail("unknown_scene", "/params/scene_id", "no stored scene \"" + *rp.scene_id + "\"");
+    scene = std::shared_ptr<const Scene>(stored, &stored->scene);  // keeps the entry alive
+    scene_json = &stored->json;
+  }
+  if (rp.output) {
+    json merged = scene_json->value("output", json::object());
+    merged.merge_patch(*rp.output);
+    auto copy = std::make_shared<Scene>(*scene);
+    copy->output = parse_output_settings(merged, "/params/output");
+    scene = std::move(copy);
+  }
+  std::vector<Camera> cameras = rp.cameras ? *rp.cameras : scene->cameras;
+
+  if (!session->try_begin_render()) {
+    fail("busy", "", "max_inflight_per_connection (" +
+                         std::to_string(core.config.max_inflight_per_connection) +
+                         ") requests already in flight on this connection; retry later");
+  }
+  RenderJob job;
+  job.scene = scene;
+  job.cameras = cameras;
+  job.client_alive = session->alive_flag();
+  job.arrived = arrived;
+  job.done = [&core, session, id, cameras, arrived, base64 = rp.base64,
+              passes = plan_passes(*scene), bit_depth = scene->output.bit_depth](
+                 RenderOutcome&& out) {
+    session->end_render();
+    if (out.dropped) return;
+    if (out.error) {
+      session->send_error(id, *out.error);
+      return;
+    }
+    json frames = json::array();
+    std::vector<std::uint8_t> binary;
+    double readback_ms = 0.0;
+    for (std::size_t i = 0; i < out.frames.size(); ++i) {
+      const FrameResult& fr = out.frames[i];
+      json pass_ms = json::object();
+      for (const PassTiming& p : fr.passes) pass_ms[p.name] = p.gpu_ms;
+      json f = {{"camera", frame_name(cameras[i], i)},
+                {"index", i},
+                {"width", cameras[i].width},
+                {"height", cameras[i].height},
+                {"format", "png"},
+                {"bit_depth", bit_depth},
+                {"gpu_ms", fr.gpu_ms},
+                {"pass_ms", pass_ms},
+                {"readback_ms", fr.readback_ms},
+                {"encode_ms", out.encode_ms[i]}};
+      readback_ms += fr.readback_ms;
+      if (base64) {
+        f["data_base64"] = base64_encode(out.pngs[i]);
+      } else {
+        f["attachment"] = {{"offset", binary.size()}, {"length", out.pngs[i].size()}};
+        binary.insert(binary.end(), out.pngs[i].begin(), out.pngs[i].end());
+      }
+      frames.push_back(std::move(f));
+    }
+    json result = {{"passes", passes},
+                   {"frames", std::move(frames)},
+                   {"timings",
+                    {{"queue_ms", out.queue_ms},
+                     {"render_ms", out.render_ms},
+                     {"readback_ms", readback_ms},
+                     {"encode_ms", out.encode_wall_ms},
+                     {"server_ms", ms_since(arrived)}}}};
+    core.stats.count_frames(out.frames.size());
+    session->send(ok_response(id, std::move(result)), std::move(binary));
+  };
+  if (!core.renders->submit(std::move(job))) {
+    session->end_render();
+    fail("busy", "", "the server has max_inflight_total (" +
+                         std::to_string(core.config.max_inflight_total) +
+                         ") renders in flight; retry later");
+  }
+}
+
+}  // namespace
+
+std::string base64_encode(const std::vector<std::uint8_t>& in) {
+  static const char* kAlphabet =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((in.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    const std::uint32_t v = (in[i] << 16) | (in[i + 1] << 8) | in[i + 2];
+    for (int k = 18; k >= 0; k -= 6) out.push_back(kAlphabet[(v >> k) & 63]);
+  }
+  if (i < in.size()) {
+    std::uint32_t v = in[i] << 16;
+    if (i + 1 < in.size()) v |= in[i + 1] << 8;
+    out.push_back(kAlphabet[(v >> 18) & 63]);
+    out.push_back(kAlphabet[(v >> 12) & 63]);
+    out.push_back(i + 1 < in.size() ? kAlphabet[(v >> 6) & 63] : '=');
+    out.push_back('=');
+  }
+  return out;
+}
+
+void handle_message(ServerCore& core, const std::shared_ptr<Session>& session,
+                    std::string_view json_text, Clock::time_point arrived) {
+  json id;
+  try {
+    const Request req = parse_request(json_text, &id);
+    static const char* kMethods[] = {"hello", "ping", "stats", "render", "scene.put",
+                                     "scene.update", "scene.delete"};
+    // Count unknown methods under one key: client-chosen strings must not grow the map.
+    const bool known = std::any_of(std::begin(kMethods), std::end(kMethods),
+                                   [&](const char* m) { return req.method == m; });
+    core.stats.count_request(known ? req.method : "(unknown)");
+    const json& params = req.params;
+    const bool mutating = req.method == "render" || req.method.starts_with("scene.");
+    if (mutating && core.shutting_down.load()) {
+      fail("shutting_down", "", "the server is shutting down and takes no new work");
+    }
+    if (req.method == "hello") {
+      session->send(ok_response(id, hello_result(core, params)));
+    } else if (req.method == "ping") {
+      session->send(ok_response(id, {{"echo", params}}));
+    } else if (req.method == "stats") {
+      json s = core.stats.to_json();
+      s["inflight"] = core.renders->inflight();
+      s["queue_depth"] = core.renders->queued();
+      s["scenes"] = {{"count", core.scenes.count()}, {"bytes", core.scenes.bytes()}};
+      session->send(ok_response(id, std::move(s)));
+    } else if (req.method == "render") {
+      handle_render(core, session, id, params, arrived);
+    } else if (req.method == "scene.put") {
+      const std::string sid = parse_scene_id(params, "/params/scene_id");
+      const json& sj = required_object(params, "scene");
+      Scene scene = parse_scene_at(core, sj, "/params/scene");
+      session->send(ok_response(id, store_scene(core, sid, sj, std::move(scene))));
+    } else if (req.method == "scene.update") {
+      const std::string sid = parse_scene_id(params, "/params/scene_id");
+      const json& patch = required_object(params, "patch");
+      auto stored = core.scenes.get(sid);
+      if (!stored) fail("unknown_scene", "/params/scene_id", "no stored scene \"" + sid + "\"");
+      json merged = stored->json;
+      merged.merge_patch(patch);
+      Scene scene = parse_scene_at(core, merged, "/params/patch");
+      session->send(ok_response(id, store_scene(core, sid, std::move(merged), std::move(scene))));
+    } else if (req.method == "scene.delete") {
+      const std::string sid = parse_scene_id(params, "/params/scene_id");
+      if (!core.scenes.erase(sid)) fail("unknown_scene", "/params/scene_id", "no stored scene \"" + sid + "\"");
+      session->send(ok_response(id, {{"deleted", true}}));
+    } else {
+      fail("unknown_method", "/method",
+           "unknown method \"" + req.method +
+               "\" (hello, ping, render, scene.put, scene.update, scene.delete, stats)");
+    }
+  } catch (const ProtocolError& e) {
+    session->send_error(id, e.info());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "beamcast-server: internal error: %s\n", e.what());
+    session->send_error(id, ErrorInfo{"internal", e.what(), ""});
+  }
+}
+
+}  // namespace beamcast

@@ -1,0 +1,21 @@
+// What each method does (PROTOCOL.md, "Methods"). Runs on the session's strand;
+// render work is handed to the RenderService and answered when it completes.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <string_view>
+
+#include "server/server_core.hpp"
+
+namespace beamcast {
+
+class Session;
+
+void handle_message(ServerCore& core, const std::shared_ptr<Session>& session,
+                    std::string_view json_text, std::chrono::steady_clock::time_point arrived);
+
+// Standard base64 (RFC 4648) for the "base64" encoding of frames.
+std::string base64_encode(const std::vector<std::uint8_t>& bytes);
+
+}  // namespace beamcast

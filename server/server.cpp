@@ -1,0 +1,141 @@
+#include "server/server.hpp"
+
+#include <boost/asio/post.hpp>
+#include <boost/asio/strand.hpp>
+#include <boost/asio/write.hpp>
+
+#include <cstdio>
+#include <csignal>
+
+#include "protocol/framing.hpp"
+#include "protocol/request.hpp"
+#include "server/session.hpp"
+
+namespace beamcast {
+
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+
+Server::Server(const ServerConfig& config, RendererFactory renderers)
+    : core_(config),
+      factory_(std::move(renderers)),
+      acceptor_(io_),
+      signals_(io_),
+      drain_timer_(io_) {}
+
+Server::~Server() {
+  // Workers and encoders call into sessions; stop them before the io_context
+  // (and the handlers that hold sessions) goes away.
+  if (core_.renders) core_.renders->stop();
+}
+
+unsigned short Server::start() {
+  const ServerConfig& c = core_.config;
+  core_.renders = std::make_unique<RenderService>(factory_, c.render_workers, c.encode_threads,
+                                                  c.png_level, c.max_inflight_total);
+  core_.renderer_description = core_.renders->wait_ready();
+  const tcp::endpoint ep(asio::ip::make_address(c.bind), c.port);
+  acceptor_.open(ep.protocol());
+  acceptor_.set_option(tcp::acceptor::reuse_address(true));
+  acceptor_.bind(ep);
+  acceptor_.listen(asio::socket_base::max_listen_connections);
+  do_accept();
+  return acceptor_.local_endpoint().port();
+}
+
+void Server::do_accept() {
+  acceptor_.async_accept(asio::make_strand(io_), [this](const boost::system::error_code& ec,
+                                                        tcp::socket socket) {
+    if (ec) {
+      if (ec != asio::error::operation_aborted) {
+        std::fprintf(stderr, "beamcast-server: accept: %s\n", ec.message().c_str());
+      }
+      if (!acceptor_.is_open()) return;
+      do_accept();
+      return;
+    }
+    if (core_.stats.connections_open() >= core_.config.max_connections) {
+      // Over the limit: one error, then close; the other clients carry on.
+      const ErrorInfo e{"busy",
+                        "max_connections (" + std::to_string(core_.config.max_connections) +
+                            ") reached; retry later",
+                        ""};
+      core_.stats.count_error(e.code);
+      auto frame = std::make_shared<std::vector<std::uint8_t>>(
+          encode_frame(error_response(nullptr, e).dump()));
+      auto sock = std::make_shared<tcp::socket>(std::move(socket));
+      asio::async_write(*sock, asio::buffer(*frame),
+                        [sock, frame](const boost::system::error_code&, std::size_t) {
+                          boost::system::error_code ignored;
+                          sock->close(ignored);
+                        });
+    } else {
+      auto session = std::make_shared<Session>(std::move(socket), core_);
+      {
+        std::lock_guard lock(sessions_mu_);
+        std::erase_if(sessions_, [](const auto& w) { return w.expired(); });
+        sessions_.push_back(session);
+      }
+      session->start();
+    }
+    do_accept();
+  });
+}
+
+void Server::run(bool handle_signals) {
+  if (handle_signals) {
+    signals_.add(SIGINT);
+    signals_.add(SIGTERM);
+    signals_.async_wait([this](const boost::system::error_code& ec, int sig) {
+      if (ec) return;
+      std::fprintf(stderr, "beamcast-server: signal %d: shutting down\n", sig);
+      shutdown();
+    });
+  }
+  std::vector<std::thread> extra;
+  for (int i = 1; i < core_.config.network_threads; ++i) extra.emplace_back([this] { io_.run(); });
+  io_.run();
+  for (auto& t : extra) t.join();
+}
+
+void Server::shutdown() {
+  asio::post(io_, [this] {
+    if (core_.shutting_down.exchange(true)) return;
+    boost::system::error_code ignored;
+    acceptor_.close(ignored);
+    signals_.cancel(ignored);
+    drain_step(std::chrono::steady_clock::now() +
+               std::chrono::milliseconds(core_.config.drain_timeout_ms));
+  });
+}
+
+void Server::drain_step(std::chrono::steady_clock::time_point deadline) {
+  if (core_.renders->inflight() > 0 && std::chrono::steady_clock::now() < deadline) {
+    drain_timer_.expires_after(std::chrono::milliseconds(20));
+    drain_timer_.async_wait([this, deadline](const boost::system::error_code& ec) {
+      if (!ec) drain_step(deadline);
+    });
+    return;
+  }
+  if (core_.renders->inflight() > 0) {
+    std::fprintf(stderr, "beamcast-server: drain deadline passed with %d renders in flight\n",
+                 core_.renders->inflight());
+  }
+  // Let the last responses reach their sockets, then close everything.
+  drain_timer_.expires_after(std::chrono::milliseconds(50));
+  drain_timer_.async_wait([this](const boost::system::error_code&) {
+    std::vector<std::shared_ptr<Session>> open;
+    {
+      std::lock_guard lock(sessions_mu_);
+      for (auto& w : sessions_) {
+        if (auto s = w.lock()) open.push_back(std::move(s));
+      }
+      sessions_.clear();
+    }
+    for (auto& s : open) s->close();
+    core_.renders->stop();
+    io_.stop();
+  });
+}
+
+}  // namespace beamcast

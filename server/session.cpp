@@ -1,0 +1,248 @@
+#include "server/session.hpp"
+
+#include <boost/asio/post.hpp>
+#include <boost/asio/read.hpp>
+#include <boost/asio/write.hpp>
+
+#include <algorithm>
+#include <cstdio>
+
+#include "protocol/request.hpp"
+#include "server/request_handler.hpp"
+
+namespace beamcast {
+
+namespace asio = boost::asio;
+using Clock = std::chrono::steady_clock;
+
+Session::Session(asio::ip::tcp::socket socket, ServerCore& core)
+    : socket_(std::move(socket)),
+      core_(core),
+      read_timer_(socket_.get_executor()),
+      write_timer_(socket_.get_executor()),
+      alive_(std::make_shared<std::atomic<bool>>(true)) {
+  core_.stats.connection_opened();
+}
+
+Session::~Session() { core_.stats.connection_closed(); }
+
+void Session::start() {
+  asio::post(socket_.get_executor(), [self = shared_from_this()] { self->do_read_header(); });
+}
+
+void Session::do_read_header() {
+  if (closed_) return;
+  state_ = ReadState::kHeader;
+  if (paused_) return;  // resumed by on_write once the client has read enough
+  arm_read_deadline();
+  read_pending_ = true;
+  asio::async_read(socket_, asio::buffer(header_),
+                   [self = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
+                     self->on_header(ec, n);
+                   });
+}
+
+void Session::on_header(const boost::system::error_code& ec, std::size_t) {
+  read_pending_ = false;
+  if (ec || closed_) {
+    close_now();  // peer closed or reset: nothing to answer
+    return;
+  }
+  FrameHeader h;
+  switch (parse_frame_header(header_, core_.config.max_message_bytes, &h)) {
+    case HeaderStatus::kOk:
+      break;
+    case HeaderStatus::kBadMagic:
+    case HeaderStatus::kEmptyJson: {
+      // The stream cannot be resynchronized: answer once, then close.
+      state_ = ReadState::kStopped;
+      read_timer_.cancel();
+      const ErrorInfo e{"bad_framing",
+                        "expected a frame starting with \"BCP1\" and a non-zero JSON length "
+                        "(see PROTOCOL.md, Framing)",
+                        ""};
+      core_.stats.count_error(e.code);
+      enqueue(encode_frame(error_response(nullptr, e).dump()), true);
+      return;
+    }
+    case HeaderStatus::kTooLarge: {
+      const ErrorInfo e{"message_too_large",
+                        "message body of " + std::to_string(h.body_length()) +
+                            " bytes exceeds max_message_bytes (" +
+                            std::to_string(core_.config.max_message_bytes) + ")",
+                        ""};
+      send_error(nullptr, e);
+      discard_left_ = h.body_length();
+      state_ = ReadState::kDiscard;
+      arm_read_deadline();
+      do_discard();
+      return;
+    }
+  }
+  body_.resize(h.body_length());
+  state_ = ReadState::kBody;
+  arm_read_deadline();
+  read_pending_ = true;
+  asio::async_read(socket_, asio::buffer(body_),
+                   [self = shared_from_this(), json_len = h.json_length](
+                       const boost::system::error_code& ec, std::size_t n) {
+                     self->read_pending_ = false;
+                     if (!ec) self->body_.resize(json_len);  // v1 requests carry no attachments
+                     self->on_body(ec, n);
+                   });
+}
+
+void Session::on_body(const boost::system::error_code& ec, std::size_t) {
+  if (ec || closed_) {
+    close_now();
+    return;
+  }
+  const std::string text(body_.begin(), body_.end());
+  body_.clear();
+  body_.shrink_to_fit();
+  handle_message(core_, shared_from_this(), text, Clock::now());
+  do_read_header();
+}
+
+void Session::do_discard() {
+  if (discard_left_ == 0) {
+    do_read_header();
+    return;
+  }
+  body_.resize(static_cast<std::size_t>(std::min<std::uint64_t>(discard_left_, 64 * 1024)));
+  read_pending_ = true;
+  asio::async_read(socket_, asio::buffer(body_),
+                   [self = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
+                     self->read_pending_ = false;
+                     if (ec || self->closed_) {
+                       self->close_now();
+                       return;
+                     }
+                     self->discard_left_ -= n;
+                     self->do_discard();
+                   });
+}
+
+void Session::arm_read_deadline() {
+  const int ms =
+      state_ == ReadState::kHeader ? core_.config.idle_timeout_ms : core_.config.read_timeout_ms;
+  read_timer_.expires_after(std::chrono::milliseconds(ms));
+  read_timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+    self->on_read_deadline(ec);
+  });
+}
+
+void Session::on_read_deadline(const boost::system::error_code& ec) {
+  if (ec == asio::error::operation_aborted || closed_) return;
+  if (read_timer_.expiry() > Clock::now()) return;  // re-armed since this wait began
+  if (state_ == ReadState::kHeader) {
+    if (!read_pending_) return;  // paused, not idle
+    std::fprintf(stderr, "beamcast-server: closing idle connection\n");
+    close_now();
+    return;
+  }
+  if (state_ == ReadState::kBody || state_ == ReadState::kDiscard) {
+    const ErrorInfo e{"timeout",
+                      "message incomplete after read_timeout_ms (" +
+                          std::to_string(core_.config.read_timeout_ms) + " ms)",
+                      ""};
+    core_.stats.count_error(e.code);
+    state_ = ReadState::kStopped;
+    boost::system::error_code ignored;
+    socket_.shutdown(asio::ip::tcp::socket::shutdown_receive, ignored);
+    enqueue(encode_frame(error_response(nullptr, e).dump()), true);
+  }
+}
+
+void Session::send(const nlohmann::json& response, std::vector<std::uint8_t> binary) {
+  auto frame = encode_frame(response.dump(), binary);
+  core_.stats.count_bytes_out(frame.size());
+  asio::post(socket_.get_executor(), [self = shared_from_this(), f = std::move(frame)]() mutable {
+    self->enqueue(std::move(f), false);
+  });
+}
+
+void Session::send_error(const nlohmann::json& id, const ErrorInfo& error) {
+  core_.stats.count_error(error.code);
+  send(error_response(id, error));
+}
+
+void Session::enqueue(std::vector<std::uint8_t> frame, bool close_after) {
+  if (closed_) return;
+  queued_bytes_ += frame.size();
+  writes_.push_back(std::move(frame));
+  if (close_after) close_after_write_ = true;
+  if (queued_bytes_ > core_.config.max_write_queue_bytes) paused_ = true;
+  if (!writing_) do_write();
+}
+
+void Session::do_write() {
+  writing_ = true;
+  write_timer_.expires_after(std::chrono::milliseconds(core_.config.write_timeout_ms));
+  write_timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+    if (ec == asio::error::operation_aborted || self->closed_) return;
+    if (self->write_timer_.expiry() > Clock::now()) return;
+    std::fprintf(stderr, "beamcast-server: client did not read for write_timeout_ms; closing\n");
+    self->close_now();
+  });
+  asio::async_write(socket_, asio::buffer(writes_.front()),
+                    [self = shared_from_this()](const boost::system::error_code& ec,
+                                                std::size_t n) { self->on_write(ec, n); });
+}
+
+void Session::on_write(const boost::system::error_code& ec, std::size_t) {
+  write_timer_.cancel();
+  if (ec || closed_) {
+    close_now();
+    return;
+  }
+  queued_bytes_ -= writes_.front().size();
+  writes_.pop_front();
+  if (!writes_.empty()) {
+    do_write();
+    return;
+  }
+  writing_ = false;
+  if (close_after_write_) {
+    close_now();
+    return;
+  }
+  resume_reading_if_paused();
+}
+
+void Session::resume_reading_if_paused() {
+  if (paused_ && queued_bytes_ <= core_.config.max_write_queue_bytes / 2) {
+    paused_ = false;
+    if (state_ == ReadState::kHeader && !read_pending_) do_read_header();
+  }
+}
+
+bool Session::try_begin_render() {
+  int current = inflight_.load();
+  do {
+    if (current >= core_.config.max_inflight_per_connection) return false;
+  } while (!inflight_.compare_exchange_weak(current, current + 1));
+  return true;
+}
+
+void Session::end_render() { inflight_.fetch_sub(1); }
+
+void Session::close() {
+  asio::post(socket_.get_executor(), [self = shared_from_this()] { self->close_now(); });
+}
+
+void Session::close_now() {
+  if (closed_) return;
+  closed_ = true;
+  alive_->store(false);  // queued renders of this client are dropped
+  state_ = ReadState::kStopped;
+  read_timer_.cancel();
+  write_timer_.cancel();
+  boost::system::error_code ignored;
+  socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
+  socket_.close(ignored);
+  writes_.clear();
+  queued_bytes_ = 0;
+}
+
+}  // namespace beamcast

@@ -1,0 +1,77 @@
+// One client connection: owns its socket, read buffers and write queue, and
+// runs every handler on its own strand (Beast's async-session shape). A
+// deadline guards every read and write.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <vector>
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <nlohmann/json.hpp>
+
+#include "protocol/errors.hpp"
+#include "protocol/framing.hpp"
+#include "server/server_core.hpp"
+
+namespace beamcast {
+
+class Session : public std::enable_shared_from_this<Session> {
+ public:
+  Session(boost::asio::ip::tcp::socket socket, ServerCore& core);
+  ~Session();
+
+  void start();
+  // Thread-safe: queues one response frame for writing.
+  void send(const nlohmann::json& response, std::vector<std::uint8_t> binary = {});
+  void send_error(const nlohmann::json& id, const ErrorInfo& error);
+  // Thread-safe: closes the connection (pending writes are dropped).
+  void close();
+
+  // Per-connection admission of render work (thread-safe).
+  bool try_begin_render();
+  void end_render();
+  std::shared_ptr<const std::atomic<bool>> alive_flag() const { return alive_; }
+
+ private:
+  enum class ReadState { kHeader, kBody, kDiscard, kStopped };
+
+  void do_read_header();
+  void on_header(const boost::system::error_code& ec, std::size_t n);
+  void do_read_body();
+  void on_body(const boost::system::error_code& ec, std::size_t n);
+  void do_discard();
+  void arm_read_deadline();
+  void on_read_deadline(const boost::system::error_code& ec);
+  void enqueue(std::vector<std::uint8_t> frame, bool close_after);
+  void do_write();
+  void on_write(const boost::system::error_code& ec, std::size_t n);
+  void resume_reading_if_paused();
+  void close_now();
+
+  boost::asio::ip::tcp::socket socket_;
+  ServerCore& core_;
+  boost::asio::steady_timer read_timer_;
+  boost::asio::steady_timer write_timer_;
+  std::shared_ptr<std::atomic<bool>> alive_;
+  std::atomic<int> inflight_{0};
+
+  // Strand-only state.
+  ReadState state_ = ReadState::kHeader;
+  bool read_pending_ = false;  // an async read is outstanding
+  bool paused_ = false;        // reading stopped: write queue over its limit
+  std::array<std::uint8_t, kFrameHeaderSize> header_{};
+  std::vector<std::uint8_t> body_;
+  std::uint64_t discard_left_ = 0;
+  std::deque<std::vector<std::uint8_t>> writes_;
+  std::uint64_t queued_bytes_ = 0;
+  bool writing_ = false;
+  bool close_after_write_ = false;
+  bool closed_ = false;
+};
+
+}  // namespace beamcast
