@@ -114,6 +114,7 @@ void RenderService::worker_main(int index) {
     out.queue_ms = ms_between(job.arrived, start);
     if (!job.client_alive->load()) {
       out.dropped = true;  // a disconnected client costs no GPU time
+      dropped_.fetch_add(1);
       finish(job, std::move(out));
       continue;
     }

@@ -71,6 +71,8 @@ class RenderService {
   bool submit(RenderJob job);
   int inflight() const { return inflight_.load(); }
   int queued() const;
+  // Jobs dropped because their client had gone (never rendered).
+  std::uint64_t dropped() const { return dropped_.load(); }
   // Stops the workers; jobs still queued are dropped (their `done` is called
   // with dropped = true).
   void stop();
@@ -83,6 +85,7 @@ class RenderService {
   int png_level_;
   int max_inflight_;
   std::atomic<int> inflight_{0};
+  std::atomic<std::uint64_t> dropped_{0};
   mutable std::mutex mu_;
   std::condition_variable cv_;
   std::deque<RenderJob> queue_;
