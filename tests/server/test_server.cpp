@@ -392,13 +392,18 @@ TEST(Server, DisconnectMidRequestLeavesServerHealthy) {
     // Gone before the answers: queued work must be dropped, not rendered.
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  while (s.core().renders->inflight() > 0 && std::chrono::steady_clock::now() < deadline) {
+  // Wait until the server has read all ten requests and finished with them.
+  auto settled = [&s] {
+    const json st = s.core().stats.to_json();
+    return st["requests"].value("render", 0) == 10 && s.core().renders->inflight() == 0;
+  };
+  while (!settled() && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   EXPECT_EQ(s.core().renders->inflight(), 0);
   // Each 384x384 render takes tens of milliseconds, the disconnect arrives
   // within one: most of the ten were still queued and never reached the GPU.
-  EXPECT_GE(s.core().renders->dropped(), 1u);
+  EXPECT_GE(s.core().renders->dropped(), 1u) << s.core().stats.to_json();
   EXPECT_TRUE(s.healthy());
   Conn c(s.port());
   EXPECT_TRUE(c.call(render_req(1, small_scene())).json["ok"]);
