@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   beamcast::cli::add_render_command(app);
   beamcast::cli::add_info_command(app);
+  beamcast::cli::add_server_commands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

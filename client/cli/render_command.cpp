@@ -134,24 +134,62 @@ int run_render(const RenderArgs& args) {
 
 void add_render_command(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
-  CLI::App* cmd = app.add_subcommand("render", "Render a scene file to one PNG per camera");
-  cmd->add_option("scene", args->scene, "Scene JSON file (docs/scene-format.md)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  auto remote = std::make_shared<RemoteRenderArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "render", "Render a scene to one PNG per camera, offline or on a beamcast-server");
+  CLI::Option* scene =
+      cmd->add_option("scene", args->scene, "Scene JSON file (docs/scene-format.md)")
+          ->check(CLI::ExistingFile);
   cmd->add_option("--out,-o", args->out, "Output directory (created if missing)");
-  cmd->add_option("--assets", args->assets,
-                  "Directory mesh files are read from (default: the scene file's directory)");
-  cmd->add_flag("--reference", args->reference,
-                "Render with the double-precision CPU reference instead of the GPU");
+  CLI::Option* assets =
+      cmd->add_option("--assets", args->assets,
+                      "Directory mesh files are read from (default: the scene file's directory)");
+  CLI::Option* reference =
+      cmd->add_flag("--reference", args->reference,
+                    "Render with the double-precision CPU reference instead of the GPU");
   cmd->add_flag("--json", args->json, "Print a machine-readable summary on stdout");
-  cmd->add_flag("--hdr", args->hdr, "Also write the linear HDR buffer (.rgb32f, float32 RGB)");
-  cmd->add_option("--device", args->device,
-                  "EGL device index (default: $BEAMCAST_EGL_DEVICE, else the first that works)");
-  cmd->add_option("--platform", args->platform, "EGL platform: auto, device or surfaceless")
-      ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
-  cmd->add_option("--threads", args->threads, "CPU reference threads (0: all cores)");
-  cmd->callback([args] {
-    const int rc = run_render(*args);
+  CLI::Option* hdr =
+      cmd->add_flag("--hdr", args->hdr, "Also write the linear HDR buffer (.rgb32f, float32 RGB)");
+  CLI::Option* device = cmd->add_option(
+      "--device", args->device,
+      "EGL device index (default: $BEAMCAST_EGL_DEVICE, else the first that works)");
+  CLI::Option* platform =
+      cmd->add_option("--platform", args->platform, "EGL platform: auto, device or surfaceless")
+          ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
+  CLI::Option* threads =
+      cmd->add_option("--threads", args->threads, "CPU reference threads (0: all cores)");
+
+  // Rendering on a server: the scene file is sent inline, or a stored scene named.
+  CLI::Option* server = cmd->add_option(
+      "--server", remote->server, "Render on the beamcast-server at HOST:PORT instead of locally");
+  cmd->add_option("--scene-id", remote->scene_id, "With --server: render this stored scene")
+      ->needs(server)
+      ->excludes(scene);
+  cmd->add_option("--encoding", remote->encoding,
+                  "With --server: PNG transport, binary (attachments) or base64")
+      ->check(CLI::IsMember({"binary", "base64"}))
+      ->needs(server);
+  cmd->add_option("--timeout", remote->timeout_s, "With --server: seconds to wait for the frames")
+      ->check(CLI::PositiveNumber)
+      ->needs(server);
+  // Options of the local renderer mean nothing to a server render.
+  for (CLI::Option* local : {assets, reference, hdr, device, platform, threads})
+    server->excludes(local);
+
+  cmd->callback([args, remote] {
+    int rc = 0;
+    if (!remote->server.empty()) {
+      if (args->scene.empty() && remote->scene_id.empty()) {
+        throw CLI::ValidationError("render --server needs a scene file or --scene-id");
+      }
+      remote->scene = args->scene;
+      remote->out = args->out;
+      remote->json = args->json;
+      rc = run_remote_render(*remote);
+    } else {
+      if (args->scene.empty()) throw CLI::RequiredError("scene");
+      rc = run_render(*args);
+    }
     if (rc != 0) throw CLI::RuntimeError(rc);
   });
 }

@@ -1,0 +1,193 @@
+#!/usr/bin/env python3
+"""Beamcast wire-protocol client (protocol/PROTOCOL.md), standard library only.
+
+As a module:
+    c = BeamcastClient("127.0.0.1", 7878)
+    frames, result = c.render(scene_id="demo")   # frames: list of dicts with "png" bytes
+As a script:
+    beamcast_client.py --server 127.0.0.1:7878 --scene-id demo --out /tmp/frame.png
+    beamcast_client.py --server 127.0.0.1:7878 --scene scene.json --out /tmp/frame.png
+"""
+import argparse
+import base64
+import itertools
+import json
+import socket
+import struct
+import sys
+import time
+
+MAGIC = b"BCP1"
+HEADER = struct.Struct(">4sII")  # magic, json_length, binary_length (big-endian)
+
+
+class ServerError(Exception):
+    """The server answered ok: false; code/message/path as in PROTOCOL.md."""
+
+    def __init__(self, error):
+        self.code = error.get("code", "")
+        self.message = error.get("message", "")
+        self.path = error.get("path", "")
+        super().__init__(f"[{self.code}] {self.path + ': ' if self.path else ''}{self.message}")
+
+
+class BeamcastClient:
+    def __init__(self, host="127.0.0.1", port=7878, timeout=60.0):
+        self.sock = None
+        self._ids = itertools.count(1)
+        self._kept = {}  # responses that arrived while waiting for another id
+        if host is not None:
+            self.connect(host, port, timeout)
+
+    def connect(self, host, port, timeout=60.0):
+        self.sock = socket.create_connection((host, port), timeout=timeout)
+        # Requests are small and latency is measured: do not let Nagle delay them.
+        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+
+    def close(self):
+        if self.sock:
+            self.sock.close()
+            self.sock = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    # --- framing ---
+    def send(self, method, params=None, request_id=None):
+        """Writes one request frame; returns its id (pipelining: receive later)."""
+        rid = next(self._ids) if request_id is None else request_id
+        req = {"id": rid, "method": method}
+        if params is not None:
+            req["params"] = params
+        body = json.dumps(req, separators=(",", ":")).encode()
+        self.sock.sendall(HEADER.pack(MAGIC, len(body), 0) + body)
+        return rid
+
+    def _read_exact(self, n):
+        chunks = bytearray()
+        while len(chunks) < n:
+            got = self.sock.recv(min(n - len(chunks), 1 << 20))
+            if not got:
+                raise ConnectionError("server closed the connection")
+            chunks += got
+        return bytes(chunks)
+
+    def receive(self):
+        """Reads the next frame: (response dict, binary bytes)."""
+        magic, json_len, bin_len = HEADER.unpack(self._read_exact(HEADER.size))
+        if magic != MAGIC:
+            raise ConnectionError(f"not a Beamcast frame (magic {magic!r})")
+        msg = json.loads(self._read_exact(json_len))
+        return msg, self._read_exact(bin_len)
+
+    def receive_for(self, rid):
+        """The response to `rid`; others are kept. A null id (the server could not
+        read the request's id) is returned too: it can match nothing else."""
+        if rid in self._kept:
+            return self._kept.pop(rid)
+        while True:
+            msg, binary = self.receive()
+            if msg.get("id") == rid or msg.get("id") is None:
+                return msg, binary
+            self._kept[msg.get("id")] = (msg, binary)
+
+    def call(self, method, params=None):
+        """send + receive_for; returns (result, binary) or raises ServerError."""
+        msg, binary = self.receive_for(self.send(method, params))
+        if not msg.get("ok"):
+            raise ServerError(msg.get("error", {}))
+        return msg.get("result", {}), binary
+
+    # --- methods ---
+    def hello(self, client="beamcast-py/0.1.0"):
+        return self.call("hello", {"protocol": 1, "client": client})[0]
+
+    def ping(self, payload=None):
+        return self.call("ping", payload if payload is not None else {})[0]
+
+    def stats(self):
+        return self.call("stats")[0]
+
+    def scene_put(self, scene_id, scene):
+        return self.call("scene.put", {"scene_id": scene_id, "scene": scene})[0]
+
+    def render(self, scene=None, scene_id=None, encoding="binary", cameras=None, output=None):
+        """Returns (frames, result); each frame is the server's dict plus "png" bytes,
+        result["client_e2e_ms"] is the client-measured wall time of the request."""
+        if (scene is None) == (scene_id is None):
+            raise ValueError("give exactly one of scene, scene_id")
+        params = {"scene": scene} if scene is not None else {"scene_id": scene_id}
+        params["encoding"] = encoding
+        if cameras is not None:
+            params["cameras"] = cameras
+        if output is not None:
+            params["output"] = output
+        t0 = time.perf_counter()
+        result, binary = self.call("render", params)
+        result["client_e2e_ms"] = (time.perf_counter() - t0) * 1000.0
+        frames = []
+        for f in result["frames"]:
+            f = dict(f)
+            if "attachment" in f:
+                off, n = f["attachment"]["offset"], f["attachment"]["length"]
+                if off + n > len(binary):
+                    raise ConnectionError(f"frame {f['camera']}: attachment outside binary part")
+                f["png"] = binary[off:off + n]
+            else:
+                f["png"] = base64.b64decode(f["data_base64"], validate=True)
+            frames.append(f)
+        return frames, result
+
+
+def parse_server(text):
+    host, sep, port = text.rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ValueError(f"--server {text!r}: expected HOST:PORT with PORT in 1..65535")
+    return host.strip("[]"), int(port)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description="Render on a beamcast-server, save the first frame")
+    ap.add_argument("--server", default="127.0.0.1:7878", help="HOST:PORT")
+    src = ap.add_mutually_exclusive_group(required=True)
+    src.add_argument("--scene", help="scene JSON file, sent inline")
+    src.add_argument("--scene-id", help="a scene stored on the server (e.g. demo)")
+    ap.add_argument("--out", default="frame.png", help="where the first frame's PNG goes")
+    ap.add_argument("--encoding", choices=["binary", "base64"], default="binary")
+    args = ap.parse_args(argv)
+    try:
+        host, port = parse_server(args.server)
+    except ValueError as e:
+        ap.error(str(e))
+    scene = None
+    if args.scene:
+        with open(args.scene) as f:
+            scene = json.load(f)
+    try:
+        with BeamcastClient(host, port) as c:
+            frames, result = c.render(scene=scene, scene_id=args.scene_id, encoding=args.encoding)
+    except ServerError as e:
+        print(f"server error {e}", file=sys.stderr)
+        return 2
+    except (OSError, ValueError) as e:
+        print(f"beamcast_client: {args.server}: {e}", file=sys.stderr)
+        return 1
+    with open(args.out, "wb") as f:
+        f.write(frames[0]["png"])
+    t = result.get("timings", {})
+    e2e = result["client_e2e_ms"]
+    for fr in frames:
+        print(f"{fr['camera']:<20} {fr['width']}x{fr['height']} gpu {fr.get('gpu_ms', 0):.3f} ms "
+              f"read-back {fr.get('readback_ms', 0):.2f} ms encode {fr.get('encode_ms', 0):.2f} ms")
+    print(f"server: queue {t.get('queue_ms', 0):.2f} render {t.get('render_ms', 0):.2f} "
+          f"encode {t.get('encode_ms', 0):.2f} total {t.get('server_ms', 0):.2f} ms; "
+          f"client end-to-end {e2e:.2f} ms, network {e2e - t.get('server_ms', 0):.2f} ms")
+    print(f"wrote {args.out} ({frames[0]['camera']}, {len(frames[0]['png'])} bytes)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,273 @@
+// beamcast_client against a scripted peer on a loopback socket (no real
+// server): id matching with out-of-order responses, frame decoding from
+// attachments and base64, server errors as values, and transport failures
+// (timeout, close, bad magic, refused) as std::runtime_error.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "client/client.hpp"
+#include "protocol/framing.hpp"
+
+namespace beamcast::client {
+namespace {
+
+using nlohmann::json;
+
+// Listens on 127.0.0.1:<ephemeral>, accepts one connection and runs `script` on it.
+class FakePeer {
+ public:
+  explicit FakePeer(std::function<void(int fd)> script) {
+    listen_fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t len = sizeof addr;
+    if (::bind(listen_fd_, reinterpret_cast<sockaddr*>(&addr), len) != 0 ||
+        ::listen(listen_fd_, 1) != 0 ||
+        ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&addr), &len) != 0) {
+      throw std::runtime_error("FakePeer: cannot listen");
+    }
+    port_ = ntohs(addr.sin_port);
+    thread_ = std::thread([this, script = std::move(script)] {
+      const int fd = ::accept(listen_fd_, nullptr, nullptr);
+      if (fd < 0) return;
+      script(fd);
+      ::close(fd);
+    });
+  }
+  ~FakePeer() {
+    ::shutdown(listen_fd_, SHUT_RDWR);  // unblocks accept if nobody connected
+    thread_.join();
+    ::close(listen_fd_);
+  }
+  std::uint16_t port() const { return port_; }
+
+ private:
+  int listen_fd_ = -1;
+  std::uint16_t port_ = 0;
+  std::thread thread_;
+};
+
+bool read_exact(int fd, std::uint8_t* p, std::size_t n) {
+  while (n > 0) {
+    const ssize_t got = ::recv(fd, p, n, 0);
+    if (got <= 0) return false;
+    p += got;
+    n -= static_cast<std::size_t>(got);
+  }
+  return true;
+}
+
+json read_request(int fd) {
+  std::uint8_t header[kFrameHeaderSize];
+  FrameHeader h;
+  if (!read_exact(fd, header, sizeof header) ||
+      parse_frame_header(std::span<const std::uint8_t, kFrameHeaderSize>(header), 1 << 20, &h) !=
+          HeaderStatus::kOk) {
+    return nullptr;
+  }
+  std::string body(h.body_length(), '\0');
+  if (!read_exact(fd, reinterpret_cast<std::uint8_t*>(body.data()), body.size())) return nullptr;
+  return json::parse(body.substr(0, h.json_length));
+}
+
+void write_raw(int fd, const std::vector<std::uint8_t>& bytes) {
+  ASSERT_EQ(::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL),
+            static_cast<ssize_t>(bytes.size()));
+}
+
+void reply(int fd, const json& response, const std::vector<std::uint8_t>& binary = {}) {
+  write_raw(fd, encode_frame(response.dump(), binary));
+}
+
+RenderRequest stored(const std::string& scene_id) {
+  RenderRequest r;
+  r.scene_id = scene_id;
+  return r;
+}
+RenderRequest inline_scene(const json& scene) {
+  RenderRequest r;
+  r.scene = scene;
+  return r;
+}
+
+TEST(ClientLoopback, CallMatchesItsIdAndKeepsTheOthers) {
+  FakePeer peer([](int fd) {
+    const json a = read_request(fd);
+    const json b = read_request(fd);
+    EXPECT_EQ(a["method"], "ping");
+    EXPECT_EQ(b["method"], "stats");
+    EXPECT_NE(a["id"], b["id"]);  // auto-incremented
+    reply(fd, {{"id", a["id"]}, {"ok", true}, {"result", {{"echo", a["params"]}}}});
+    reply(fd, {{"id", b["id"]}, {"ok", true}, {"result", {{"frames", 3}}}});
+  });
+  Client c;
+  c.connect("127.0.0.1", peer.port());
+  const json ping_id = c.send({{"method", "ping"}, {"params", {{"x", 1}}}});
+  const Response stats = c.stats();  // the ping's answer arrives first and is kept
+  ASSERT_TRUE(stats.ok);
+  EXPECT_EQ(stats.result()["frames"], 3);
+  const Response ping = c.receive_for(ping_id);
+  ASSERT_TRUE(ping.ok);
+  EXPECT_EQ(ping.id, ping_id);
+  EXPECT_EQ(ping.result()["echo"]["x"], 1);
+}
+
+TEST(ClientLoopback, RenderDecodesAttachmentsAndBase64) {
+  const std::vector<std::uint8_t> png_a = {0x89, 'P', 'N', 'G', 1, 2, 3};
+  const std::vector<std::uint8_t> png_b = {0x89, 'P', 'N', 'G', 0, 255};
+  FakePeer peer([&](int fd) {
+    const json req = read_request(fd);
+    EXPECT_EQ(req["params"]["scene_id"], "demo");
+    EXPECT_EQ(req["params"]["encoding"], "binary");
+    std::vector<std::uint8_t> binary = {9, 9};  // attachments need not start at 0
+    binary.insert(binary.end(), png_a.begin(), png_a.end());
+    const json frames = json::array({{{"camera", "view"},
+                                      {"index", 0},
+                                      {"width", 4},
+                                      {"height", 2},
+                                      {"format", "png"},
+                                      {"attachment", {{"offset", 2}, {"length", png_a.size()}}},
+                                      {"gpu_ms", 1.5},
+                                      {"pass_ms", {{"beams", 1.5}}}},
+                                     {{"camera", "camera_1"},
+                                      {"index", 1},
+                                      {"width", 8},
+                                      {"height", 8},
+                                      {"data_base64", base64_encode(png_b)},
+                                      {"encode_ms", 0.5}}});
+    reply(fd,
+          {{"id", req["id"]},
+           {"ok", true},
+           {"result",
+            {{"passes", {"beams", "tonemap"}},
+             {"frames", frames},
+             {"timings", {{"queue_ms", 0.1}, {"server_ms", 2.5}}}}}},
+          binary);
+  });
+  Client c;
+  c.connect("127.0.0.1", peer.port());
+  const RenderResult r = c.render(stored("demo"));
+  ASSERT_TRUE(r.ok) << r.error.message;
+  ASSERT_EQ(r.frames.size(), 2u);
+  EXPECT_EQ(r.frames[0].camera, "view");
+  EXPECT_EQ(r.frames[0].width, 4);
+  EXPECT_EQ(r.frames[0].png, png_a);
+  EXPECT_EQ(r.frames[0].timings["gpu_ms"], 1.5);
+  EXPECT_TRUE(r.frames[0].timings.contains("pass_ms"));
+  EXPECT_EQ(r.frames[1].png, png_b);
+  EXPECT_EQ(r.passes, json({"beams", "tonemap"}));
+  EXPECT_DOUBLE_EQ(r.server_ms, 2.5);
+  EXPECT_GE(r.e2e_ms, 0.0);
+  EXPECT_DOUBLE_EQ(r.network_ms, r.e2e_ms - r.server_ms);
+}
+
+TEST(ClientLoopback, ServerErrorIsReturnedNotThrown) {
+  FakePeer peer([](int fd) {
+    const json req = read_request(fd);
+    reply(fd, {{"id", req["id"]},
+               {"ok", false},
+               {"error",
+                {{"code", "invalid_value"},
+                 {"message", "radius must be > 0"},
+                 {"path", "/params/scene/beams/0/radius"}}}});
+  });
+  Client c;
+  c.connect("127.0.0.1", peer.port());
+  const RenderResult r = c.render(inline_scene(json::parse(R"({"cameras": [{}]})")));
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error.code, "invalid_value");
+  EXPECT_EQ(r.error.path, "/params/scene/beams/0/radius");
+}
+
+TEST(ClientLoopback, NullIdErrorReachesTheWaitingCall) {
+  FakePeer peer([](int fd) {
+    read_request(fd);
+    reply(fd, {{"id", nullptr},
+               {"ok", false},
+               {"error", {{"code", "busy"}, {"message", "too many connections"}, {"path", ""}}}});
+  });
+  Client c;
+  c.connect("127.0.0.1", peer.port());
+  const Response r = c.ping();
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error.code, "busy");
+}
+
+TEST(ClientLoopback, AttachmentOutsideTheBinaryPartThrows) {
+  FakePeer peer([](int fd) {
+    const json req = read_request(fd);
+    const json frame = {{"camera", "v"},
+                        {"width", 1},
+                        {"height", 1},
+                        {"attachment", {{"offset", 1}, {"length", 4}}}};
+    reply(fd, {{"id", req["id"]}, {"ok", true}, {"result", {{"frames", {frame}}}}}, {1, 2, 3, 4});
+  });
+  Client c;
+  c.connect("127.0.0.1", peer.port());
+  EXPECT_THROW(c.render(stored("demo")), std::runtime_error);
+}
+
+// Runs `fn`, expecting std::runtime_error whose message contains `needle`.
+void expect_transport_error(const std::function<void()>& fn, const std::string& needle) {
+  try {
+    fn();
+    ADD_FAILURE() << "no exception; expected one mentioning '" << needle << "'";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(ClientLoopback, ReceiveTimesOut) {
+  FakePeer peer([](int fd) {
+    read_request(fd);
+    read_request(fd);  // holds the connection, never answers, until the client closes
+  });
+  Client c;
+  c.connect("127.0.0.1", peer.port());
+  c.set_receive_timeout(std::chrono::milliseconds(200));
+  expect_transport_error([&] { c.ping(); }, "timed out");
+  EXPECT_FALSE(c.is_open());
+}
+
+TEST(ClientLoopback, ClosedConnectionThrows) {
+  FakePeer peer([](int fd) { read_request(fd); });
+  Client c;
+  c.connect("127.0.0.1", peer.port());
+  expect_transport_error([&] { c.ping(); }, "closed the connection");
+}
+
+TEST(ClientLoopback, BadMagicThrows) {
+  FakePeer peer([](int fd) {
+    read_request(fd);
+    write_raw(fd, {'H', 'T', 'T', 'P', '/', '1', '.', '1', ' ', '4', '0', '0'});
+  });
+  Client c;
+  c.connect("127.0.0.1", peer.port());
+  expect_transport_error([&] { c.ping(); }, "BCP1");
+}
+
+TEST(ClientLoopback, RefusedConnectThrows) {
+  std::uint16_t port = 0;
+  {
+    FakePeer peer([](int) {});  // an ephemeral port that is closed once the peer is gone
+    port = peer.port();
+    Client c;
+    c.connect("127.0.0.1", port);  // lets the peer's accept return
+  }
+  Client c;
+  expect_transport_error([&] { c.connect("127.0.0.1", port); }, "127.0.0.1:");
+  expect_transport_error([&] { c.ping(); }, "not connected");
+}
+
+}  // namespace
+}  // namespace beamcast::client
