@@ -1,10 +1,9 @@
 #!/usr/bin/env bash
-# The service command: installs dependencies, builds, and renders the demo
-# scene (the paper's 10 beam sets at 512x512) on the headless GPU path, with
-# per-pass timings. Arguments are passed to `beamcast render` after the scene.
+# The service command: installs dependencies, builds, and starts beamcast-server
+# on 127.0.0.1:7878 with embedded defaults (llvmpipe or the first GPU, the
+# paper's 10 beam sets preloaded as scene "demo"). Extra arguments go to the
+# server (e.g. --port 0, --device 1, --render-workers 2; see --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/build.sh
-build/bin/beamcast info
-build/bin/beamcast render examples/paper_10sets.json --out out/demo "$@"
-echo "demo frame: out/demo/view.png"
+exec build/bin/beamcast-server "$@"

@@ -18,7 +18,10 @@ struct ServerConfig {
   int render_workers = 1;  // threads that each own a GL context
   int encode_threads = 2;  // PNG encoding pool
   int network_threads = 1;
-  int png_level = 1;  // zlib level; see docs/performance.md for the measurement
+  // PNG zlib level and libpng filter mask (PNG_FILTER_SUB = 0x10), chosen by
+  // measurement: docs/performance.md, "PNG encoding".
+  int png_level = 2;
+  int png_filters = 0x10;
   std::filesystem::path assets_dir;
 
   SceneLimits scene_limits{.max_beams = 10000,

@@ -31,6 +31,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--png-level", c.png_level, "zlib level of PNG frames (docs/performance.md)")
       ->check(CLI::Range(0, 9))->capture_default_str();
+  std::string png_filter = "sub";
+  app.add_option("--png-filter", png_filter, "PNG row filter: none, sub, up, paeth or adaptive")
+      ->check(CLI::IsMember({"none", "sub", "up", "paeth", "adaptive"}))->capture_default_str();
   app.add_option("--assets", assets, "Directory scenes' mesh files are read from")->capture_default_str();
   app.add_flag("--no-demo", no_demo, "Do not preload the scene 'demo'");
   app.add_option("--max-message-bytes", c.max_message_bytes)->capture_default_str();
@@ -53,6 +56,12 @@ int main(int argc, char** argv) {
   app.add_option("--drain-timeout-ms", c.drain_timeout_ms)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   c.assets_dir = assets;
+  // libpng's PNG_FILTER_* masks.
+  c.png_filters = png_filter == "none"    ? 0x08
+                  : png_filter == "sub"   ? 0x10
+                  : png_filter == "up"    ? 0x20
+                  : png_filter == "paeth" ? 0x80
+                                          : 0xF8;
 
   try {
     RendererOptions ropts;

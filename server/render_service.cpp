@@ -34,9 +34,10 @@ RendererFactory gl_renderer_factory(const RendererOptions& opts) {
 }
 
 RenderService::RenderService(RendererFactory factory, int workers, int encode_threads,
-                             int png_level, int max_inflight)
+                             int png_level, int png_filters, int max_inflight)
     : factory_(std::move(factory)),
       png_level_(png_level),
+      png_filters_(png_filters),
       max_inflight_(max_inflight),
       encoders_(static_cast<std::size_t>(std::max(1, encode_threads))) {
   for (int i = 0; i < std::max(1, workers); ++i) {
@@ -153,7 +154,7 @@ void RenderService::worker_main(int index) {
       boost::asio::post(encoders_, [this, st, i] {
         const auto t0 = Clock::now();
         Image& img = st->out.frames[i].image;
-        st->out.pngs[i] = encode_png(img, png_level_);
+        st->out.pngs[i] = encode_png(img, png_level_, png_filters_);
         st->out.encode_ms[i] = ms_between(t0, Clock::now());
         img.rgb = {};  // the PNG is what travels; free the pixels now
         if (st->remaining.fetch_sub(1) == 1) {

@@ -60,7 +60,7 @@ struct RenderJob {
 class RenderService {
  public:
   RenderService(RendererFactory factory, int workers, int encode_threads, int png_level,
-                int max_inflight);
+                int png_filters, int max_inflight);
   ~RenderService();
 
   // Blocks until every worker has a renderer (or failed to get one); returns
@@ -83,6 +83,7 @@ class RenderService {
 
   RendererFactory factory_;
   int png_level_;
+  int png_filters_;
   int max_inflight_;
   std::atomic<int> inflight_{0};
   std::atomic<std::uint64_t> dropped_{0};

@@ -32,7 +32,8 @@ Server::~Server() {
 unsigned short Server::start() {
   const ServerConfig& c = core_.config;
   core_.renders = std::make_unique<RenderService>(factory_, c.render_workers, c.encode_threads,
-                                                  c.png_level, c.max_inflight_total);
+                                                  c.png_level, c.png_filters,
+                                                  c.max_inflight_total);
   core_.renderer_description = core_.renders->wait_ready();
   const tcp::endpoint ep(asio::ip::make_address(c.bind), c.port);
   acceptor_.open(ep.protocol());
