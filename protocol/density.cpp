@@ -98,6 +98,11 @@ std::string Density::key() const {
   return k;
 }
 
+bool has_closed_form(const Density& density) {
+  return density.kind == DensityKind::kAbe || density.kind == DensityKind::kLinear ||
+         density.kind == DensityKind::kQuadratic || density.kind == DensityKind::kGaussian;
+}
+
 bool density_from_name(const std::string& name, Density* out) {
   static const struct {
     const char* name;

@@ -34,6 +34,10 @@ struct Density {
   std::string name() const;
 };
 
+// Whether the shader has the exact antiderivative of this density (the
+// "closed_form" method): abe, linear, quadratic, gaussian.
+bool has_closed_form(const Density& density);
+
 // The built-in density for a name ("abe", "shell", "linear", "quadratic",
 // "gaussian"); false if the name is unknown.
 bool density_from_name(const std::string& name, Density* out);

@@ -98,11 +98,34 @@ struct OutputSettings {
   int bit_depth = 8;  // 8 or 16 bits per channel PNG
 };
 
-// How the beam line integrals are evaluated; accuracy knobs live here.
+// How the beam line integrals are evaluated; every accuracy knob lives here
+// (docs/accuracy.md measures each against time).
+enum class IntegrationMethod {
+  kTable,       // g(d, s) from a precomputed table (the default)
+  kClosedForm,  // exact antiderivative in the shader (abe, linear, quadratic, gaussian)
+  kMarch,       // `samples` evaluations of f along the ray per beam piece
+};
+enum class TableLayout {
+  kUniform,      // the paper's grid: d and s uniform on [0, 1] x [0, 2]
+  kChord,        // s normalized to the chord: s' = (s - 1) / sqrt(1 - d^2) on [-1, 1]
+  kWarped,       // d rows placed per density where g varies most, s uniform
+  kChordWarped,  // both
+};
+enum class TableFilter {
+  kHardware,  // the texture unit's bilinear filter
+  kShader,    // four texel fetches, weights in full float precision
+};
+enum class MarchRule { kMidpoint, kSimpson };
+
 struct RenderSettings {
+  IntegrationMethod method = IntegrationMethod::kTable;
   int table_d = 128;  // rows of g(d, s) (d axis)
   int table_s = 128;  // columns of g(d, s) (s axis)
-  int f_table = 1024;  // samples of the 1D table of f for the near-parallel path
+  TableLayout layout = TableLayout::kUniform;
+  TableFilter filter = TableFilter::kHardware;
+  int f_table = 1024;  // samples of the 1D table of f (near-parallel path, user tables)
+  int samples = 64;    // kMarch: sub-intervals per beam piece (even for Simpson)
+  MarchRule rule = MarchRule::kMidpoint;
 };
 
 struct Scene {

@@ -317,8 +317,35 @@ OutputSettings parse_output(const Node& n) {
 
 RenderSettings parse_render(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "render settings");
-  o.allow_only({"table_size", "f_table"});
+  o.allow_only({"method", "table_size", "layout", "filter", "f_table", "samples", "rule"});
   RenderSettings r;
+  if (auto m = o.optional("method")) {
+    r.method = read_enum<IntegrationMethod>(*m, {{"table", IntegrationMethod::kTable},
+                                                 {"closed_form", IntegrationMethod::kClosedForm},
+                                                 {"march", IntegrationMethod::kMarch}});
+  }
+  if (auto l = o.optional("layout")) {
+    r.layout = read_enum<TableLayout>(*l, {{"uniform", TableLayout::kUniform},
+                                           {"chord", TableLayout::kChord},
+                                           {"warped", TableLayout::kWarped},
+                                           {"chord_warped", TableLayout::kChordWarped}});
+  }
+  if (auto f = o.optional("filter")) {
+    r.filter = read_enum<TableFilter>(*f, {{"hardware", TableFilter::kHardware},
+                                           {"shader", TableFilter::kShader}});
+  }
+  if (auto ru = o.optional("rule")) {
+    r.rule = read_enum<MarchRule>(*ru, {{"midpoint", MarchRule::kMidpoint},
+                                        {"simpson", MarchRule::kSimpson}});
+  }
+  if (auto n_samples = o.optional("samples")) {
+    r.samples = read_int_in(*n_samples, 4, 1024);
+    if (r.rule == MarchRule::kSimpson && r.samples % 2 != 0) {
+      fail("invalid_value", n_samples->path,
+           "Simpson's rule needs an even number of sub-intervals, got " +
+               std::to_string(r.samples));
+    }
+  }
   if (auto t = o.optional("table_size")) {
     if (t->json().is_array()) {
       if (t->json().size() != 2) {
@@ -438,6 +465,19 @@ Camera parse_camera(const json& j, const std::string& path, const SceneLimits& l
   return c;
 }
 
+// The closed form exists only for densities with a known antiderivative.
+void check_method_fits_densities(const Scene& scene) {
+  if (scene.render.method != IntegrationMethod::kClosedForm) return;
+  for (std::size_t i = 0; i < scene.beams.size(); ++i) {
+    if (!has_closed_form(scene.beams[i].density)) {
+      fail("invalid_value", "/render/method",
+           "closed_form is not available for beam " + std::to_string(i) + "'s density " +
+               scene.beams[i].density.name() +
+               " (it exists for abe, linear, quadratic and gaussian); use table or march");
+    }
+  }
+}
+
 Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   const SceneLimits& limits = opts.limits;
   const Node root{&j, ""};
@@ -483,6 +523,7 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
            "camera name \"" + name + "\" is used by more than one camera");
     }
   }
+  check_method_fits_densities(scene);
   return scene;
 }
 
