@@ -100,46 +100,151 @@ double line_integral(const Density& density, double d, double s) {
   return -row.integrate(s, 0.0);
 }
 
-LineIntegralTable build_table(const Density& density, int nd, int ns, int nf) {
+namespace {
+
+bool chord_columns(TableLayout l) {
+  return l == TableLayout::kChord || l == TableLayout::kChordWarped;
+}
+bool warped_rows(TableLayout l) {
+  return l == TableLayout::kWarped || l == TableLayout::kChordWarped;
+}
+
+// Column positions of row d: uniform on [0, 2] or uniform across the chord.
+void row_columns(double d, int ns, bool chord, std::vector<double>* s) {
+  s->resize(static_cast<std::size_t>(ns));
+  const double c = d < 1.0 ? std::sqrt((1.0 - d) * (1.0 + d)) : 0.0;
+  for (int j = 0; j < ns; ++j) {
+    const double u = static_cast<double>(j) / (ns - 1);
+    (*s)[j] = chord ? 1.0 + (2.0 * u - 1.0) * c : 2.0 * u;
+  }
+}
+
+// g along one row at the given increasing columns, cumulatively.
+void integrate_row(const Density& density, double d, const std::vector<double>& s, float* out) {
+  const Row row(density, d);
+  double acc = row.integrate(0.0, s[0]);
+  out[0] = static_cast<float>(acc);
+  for (std::size_t j = 1; j < s.size(); ++j) {
+    acc += row.integrate(s[j - 1], s[j]);
+    out[j] = static_cast<float>(acc);
+  }
+}
+
+// Runs body(i) for i in [0, n) on all cores, rows interleaved (rows with small d
+// cost more, so interleaving balances the load).
+template <typename Body>
+void parallel_rows(int n, long long work, const Body& body) {
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const int nthreads = static_cast<int>(std::min<unsigned>(hw, static_cast<unsigned>(n)));
+  if (nthreads <= 1 || work < 4096) {
+    for (int i = 0; i < n; ++i) body(i);
+    return;
+  }
+  std::vector<std::thread> pool;
+  pool.reserve(nthreads);
+  for (int k = 0; k < nthreads; ++k) {
+    pool.emplace_back([&, k] {
+      for (int i = k; i < n; i += nthreads) body(i);
+    });
+  }
+  for (auto& th : pool) th.join();
+}
+
+// The warp W(d) on nw uniform points (see lut.hpp): from a fine uniform-d table
+// in the same column layout, the second difference across rows, maximized over
+// columns; row density ~ sqrt of it, smoothed, plus 10% of its mean as a floor.
+std::vector<double> compute_warp(const Density& density, int nw, bool chord) {
+  const int kColumns = 257;
+  std::vector<float> fine(static_cast<std::size_t>(nw) * kColumns);
+  parallel_rows(nw, static_cast<long long>(nw) * kColumns, [&](int m) {
+    std::vector<double> s;
+    const double d = static_cast<double>(m) / (nw - 1);
+    row_columns(d, kColumns, chord, &s);
+    integrate_row(density, d, s, &fine[static_cast<std::size_t>(m) * kColumns]);
+  });
+  std::vector<double> rho(static_cast<std::size_t>(nw), 0.0);
+  for (int m = 1; m + 1 < nw; ++m) {
+    double worst = 0.0;
+    for (int k = 0; k < kColumns; ++k) {
+      const auto at = [&](int mm) { return static_cast<double>(fine[mm * kColumns + k]); };
+      worst = std::max(worst, std::abs(at(m + 1) - 2.0 * at(m) + at(m - 1)));
+    }
+    rho[m] = std::sqrt(worst);
+  }
+  rho[0] = rho[1];
+  rho[nw - 1] = rho[nw - 2];
+  std::vector<double> smooth(rho.size());
+  for (int m = 0; m < nw; ++m) {
+    double sum = 0.0;
+    int count = 0;
+    for (int k = std::max(0, m - 3); k <= std::min(nw - 1, m + 3); ++k, ++count) sum += rho[k];
+    smooth[m] = sum / count;
+  }
+  double mean = 0.0;
+  for (double r : smooth) mean += r;
+  mean /= nw;
+  if (!(mean > 0.0)) mean = 1.0;  // g linear in d everywhere: uniform rows
+  std::vector<double> w(static_cast<std::size_t>(nw), 0.0);
+  for (int m = 1; m < nw; ++m) {
+    w[m] = w[m - 1] + 0.5 * (smooth[m - 1] + smooth[m]) + 0.1 * mean;
+  }
+  for (double& x : w) x /= w.back();
+  return w;
+}
+
+// d with W(d) = u for the piecewise-linear W on uniform points.
+double invert_warp(const std::vector<double>& w, double u) {
+  const int nw = static_cast<int>(w.size());
+  const auto it = std::upper_bound(w.begin(), w.end(), u);
+  if (it == w.begin()) return 0.0;
+  if (it == w.end()) return 1.0;
+  const int m = static_cast<int>(it - w.begin()) - 1;
+  const double a = (u - w[m]) / (w[m + 1] - w[m]);
+  return (m + a) / (nw - 1);
+}
+
+}  // namespace
+
+std::vector<double> table_rows(const LineIntegralTable& table) {
+  std::vector<double> rows(static_cast<std::size_t>(table.nd));
+  std::vector<double> w(table.warp.begin(), table.warp.end());
+  for (int i = 0; i < table.nd; ++i) {
+    const double u = static_cast<double>(i) / (table.nd - 1);
+    rows[i] = w.empty() ? u : invert_warp(w, u);
+  }
+  return rows;
+}
+
+LineIntegralTable build_table(const Density& density, int nd, int ns, int nf,
+                              TableLayout layout) {
   check_size("nd", nd);
   check_size("ns", ns);
   check_size("nf", nf);
   LineIntegralTable table;
+  table.layout = layout;
   table.nd = nd;
   table.ns = ns;
   table.nf = nf;
   table.g.assign(static_cast<std::size_t>(nd) * ns, 0.0f);
   table.f.resize(static_cast<std::size_t>(nf));
-
-  std::vector<double> s(static_cast<std::size_t>(ns));
-  for (int j = 0; j < ns; ++j) s[j] = 2.0 * j / (ns - 1);
-
-  auto build_row = [&](int i) {
-    const Row row(density, static_cast<double>(i) / (nd - 1));
-    float* out = &table.g[static_cast<std::size_t>(i) * ns];
-    out[0] = 0.0f;
-    double acc = 0.0;
-    for (int j = 1; j < ns; ++j) {
-      acc += row.integrate(s[j - 1], s[j]);
-      out[j] = static_cast<float>(acc);
-    }
-  };
-
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const int nthreads = static_cast<int>(std::min<unsigned>(hw, static_cast<unsigned>(nd)));
-  if (nthreads <= 1 || static_cast<long long>(nd) * ns < 4096) {
-    for (int i = 0; i < nd; ++i) build_row(i);
-  } else {
-    std::vector<std::thread> pool;
-    pool.reserve(nthreads);
-    for (int k = 0; k < nthreads; ++k) {
-      // Interleaved rows: rows with small d cost more, so this balances the load.
-      pool.emplace_back([&, k] {
-        for (int i = k; i < nd; i += nthreads) build_row(i);
-      });
-    }
-    for (auto& th : pool) th.join();
+  const bool chord = chord_columns(layout);
+  std::vector<double> w;
+  if (warped_rows(layout)) {
+    table.nw = 1024;
+    w = compute_warp(density, table.nw, chord);
+    table.warp.assign(w.begin(), w.end());
   }
+  // Rows from the double-precision warp, not its float copy.
+  std::vector<double> rows(static_cast<std::size_t>(nd));
+  for (int i = 0; i < nd; ++i) {
+    const double u = static_cast<double>(i) / (nd - 1);
+    rows[i] = w.empty() ? u : invert_warp(w, u);
+  }
+  parallel_rows(nd, static_cast<long long>(nd) * ns, [&](int i) {
+    std::vector<double> s;
+    row_columns(rows[i], ns, chord, &s);
+    integrate_row(density, rows[i], s, &table.g[static_cast<std::size_t>(i) * ns]);
+  });
 
   for (int k = 0; k < nf; ++k) {
     // Left limit at x = 1, where f jumps to 0 (e.g. the cut gaussian), so that

@@ -9,13 +9,27 @@
 #include <vector>
 
 #include "protocol/density.hpp"
+#include "protocol/scene.hpp"
 
 namespace beamcast {
 
+// Layouts (docs/accuracy.md measures them):
+//  rows    uniform: d_i = i / (nd - 1)
+//          warped:  d_i = W^-1(i / (nd - 1)), W the density's warp below
+//  columns uniform: s_j = 2 j / (ns - 1)
+//          chord:   s_ij = 1 + (2 j / (ns - 1) - 1) sqrt(1 - d_i^2), so every column
+//                   lies inside the unit disk and none is spent where g is constant
 struct LineIntegralTable {
-  int nd = 0;  // rows: d_i = i / (nd - 1)
-  int ns = 0;  // columns: s_j = 2 j / (ns - 1)
-  std::vector<float> g;  // g[i * ns + j] = g(d_i, s_j)
+  TableLayout layout = TableLayout::kUniform;
+  int nd = 0;
+  int ns = 0;
+  std::vector<float> g;  // g[i * ns + j] = g(d_i, s_ij)
+  // Warped layouts: W(d) at d_m = m / (nw - 1), increasing from 0 to 1. The
+  // shader finds the row coordinate of d as W(d) (nd - 1). Row density follows
+  // sqrt(max_s |d^2 g / dd^2|), which spreads linear interpolation error
+  // (h^2 |g''| / 8) evenly over d, plus a floor so no region starves.
+  int nw = 0;
+  std::vector<float> warp;
   int nf = 0;  // 1D table of f: f_k = f(k / (nf - 1)), for the near-parallel path
   std::vector<float> f;
 };
@@ -26,6 +40,10 @@ struct LineIntegralTable {
 double line_integral(const Density& density, double d, double s);
 
 // The whole table; each row is built cumulatively along s.
-LineIntegralTable build_table(const Density& density, int nd, int ns, int nf);
+LineIntegralTable build_table(const Density& density, int nd, int ns, int nf,
+                              TableLayout layout = TableLayout::kUniform);
+
+// Row positions of a table with `nd` rows and the given layout (d_i above).
+std::vector<double> table_rows(const LineIntegralTable& table);
 
 }  // namespace beamcast

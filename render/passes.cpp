@@ -82,9 +82,13 @@ class BeamPass final : public Pass {
  public:
   BeamPass()
       : program_(build_program("beam", assemble_shader({"common.glsl", "beam.vert"}),
-                               assemble_shader({"common.glsl", "beam.frag"}))) {
+                               assemble_shader({"common.glsl", "beam_math.glsl", "beam.frag"}))) {
     table_loc_ = glGetUniformLocation(program_.get(), "u_table_size");
     surfaces_loc_ = glGetUniformLocation(program_.get(), "u_has_surfaces");
+    for (const char* name : {"u_warp_size", "u_method", "u_chord", "u_warped", "u_shader_filter",
+                             "u_samples", "u_simpson"}) {
+      knob_loc_.push_back(glGetUniformLocation(program_.get(), name));
+    }
   }
   const char* name() const override { return "beams"; }
   void execute(FrameContext& ctx) override {
@@ -93,9 +97,21 @@ class BeamPass final : public Pass {
     glUniform3i(table_loc_, ctx.resources.table_d(), ctx.resources.table_s(),
                 ctx.resources.table_f());
     glUniform1i(surfaces_loc_, ctx.scene.occluders.empty() ? 0 : 1);
+    const RenderSettings& rs = ctx.scene.render;
+    const bool chord = rs.layout == TableLayout::kChord || rs.layout == TableLayout::kChordWarped;
+    const bool warped = rs.layout == TableLayout::kWarped || rs.layout == TableLayout::kChordWarped;
+    const int knobs[] = {ctx.resources.warp_size(),
+                         static_cast<int>(rs.method),
+                         chord ? 1 : 0,
+                         warped ? 1 : 0,
+                         rs.filter == TableFilter::kShader ? 1 : 0,
+                         rs.samples,
+                         rs.rule == MarchRule::kSimpson ? 1 : 0};
+    for (std::size_t k = 0; k < knob_loc_.size(); ++k) glUniform1i(knob_loc_[k], knobs[k]);
     glBindTextureUnit(0, ctx.resources.g_texture());
     glBindTextureUnit(1, ctx.resources.f_texture());
     glBindTextureUnit(2, ctx.targets.view_depth.get());
+    glBindTextureUnit(3, ctx.resources.warp_texture());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx.resources.beam_buffer());
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
@@ -117,6 +133,7 @@ class BeamPass final : public Pass {
   GlProgram program_;
   GLint table_loc_ = -1;
   GLint surfaces_loc_ = -1;
+  std::vector<GLint> knob_loc_;  // same order as `knobs` in execute
 };
 
 // HDR -> display values in the output's bit depth.

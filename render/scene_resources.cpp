@@ -7,16 +7,18 @@
 namespace beamcast {
 
 std::shared_ptr<const LineIntegralTable> TableCache::get(const Density& density, int nd, int ns,
-                                                         int nf) {
+                                                         int nf, TableLayout layout) {
   const std::string key = density.key() + "|" + std::to_string(nd) + "x" + std::to_string(ns) +
-                          "|" + std::to_string(nf);
+                          "|" + std::to_string(nf) + "|" +
+                          std::to_string(static_cast<int>(layout));
   for (auto it = entries_.begin(); it != entries_.end(); ++it) {
     if (it->first == key) {
       entries_.splice(entries_.begin(), entries_, it);  // most recently used first
       return entries_.front().second;
     }
   }
-  auto table = std::make_shared<const LineIntegralTable>(build_table(density, nd, ns, nf));
+  auto table =
+      std::make_shared<const LineIntegralTable>(build_table(density, nd, ns, nf, layout));
   entries_.emplace_front(key, table);
   while (entries_.size() > max_entries_) entries_.pop_back();
   return table;
@@ -40,6 +42,7 @@ struct alignas(16) BeamData {
   float axis_length[4];
   float color_layer[4];
   float caps_kind[4];
+  float density[4];
 };
 
 struct alignas(16) AnalyticData {
@@ -159,7 +162,7 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables) : scene_(
     auto it = std::find(keys.begin(), keys.end(), key);
     if (it == keys.end()) {
       keys.push_back(key);
-      layers.push_back(tables.get(beam.density, nd_, ns_, nf_));
+      layers.push_back(tables.get(beam.density, nd_, ns_, nf_, scene.render.layout));
       it = keys.end() - 1;
     }
     beam_layers_.push_back(static_cast<float>(it - keys.begin()));
@@ -173,10 +176,21 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables) : scene_(
     glCreateTextures(GL_TEXTURE_1D_ARRAY, 1, &id);
     f_tex_ = GlTexture(id);
     glTextureStorage2D(id, 1, GL_R32F, nf_, count);
+    // Warped layouts carry W(d); others get a 2-texel identity so the binding
+    // is always complete.
+    nw_ = layers[0]->nw > 0 ? layers[0]->nw : 2;
+    glCreateTextures(GL_TEXTURE_1D_ARRAY, 1, &id);
+    warp_tex_ = GlTexture(id);
+    glTextureStorage2D(id, 1, GL_R32F, nw_, count);
+    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     for (GLsizei i = 0; i < count; ++i) {
       glTextureSubImage3D(g_tex_.get(), 0, 0, 0, i, ns_, nd_, 1, GL_RED, GL_FLOAT,
                           layers[i]->g.data());
       glTextureSubImage2D(f_tex_.get(), 0, 0, i, nf_, 1, GL_RED, GL_FLOAT, layers[i]->f.data());
+      const float identity[2] = {0.0f, 1.0f};
+      glTextureSubImage2D(warp_tex_.get(), 0, 0, i, nw_, 1, GL_RED, GL_FLOAT,
+                          layers[i]->warp.empty() ? identity : layers[i]->warp.data());
     }
     for (GLuint tex : {g_tex_.get(), f_tex_.get()}) {
       glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -284,6 +298,8 @@ void SceneResources::bind_camera(const Camera& cam, const CameraBasis& basis) {
       const auto r = static_cast<float>(beam.radius);
       const Color c = (beam.intensity) * beam.color;
       set3(d.color_layer, c, beam_layers_[i]);
+      d.density[0] = static_cast<float>(static_cast<int>(beam.density.kind));
+      d.density[1] = static_cast<float>(beam.density.sigma);
       if (const auto* s = std::get_if<SphereBeam>(&beam.shape)) {
         set3(d.p0_radius, s->center - eye, r);
         set3(d.axis_length, {0.0, 0.0, 1.0}, 0.0f);

@@ -22,7 +22,8 @@ namespace beamcast {
 class TableCache {
  public:
   explicit TableCache(std::size_t max_entries) : max_entries_(max_entries) {}
-  std::shared_ptr<const LineIntegralTable> get(const Density& density, int nd, int ns, int nf);
+  std::shared_ptr<const LineIntegralTable> get(const Density& density, int nd, int ns, int nf,
+                                               TableLayout layout);
 
  private:
   std::size_t max_entries_;
@@ -40,6 +41,8 @@ class SceneResources {
   int table_f() const { return nf_; }
   GLuint g_texture() const { return g_tex_.get(); }
   GLuint f_texture() const { return f_tex_.get(); }
+  GLuint warp_texture() const { return warp_tex_.get(); }
+  int warp_size() const { return nw_; }
   GLuint beam_buffer() const { return beam_ssbo_.get(); }
   GLsizei beam_count() const { return static_cast<GLsizei>(beam_layers_.size()); }
   GLuint camera_buffer() const { return camera_ubo_.get(); }
@@ -50,9 +53,9 @@ class SceneResources {
 
  private:
   const Scene& scene_;
-  int nd_ = 0, ns_ = 0, nf_ = 0;
+  int nd_ = 0, ns_ = 0, nf_ = 0, nw_ = 2;
   std::vector<float> beam_layers_;  // table layer of each beam
-  GlTexture g_tex_, f_tex_;
+  GlTexture g_tex_, f_tex_, warp_tex_;
   GlBuffer beam_ssbo_, camera_ubo_, analytic_ssbo_, tri_vbo_;
   GlVertexArray tri_vao_;
   GLsizei tri_vertices_ = 0;

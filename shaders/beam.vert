@@ -8,6 +8,7 @@ struct BeamData {
   vec4 axis_length;  // xyz: unit axis p0 -> p1; w: length (0 for a sphere)
   vec4 color_layer;  // rgb: color * intensity; w: table layer of the density
   vec4 caps_kind;    // x: cap at p0, y: cap at p1 (1 or 0); z: 0 sphere, 1 capsule
+  vec4 density;      // x: DensityKind, y: gaussian sigma
 };
 layout(std430, binding = 1) readonly buffer Beams { BeamData beams[]; };
 

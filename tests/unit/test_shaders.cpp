@@ -27,7 +27,7 @@ const std::vector<Stage> kStages = {
     {{"common.glsl", "fullscreen.vert"}, "vert"},
     {{"common.glsl", "analytic_occluder.frag"}, "frag"},
     {{"common.glsl", "beam.vert"}, "vert"},
-    {{"common.glsl", "beam.frag"}, "frag"},
+    {{"common.glsl", "beam_math.glsl", "beam.frag"}, "frag"},
     {{"common.glsl", "tonemap.frag"}, "frag"},
 };
 
@@ -50,7 +50,7 @@ TEST(Shaders, EveryStageCompilesWithGlslangValidator) {
 }
 
 TEST(Shaders, AssembledSourceStartsWithVersion) {
-  const std::string src = assemble_shader({"common.glsl", "beam.frag"});
+  const std::string src = assemble_shader({"common.glsl", "beam_math.glsl", "beam.frag"});
   EXPECT_EQ(src.rfind("#version 450 core\n", 0), 0u);
   EXPECT_NE(src.find("cylinder_energy"), std::string::npos);
 }
