@@ -11,6 +11,8 @@ void add_render_command(CLI::App& app);
 void add_info_command(CLI::App& app);
 // `ping` and `stats`, which talk to beamcast-server.
 void add_server_commands(CLI::App& app);
+// `bench accuracy`: integration settings against the CPU reference (bench/).
+void add_bench_command(CLI::App& app);
 
 // `beamcast render --server HOST:PORT`: the render happens on the server.
 struct RemoteRenderArgs {

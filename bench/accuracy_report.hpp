@@ -1,0 +1,38 @@
+// Outputs of the accuracy benchmark: the CSV (for scripts), the Markdown
+// summary (for people) and the plots (bench/plot_accuracy.py).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bench/accuracy.hpp"
+
+namespace beamcast::bench {
+
+// What the summary says about the run besides the rows.
+struct RunInfo {
+  std::string renderer;  // the GL device string
+  std::string machine;   // CPU count, OS
+  int size = 0;
+  bool quick = false;
+  struct Reference {
+    std::string scene;
+    int beams = 0;
+    double seconds = 0.0;
+  };
+  std::vector<Reference> references;
+  std::vector<std::string> skipped;  // settings left out on purpose
+  double total_s = 0.0;
+};
+
+// The exact CSV header, without a newline.
+const char* csv_header();
+void write_csv(const std::filesystem::path& file, const std::vector<AccuracyRow>& rows);
+void write_summary(const std::filesystem::path& file, const std::vector<AccuracyRow>& rows,
+                   const std::vector<BenchScene>& scenes, const RunInfo& info);
+// Runs /usr/bin/python3 bench/plot_accuracy.py CSV OUT_DIR. Returns an empty
+// string on success, else one line saying why there are no plots.
+std::string run_plot_script(const std::filesystem::path& csv, const std::filesystem::path& out_dir);
+
+}  // namespace beamcast::bench
