@@ -135,7 +135,8 @@ BenchScene random_beams(int count, std::uint32_t seed, int size) {
   // Rays cross several beams; a lower exposure keeps the tone curve informative.
   s.output.exposure = count > 500 ? 0.15 : 0.3;
   BenchScene bs = finish("beams_" + std::to_string(count), std::move(s), size);
-  bs.max_march_samples = count > 500 ? 128 : 256;
+  bs.max_march_samples = count > 500 ? 64 : 128;
+  bs.coarse_tables = count > 500;
   return bs;
 }
 

@@ -119,9 +119,12 @@ enum class MarchRule { kMidpoint, kSimpson };
 
 struct RenderSettings {
   IntegrationMethod method = IntegrationMethod::kTable;
+  // Default: chord_warped 128x128, chosen by `beamcast bench accuracy`
+  // (docs/accuracy.md): every built-in density under 3e-4 relative L1 image
+  // error at the frame time of the paper's uniform 32x32 table.
   int table_d = 128;  // rows of g(d, s) (d axis)
   int table_s = 128;  // columns of g(d, s) (s axis)
-  TableLayout layout = TableLayout::kUniform;
+  TableLayout layout = TableLayout::kChordWarped;
   TableFilter filter = TableFilter::kHardware;
   int f_table = 1024;  // samples of the 1D table of f (near-parallel path, user tables)
   int samples = 64;    // kMarch: sub-intervals per beam piece (even for Simpson)

@@ -73,6 +73,7 @@ TEST(Methods, MarchingConvergesWithSamples) {
 TEST(Methods, WarpedLayoutBeatsUniformOnTheShell) {
   const Scene scene = example("thin_shell", 128);
   RenderSettings uniform, warped;
+  uniform.layout = TableLayout::kUniform;
   uniform.table_d = uniform.table_s = warped.table_d = warped.table_s = 64;
   warped.layout = TableLayout::kChordWarped;
   const double eu = rel_l1(scene, uniform);
@@ -88,6 +89,7 @@ TEST(Methods, WarpedLayoutBeatsUniformOnTheShell) {
 TEST(Methods, ChordLayoutWithTheCameraInsideABeam) {
   const Scene scene = example("camera_inside", 96);
   RenderSettings uniform, chord;
+  uniform.layout = TableLayout::kUniform;
   uniform.table_d = uniform.table_s = chord.table_d = chord.table_s = 32;
   chord.layout = TableLayout::kChord;
   EXPECT_LE(rel_l1(scene, chord), rel_l1(scene, uniform) * 1.05);
