@@ -114,6 +114,42 @@ AccuracyRow measure(Renderer& renderer, const BenchScene& bs, const RenderSettin
   return row;
 }
 
+// The paper's setting and the default on one scene, alternately, `rounds`
+// times `per_round` frames each; medians of each side.
+RunInfo::Interleaved interleave(Renderer& renderer, const BenchScene& bs, const Reference& ref,
+                                int rounds, int per_round) {
+  RunInfo::Interleaved out;
+  out.scene = bs.name;
+  Scene paper = bs.scene, deflt = bs.scene;
+  paper.render = table_setting(TableLayout::kUniform, TableFilter::kHardware, 32);
+  deflt.render = RenderSettings{};
+  const Camera& cam = bs.scene.cameras[0];
+  const auto error = [&](const Scene& s) {
+    return compare_hdr(renderer.render(s, {cam}, FrameOptions{.read_hdr = true}).at(0).hdr,
+                       ref.hdr)
+        .rel_l1;
+  };
+  out.paper_rel_l1 = error(paper);
+  out.default_rel_l1 = error(deflt);
+  std::vector<double> pg, dg, pb, db;
+  for (int r = 0; r < rounds; ++r) {
+    for (const FrameResult& fr : renderer.render(paper, std::vector<Camera>(per_round, cam))) {
+      pg.push_back(fr.gpu_ms);
+      pb.push_back(pass_ms(fr, "beams"));
+    }
+    for (const FrameResult& fr : renderer.render(deflt, std::vector<Camera>(per_round, cam))) {
+      dg.push_back(fr.gpu_ms);
+      db.push_back(pass_ms(fr, "beams"));
+    }
+  }
+  out.paper_gpu_ms = median(pg);
+  out.default_gpu_ms = median(dg);
+  out.paper_beam_ms = median(pb);
+  out.default_beam_ms = median(db);
+  out.frames = static_cast<int>(pg.size());
+  return out;
+}
+
 }  // namespace
 
 const char* method_name(IntegrationMethod m) {
@@ -273,6 +309,13 @@ int run_accuracy(const AccuracyOptions& opts) {
         std::fprintf(stderr, "[%4zu/%zu] %-16s %-30s FAILED: %s\n", done, total, bs.name.c_str(),
                      label.c_str(), e.what());
       }
+    }
+    if (bs.name.starts_with("paper_") || bs.density_study) {
+      const auto& il = info.interleaved.emplace_back(
+          interleave(renderer, bs, ref, opts.quick ? 2 : 6, opts.quick ? 2 : 4));
+      std::fprintf(stderr, "%s: interleaved paper 32x32 %.3f ms vs default %.3f ms (%.3fx)\n",
+                   bs.name.c_str(), il.paper_gpu_ms, il.default_gpu_ms,
+                   il.default_gpu_ms / il.paper_gpu_ms);
     }
   }
 

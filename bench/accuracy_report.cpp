@@ -166,6 +166,20 @@ void write_summary(const std::filesystem::path& file, const std::vector<Accuracy
        << fps_cell(find_row(rows, scene, defaults)) << " |\n";
   }
 
+  md << "\n## The paper's 32x32 uniform table against the default, interleaved\n\n"
+     << "Both settings rendered alternately in rounds on the same renderer, so they see the "
+        "same machine load; medians over all frames of each side.\n\n"
+     << "| scene | frames each | paper 32x32: GPU ms (FPS) | beams ms | rel_l1 | default: GPU ms (FPS) "
+        "| beams ms | rel_l1 | default / paper time |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const RunInfo::Interleaved& il : info.interleaved) {
+    md << "| " << il.scene << " | " << il.frames << " | " << fmt("%.2f", il.paper_gpu_ms) << " ("
+       << fmt("%.0f", 1000.0 / il.paper_gpu_ms) << ") | " << fmt("%.2f", il.paper_beam_ms) << " | "
+       << fmt("%.2e", il.paper_rel_l1) << " | " << fmt("%.2f", il.default_gpu_ms) << " ("
+       << fmt("%.0f", 1000.0 / il.default_gpu_ms) << ") | " << fmt("%.2f", il.default_beam_ms)
+       << " | " << fmt("%.2e", il.default_rel_l1) << " | "
+       << fmt("%.3f", il.default_gpu_ms / il.paper_gpu_ms) << " |\n";
+  }
+
   md << "\n## Best setting per method\n\n"
      << "Most accurate setting of each method, and the cheapest one whose rel_l1 is at most "
      << fmt("%.0e", kTargetRelL1) << ".\n";

@@ -24,6 +24,16 @@ struct RunInfo {
   std::vector<Reference> references;
   std::vector<std::string> skipped;  // settings left out on purpose
   double total_s = 0.0;
+  // The paper's 32x32 uniform table against the default, rendered alternately
+  // (A B A B ...) so that both see the same machine load: medians in ms.
+  struct Interleaved {
+    std::string scene;
+    double paper_gpu_ms = 0.0, default_gpu_ms = 0.0;
+    double paper_beam_ms = 0.0, default_beam_ms = 0.0;
+    double paper_rel_l1 = 0.0, default_rel_l1 = 0.0;
+    int frames = 0;  // per side
+  };
+  std::vector<Interleaved> interleaved;
 };
 
 // The exact CSV header, without a newline.
