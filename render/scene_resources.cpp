@@ -97,7 +97,26 @@ void view_projection(const Camera& cam, const CameraBasis& b, float out[16]) {
   }
 }
 
-// Appends the 12 triangles of a box occluder in world space.
+// Appends one flat-shaded triangle (anchor-relative corners); degenerate
+// triangles cover no pixel and are skipped.
+void push_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Color& albedo,
+                   std::vector<Vertex>* out) {
+  const Vec3 cr = cross(b - a, c - a);
+  const double len = length(cr);
+  if (!(len > 0.0)) return;
+  const Vec3 n = (1.0 / len) * cr;
+  for (const Vec3* p : {&a, &b, &c}) {
+    Vertex v;
+    for (int k = 0; k < 3; ++k) {
+      v.position[k] = static_cast<float>((*p)[k]);
+      v.normal[k] = static_cast<float>(n[k]);
+      v.albedo[k] = static_cast<float>(albedo[k]);
+    }
+    out->push_back(v);
+  }
+}
+
+// Appends the 12 triangles of a box occluder.
 void box_triangles(const BoxOccluder& box, const Color& albedo, const Vec3& anchor,
                    std::vector<Vertex>* out) {
   static const int kIndex[36] = {4, 6, 2, 4, 2, 0, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
@@ -109,41 +128,16 @@ void box_triangles(const BoxOccluder& box, const Color& albedo, const Vec3& anch
     corners[i] = box.center + rotate(box.rotation, local) - anchor;
   }
   for (int t = 0; t < 12; ++t) {
-    const Vec3& a = corners[kIndex[3 * t]];
-    const Vec3& b = corners[kIndex[3 * t + 1]];
-    const Vec3& c = corners[kIndex[3 * t + 2]];
-    const Vec3 n = normalize(cross(b - a, c - a));
-    for (const Vec3* p : {&a, &b, &c}) {
-      Vertex v;
-      for (int k = 0; k < 3; ++k) {
-        v.position[k] = static_cast<float>((*p)[k]);
-        v.normal[k] = static_cast<float>(n[k]);
-        v.albedo[k] = static_cast<float>(albedo[k]);
-      }
-      out->push_back(v);
-    }
+    push_triangle(corners[kIndex[3 * t]], corners[kIndex[3 * t + 1]], corners[kIndex[3 * t + 2]],
+                  albedo, out);
   }
 }
 
 void mesh_triangles(const MeshOccluder& mesh, const Color& albedo, const Vec3& anchor,
                     std::vector<Vertex>* out) {
   for (const auto& tri : mesh.triangles) {
-    const Vec3 a = mesh.vertices[tri[0]] - anchor;
-    const Vec3 b = mesh.vertices[tri[1]] - anchor;
-    const Vec3 c = mesh.vertices[tri[2]] - anchor;
-    const Vec3 cr = cross(b - a, c - a);
-    const double len = length(cr);
-    if (!(len > 0.0)) continue;  // degenerate triangle: covers no pixel
-    const Vec3 n = (1.0 / len) * cr;
-    for (const Vec3* p : {&a, &b, &c}) {
-      Vertex v;
-      for (int k = 0; k < 3; ++k) {
-        v.position[k] = static_cast<float>((*p)[k]);
-        v.normal[k] = static_cast<float>(n[k]);
-        v.albedo[k] = static_cast<float>(albedo[k]);
-      }
-      out->push_back(v);
-    }
+    push_triangle(mesh.vertices[tri[0]] - anchor, mesh.vertices[tri[1]] - anchor,
+                  mesh.vertices[tri[2]] - anchor, albedo, out);
   }
 }
 

@@ -5,15 +5,12 @@
 #include <cmath>
 
 #include "protocol/density.hpp"
+#include "tests/unit/test_densities.hpp"
 
 namespace beamcast {
 namespace {
 
-Density named(const char* name) {
-  Density d;
-  EXPECT_TRUE(density_from_name(name, &d)) << name;
-  return d;
-}
+using testing_support::named;
 
 std::vector<Density> all_kinds() {
   std::vector<Density> v;

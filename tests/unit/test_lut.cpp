@@ -12,17 +12,14 @@
 #include <vector>
 
 #include "protocol/density.hpp"
+#include "tests/unit/test_densities.hpp"
 #include "render/lut.hpp"
 #include "render/quadrature.hpp"
 
 namespace beamcast {
 namespace {
 
-Density named(const char* name) {
-  Density d;
-  EXPECT_TRUE(density_from_name(name, &d)) << name;
-  return d;
-}
+using testing_support::named;
 
 Density gaussian(double sigma) {
   Density d = named("gaussian");

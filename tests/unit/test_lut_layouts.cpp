@@ -4,15 +4,12 @@
 #include <cmath>
 
 #include "render/lut.hpp"
+#include "tests/unit/test_densities.hpp"
 
 namespace beamcast {
 namespace {
 
-Density named(const char* name) {
-  Density d;
-  EXPECT_TRUE(density_from_name(name, &d));
-  return d;
-}
+using testing_support::named;
 
 // Entries are g in double rounded to float: relative 2^-24 ~ 6e-8 of the
 // largest value in the table, plus the quadrature's 1e-12, so 1e-6 of the
