@@ -134,6 +134,9 @@ float g_diff(float d, float s0, float s1) {
 // One texel of s for the table; for the closed form the width under which its
 // float cancellation (G(s1) - G(s0), divided by sin(theta)) is worse than the
 // 3-point Gauss rule on a short interval.
+// For the table, a wider band: there a short s-interval's table difference
+// inherits the interpolation error of f across the table's rows (divided by an
+// energy that shrinks with the interval), which the quadrature does not have.
 float parallel_threshold() {
-  return u_method == 1 ? 2e-3 : 2.0 / float(u_table_size.y - 1);
+  return u_method == 1 ? 2e-3 : 0.25;
 }
