@@ -190,6 +190,40 @@ TEST(Stability, ManyAndCoincidentBeams) {
   check("1000 overlapping beams", with(many, look({0, 0, 4}, {0, 0, 0})));
 }
 
+Occluder plane_at(Vec3 point, Vec3 normal) {
+  Occluder o;
+  o.shape = PlaneOccluder{point, normal};
+  return o;
+}
+
+Occluder ball_at(Vec3 center, double radius) {
+  Occluder o;
+  o.shape = SphereOccluder{center, radius};
+  return o;
+}
+
+TEST(Stability, OccludersInsideBeams) {
+  const std::vector<Beam> beams = {sphere({0, 0, 0}, 1.0, "abe"),
+                                   capsule({0, 0, 0}, {2, 0.5, 0}, 0.5, "shell")};
+  const Camera cam = look({0.6, 0.8, 4}, {0.6, 0, 0});
+  Scene s = with(beams, cam);
+  s.occluders = {plane_at({0, 0, 0}, {0, 0, 1})};  // through the sphere's centre
+  check("plane through a beam's centre", s);
+  s.occluders = {ball_at({0, 0, 0}, 0.2)};  // around the centre, inside the beam
+  check("occluder around the centre", s);
+  s.occluders = {ball_at({1.2, 0.3, 0.0}, 0.15)};  // inside the capsule (radius 0.5)
+  check("occluder inside a capsule", s);
+  // A plane through the camera itself lies before the near plane: clipped away,
+  // it hides nothing, and both renderers must agree on that.
+  s.occluders = {plane_at(cam.position, {0, 0, 1})};
+  check("occluder at the camera", s);
+  // Behind the far plane: it must change nothing.
+  Scene far = with(beams, cam);
+  far.cameras[0].far_plane = 20;
+  far.occluders = {plane_at({0, 0, -30}, {0, 0, 1})};
+  check("occluder behind the far plane", far);
+}
+
 TEST(Stability, ExtremeCameras) {
   const std::vector<Beam> beams = {sphere({0, 0, 0}, 1.0, "abe"), capsule({0, 0, 0}, {2, 1, 0}, 0.4)};
   check("fov 0.01 deg", with(beams, look({0.5, 0.2, 5}, {0.5, 0.2, 0}, 0.01)));
