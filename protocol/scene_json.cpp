@@ -35,12 +35,19 @@ double read_size(const Node& n, const SceneLimits& limits) {
   return v;
 }
 
+// True if normalize(v) is finite: nonzero, and not so tiny (denormal) that 1/|v| overflows.
+bool normalizable(const Vec3& v) {
+  const double len = length(v);
+  return len > 0.0 && std::isfinite(len) && std::isfinite(1.0 / len);
+}
+
 // A direction: finite, not the zero vector (need not be unit).
 Vec3 read_direction(const Node& n) {
   const Vec3 v = read_vec3(n);
-  const double len = length(v);
-  if (!(len > 0.0) || !std::isfinite(len)) {
-    fail("invalid_value", n.path, n.name() + " must be a nonzero direction vector, got [0, 0, 0]");
+  if (!normalizable(v)) {
+    fail("invalid_value", n.path,
+         n.name() + " must be a nonzero direction vector (length > 1e-300), got [" +
+             format_number(v[0]) + ", " + format_number(v[1]) + ", " + format_number(v[2]) + "]");
   }
   return v;
 }
@@ -393,12 +400,11 @@ void check_look_at(const Camera& c, const Node* target, const Node* up) {
     }
     forward = normalize(d);
   }
-  const double up_len = length(c.up);
-  if (!(up_len > 0.0)) {
+  if (!normalizable(c.up)) {
     fail("invalid_value", up ? up->path : std::string(), "up must be a nonzero vector");
   }
-  const Vec3 u = (1.0 / up_len) * c.up;
-  if (length(cross(forward, u)) < 1e-6) {
+  // camera_basis normalizes cross(forward, up) without normalizing up first.
+  if (length(cross(forward, normalize(c.up))) < 1e-6 || !normalizable(cross(forward, c.up))) {
     fail("invalid_value", up ? up->path : (target ? target->path : std::string()),
          "up must not be parallel to the view direction (target - position)");
   }

@@ -511,6 +511,11 @@ TEST(SceneJsonReject, DegenerateCameraVectors) {
                   "/cameras/0/target");
   EXPECT_REJECTED(with(base(), "/cameras/0/up", {0, 0, 0}), SceneLoadOptions{}, "invalid_value",
                   "/cameras/0/up");
+  // Denormal vectors whose normalization overflows.
+  EXPECT_REJECTED(with(base(), "/cameras/0/up", {0, 1e-320, 0}), SceneLoadOptions{},
+                  "invalid_value", "/cameras/0/up");
+  EXPECT_REJECTED(with(base(), "/light", {{"direction", {0, -1e-320, 0}}}), SceneLoadOptions{},
+                  "invalid_value", "/light/direction");
   // Default up (+Y) with a target straight below.
   EXPECT_REJECTED(with(base(), "/cameras/0/target", {0, -10, 5}), SceneLoadOptions{},
                   "invalid_value", "/cameras/0/target");
