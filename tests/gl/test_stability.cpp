@@ -20,6 +20,7 @@
 #include "render/image.hpp"
 #include "render/reference.hpp"
 #include "render/renderer.hpp"
+#include "tests/unit/test_densities.hpp"
 
 namespace beamcast {
 namespace {
@@ -29,11 +30,7 @@ Renderer& renderer() {
   return r;
 }
 
-Density named(const char* name) {
-  Density d;
-  density_from_name(name, &d);
-  return d;
-}
+using testing_support::named;
 
 Beam capsule(Vec3 p0, Vec3 p1, double r, const char* density = "linear", bool caps = true) {
   Beam b;
