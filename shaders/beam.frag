@@ -24,7 +24,7 @@ struct BeamData {
 };
 layout(std430, binding = 1) readonly buffer Beams { BeamData beams[]; };
 
-layout(binding = 2) uniform sampler2D u_view_depth;  // surfaces' view depth (huge: none)
+layout(binding = 2) uniform VIEW_SAMPLER u_view_depth;  // surfaces' view depth (huge: none)
 uniform int u_has_surfaces;
 
 flat in int v_beam;
@@ -140,6 +140,7 @@ void clip_plane(float u0, float du, float bound, bool above, inout float t0, ino
 }
 
 void main() {
+  select_view(view_index());
   BeamData b = beams[v_beam];
   g_layer = b.color_layer.w;
   g_kind = int(b.density.x);
@@ -148,7 +149,7 @@ void main() {
   float t0 = ray.t_min;
   float t1 = ray.t_max;
   if (u_has_surfaces != 0) {
-    float z = texelFetch(u_view_depth, ivec2(gl_FragCoord.xy), 0).r;
+    float z = VIEW_TEXEL(u_view_depth, ivec2(gl_FragCoord.xy)).r;
     t1 = min(t1, z / ray.cos_axis);
   }
   float r = b.p0_radius.w;
