@@ -3,13 +3,15 @@
 // "WebSocket"). Plain JS, no build step; served and embedded by beamcast-server.
 //
 // URL parameters: scene (stored id, or an example file name), size (canvas
-// pixels, default 512), budget (frame-time budget in ms, default 33),
-// inflight (requests kept in flight, default 2).
+// pixels, default 512), budget (frame-time budget in ms, default 33), still
+// (ms of rest before the full-accuracy frame, default 300), inflight (requests
+// kept in flight, default 2).
 'use strict';
 
 const params = new URLSearchParams(location.search);
 const size = Math.max(16, Math.min(2048, parseInt(params.get('size') || '512', 10)));
 const budgetMs = parseFloat(params.get('budget') || '33');
+const stillMs = parseFloat(params.get('still') || '300');
 const maxInflight = Math.max(1, parseInt(params.get('inflight') || '2', 10));
 
 const canvas = document.getElementById('canvas');
@@ -38,6 +40,7 @@ let awaitingBinary = null;  // a response whose attachments come in the next bin
 let orbit = null;           // {target, yaw, pitch, dist, up, fov, near, far, projection, ortho}
 let lastSentKey = null;
 let lastSentAt = 0;
+let lastChangeAt = 0;       // when the pose last changed
 let stillKey = null;        // pose of the latest still frame
 let inflight = 0;
 let drawing = Promise.resolve();
@@ -175,7 +178,8 @@ canvas.addEventListener('wheel', (e) => {
 // --- frames -----------------------------------------------------------------
 
 function renderRequest(camera) {
-  return {scene_id: preview.sceneId, cameras: [camera], quality: 'auto', budget_ms: budgetMs};
+  return {scene_id: preview.sceneId, cameras: [camera], quality: 'auto', budget_ms: budgetMs,
+          still_ms: stillMs};
 }
 
 async function show(res, camera) {
@@ -226,9 +230,14 @@ function tick() {
   const key = JSON.stringify(camera);
   const now = performance.now();
   if (key === lastSentKey) {
-    // Camera at rest: ask again (the server decides when the camera has been
-    // still long enough for the full-accuracy frame), until that frame is in.
-    if (key === stillKey || now - lastSentAt < 30) return;
+    // Camera at rest: once it has been still for still_ms, ask for the frame
+    // again; the server (which times the motion itself) answers with the
+    // full-accuracy frame, or with "settling" if it is early, and then we
+    // retry shortly. Nothing is sent while a button is held on a resting camera.
+    if (drag || key === stillKey || inflight > 0) return;
+    if (now - lastChangeAt < stillMs || now - lastSentAt < 40) return;
+  } else {
+    lastChangeAt = now;
   }
   lastSentKey = key;
   lastSentAt = now;
