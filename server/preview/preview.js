@@ -147,7 +147,11 @@ canvas.addEventListener('pointerdown', (e) => {
   if (!orbit) return;
   drag = {x: e.clientX, y: e.clientY, pan: e.shiftKey || e.button === 2};
   canvas.classList.add('dragging');
-  canvas.setPointerCapture(e.pointerId);
+  try {
+    canvas.setPointerCapture(e.pointerId);
+  } catch {
+    // Synthetic pointers (scripts, tests) may have no capturable id.
+  }
 });
 canvas.addEventListener('pointermove', (e) => {
   if (!drag || !orbit) return;
@@ -165,6 +169,7 @@ canvas.addEventListener('pointermove', (e) => {
     orbit.yaw -= dx * 0.01;
     orbit.pitch = Math.max(-1.55, Math.min(1.55, orbit.pitch + dy * 0.01));
   }
+  maybeSend();
 });
 const endDrag = () => { drag = null; canvas.classList.remove('dragging'); };
 canvas.addEventListener('pointerup', endDrag);
@@ -173,6 +178,7 @@ canvas.addEventListener('wheel', (e) => {
   if (!orbit) return;
   e.preventDefault();
   orbit.dist *= Math.exp(e.deltaY * 0.001);
+  maybeSend();
 }, {passive: false});
 
 // --- frames -----------------------------------------------------------------
@@ -201,6 +207,8 @@ async function show(res, camera) {
   if (q.still) {
     preview.lastStill = {camera, bytes: data.slice()};
     stillKey = JSON.stringify(camera);
+  } else {
+    stillKey = null;  // the canvas shows an interactive frame again
   }
   updateOverlay();
 }
@@ -224,6 +232,13 @@ function updateOverlay() {
 
 function tick() {
   requestAnimationFrame(tick);
+  maybeSend();
+}
+
+// Sends the next render request if the pose changed (or the still frame is
+// due) and fewer than `maxInflight` are in flight. Called every animation
+// frame, on every pointer move and when a response is in.
+function maybeSend() {
   if (!orbit || !preview.sceneId || ws.readyState !== WebSocket.OPEN) return;
   if (inflight >= maxInflight) return;
   const camera = cameraFromOrbit(orbit);
@@ -247,7 +262,7 @@ function tick() {
   // Draw in arrival order, one at a time.
   drawing = drawing.then(() => req).then((res) => show(res, camera))
       .catch((e) => setStatus(`render: ${e.code || ''} ${e.message || e}`, true))
-      .finally(() => { --inflight; });
+      .finally(() => { --inflight; maybeSend(); });
 }
 
 async function selectScene(value) {

@@ -103,15 +103,25 @@ try {
   // Drag: a smooth orbit, one pointer move per ~16 ms (a 60 Hz mouse).
   const box = await page.locator('#canvas').boundingBox();
   const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
-  let step = 0;
-  const dragFor = async (ms, radius) => {
-    const wall0 = Date.now();
-    while (Date.now() - wall0 < ms) {
-      const a = (2 * Math.PI * (Date.now() - wall0)) / ms;
-      await page.mouse.move(cx + radius * Math.sin(a) + (++step % 2), cy + 0.4 * radius * Math.sin(2 * a));
-      await sleep(16);
-    }
-  };
+  // The button goes down and up through Playwright (trusted input); the
+  // moves in between are pointer events dispatched in the page every 16 ms,
+  // as a 60 Hz mouse delivers them: one CDP round trip per move would be
+  // slower than that on a loaded machine and would cap the frame rate.
+  const dragFor = (ms, radius) => page.evaluate(({ms, radius, cx, cy}) => new Promise((done) => {
+    const canvas = document.getElementById('canvas');
+    const start = performance.now();
+    const timer = setInterval(() => {
+      const t = performance.now() - start;
+      const a = (1.5 * Math.PI * t) / ms;  // ends away from the start pose
+      canvas.dispatchEvent(new PointerEvent('pointermove', {
+        clientX: cx + radius * Math.sin(a), clientY: cy + 0.4 * radius * Math.sin(2 * a),
+        pointerId: 1, bubbles: true, buttons: 1}));
+      if (t >= ms) {
+        clearInterval(timer);
+        done();
+      }
+    }, 16);
+  }), {ms, radius, cx, cy});
   // Warm-up: a short drag builds the cheap levels' tables (a one-time cost
   // per scene and render worker), then rest until the still frame is back.
   await page.mouse.move(cx, cy);
