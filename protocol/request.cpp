@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "protocol/utf8.hpp"
+
 namespace beamcast {
 namespace {
 [[noreturn]] void fail(std::string code, std::string path, std::string message) {
@@ -62,9 +64,14 @@ nlohmann::json ok_response(const nlohmann::json& id, nlohmann::json result) {
 }
 
 nlohmann::json error_response(const nlohmann::json& id, const ErrorInfo& e) {
+  // Messages and paths quote client bytes (parser excerpts, clipped strings,
+  // object keys); repair them so the response always serializes.
   return {{"id", id},
           {"ok", false},
-          {"error", {{"code", e.code}, {"message", e.message}, {"path", e.path}}}};
+          {"error",
+           {{"code", to_valid_utf8(e.code)},
+            {"message", to_valid_utf8(e.message)},
+            {"path", to_valid_utf8(e.path)}}}};
 }
 
 ErrorInfo with_path_prefix(ErrorInfo e, std::string_view prefix) {
