@@ -101,7 +101,8 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
   }
 
   void send(const nlohmann::json& response, std::vector<std::uint8_t> binary) override {
-    std::string text = response.dump();
+    // As Session::send: never throw on bytes a client smuggled into a message.
+    std::string text = response.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     core_.stats.count_bytes_out(text.size() + binary.size());
     asio::post(ws_.get_executor(), [self = shared_from_this(), t = std::move(text),
                                     b = std::move(binary)]() mutable {
