@@ -219,6 +219,22 @@ try {
         `still frame pixel-identical to the offline render (${live.width}x${live.height}, ` +
         `${differing} differing values, max difference ${maxDiff})`);
   result.still_pixel_identical = differing === 0;
+
+  // The scene picker: an example is stored over the WebSocket and rendered.
+  const before = await page.evaluate(() => window.beamcastPreview.frames.length);
+  await page.selectOption('#scene', 'example:paper_5sets.json');
+  let picked = false;
+  try {
+    await page.waitForFunction((n) => {
+      const p = window.beamcastPreview;
+      return p.sceneId === 'example.paper_5sets' && p.frames.slice(n).some((f) => f.still);
+    }, before, {timeout: 30000});
+    picked = true;
+  } catch {
+    picked = false;
+  }
+  await page.screenshot({path: path.join(artifacts, 'example_scene.png')});
+  check(picked, 'picking an example scene stores it and shows its full-accuracy frame');
   fs.writeFileSync(path.join(artifacts, 'result.json'), JSON.stringify(result, null, 2));
 } catch (e) {
   failures.push(String(e.stack || e));
