@@ -1,5 +1,7 @@
 #include "protocol/request.hpp"
 
+#include <cstdio>
+
 #include "protocol/utf8.hpp"
 
 namespace beamcast {
@@ -123,8 +125,9 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
       if (!it->is_number()) fail("wrong_type", path, std::string(key) + " must be a number");
       const double v = it->get<double>();
       if (!(v >= lo && v <= hi)) {
-        fail("out_of_range", path,
-             std::string(key) + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        char range[64];
+        std::snprintf(range, sizeof range, " must be in [%g, %g]", lo, hi);
+        fail("out_of_range", path, std::string(key) + range);
       }
       *out = v;
     };

@@ -148,8 +148,14 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     std::lock_guard lock(st.mu);
     // Costs are per scene content: a new scene (or new render settings) starts
     // a new controller. Inline scenes are keyed by their JSON.
-    const std::string key = (rp.scene_id ? "id:" + *rp.scene_id : "inline:" + scene_json->dump()) +
-                            "|" + (rp.output ? rp.output->dump() : "");
+    const auto text = [](const json& j) {
+      return j.dump(-1, ' ', false, json::error_handler_t::replace);
+    };
+    // A stored scene is keyed by its entry: scene.put/update make a new one.
+    const std::string key = (rp.scene_id ? "id:" + *rp.scene_id + "@" +
+                                               std::to_string(reinterpret_cast<std::uintptr_t>(stored.get()))
+                                         : "inline:" + text(*scene_json)) +
+                            "|" + (rp.output ? text(*rp.output) : "");
     if (!st.controller || st.scene_key != key) {
       ControllerConfig cfg;
       st.controller = std::make_unique<AccuracyController>(make_accuracy_ladder(scene->render), cfg);
