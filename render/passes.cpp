@@ -86,7 +86,7 @@ class BeamPass final : public Pass {
     table_loc_ = glGetUniformLocation(program_.get(), "u_table_size");
     surfaces_loc_ = glGetUniformLocation(program_.get(), "u_has_surfaces");
     for (const char* name : {"u_warp_size", "u_method", "u_chord", "u_warped", "u_shader_filter",
-                             "u_samples", "u_simpson"}) {
+                             "u_samples", "u_simpson", "u_near_parallel"}) {
       knob_loc_.push_back(glGetUniformLocation(program_.get(), name));
     }
   }
@@ -106,7 +106,8 @@ class BeamPass final : public Pass {
                          warped ? 1 : 0,
                          rs.filter == TableFilter::kShader ? 1 : 0,
                          rs.samples,
-                         rs.rule == MarchRule::kSimpson ? 1 : 0};
+                         rs.rule == MarchRule::kSimpson ? 1 : 0,
+                         rs.near_parallel == NearParallel::kQuadrature ? 1 : 0};
     for (std::size_t k = 0; k < knob_loc_.size(); ++k) glUniform1i(knob_loc_[k], knobs[k]);
     glBindTextureUnit(0, ctx.resources.g_texture());
     glBindTextureUnit(1, ctx.resources.f_texture());
