@@ -10,7 +10,7 @@ namespace {
 bool same_settings(const RenderSettings& a, const RenderSettings& b) {
   return a.method == b.method && a.table_d == b.table_d && a.table_s == b.table_s &&
          a.layout == b.layout && a.filter == b.filter && a.f_table == b.f_table &&
-         a.samples == b.samples && a.rule == b.rule;
+         a.samples == b.samples && a.rule == b.rule && a.near_parallel == b.near_parallel;
 }
 
 std::string settings_label(const RenderSettings& r) {
