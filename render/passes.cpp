@@ -76,8 +76,20 @@ class ProgramPair {
   GlProgram single_, multi_;
 };
 
-// Instances per draw: one per view in a multi-view batch.
-GLsizei instances(const FrameContext& ctx) { return ctx.views > 0 ? ctx.views : 1; }
+// Issues `draw` once per view of a multi-view batch (u_view = the view, into
+// that layer of the layered targets), or once for a single camera.
+template <class Draw>
+void for_each_view(const FrameContext& ctx, ProgramPair& program, Draw draw) {
+  if (ctx.views == 0) {
+    draw();
+    return;
+  }
+  const GLint loc = program.uniform(true, "u_view");
+  for (int v = 0; v < ctx.views; ++v) {
+    glUniform1i(loc, v);
+    draw();
+  }
+}
 
 // Occluders: rasterized triangles (boxes, meshes) and ray-traced planes and
 // spheres, depth-tested together; writes shaded colour and view depth.
@@ -100,15 +112,16 @@ class SurfacePass final : public Pass {
     if (ctx.resources.triangle_vertex_count() > 0) {
       glUseProgram(raster_.get(multi));
       glBindVertexArray(ctx.resources.triangle_vao());
-      glDrawArraysInstanced(GL_TRIANGLES, 0, ctx.resources.triangle_vertex_count(),
-                            instances(ctx));
+      for_each_view(ctx, raster_, [&] {
+        glDrawArrays(GL_TRIANGLES, 0, ctx.resources.triangle_vertex_count());
+      });
     }
     if (ctx.resources.analytic_count() > 0) {
       glUseProgram(analytic_.get(multi));
       glUniform1i(analytic_.uniform(multi, "u_count"), ctx.resources.analytic_count());
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ctx.resources.analytic_buffer());
       glBindVertexArray(ctx.empty_vao);
-      glDrawArraysInstanced(GL_TRIANGLES, 0, 3, instances(ctx));
+      for_each_view(ctx, analytic_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
     }
     glDisable(GL_DEPTH_TEST);
     gl_check("surfaces pass");
@@ -120,8 +133,8 @@ class SurfacePass final : public Pass {
 };
 
 // Beams: additive energy from the line-integral tables, one instanced draw of
-// box proxies, back faces only (see beam.vert); a multi-view batch draws
-// views x beams instances.
+// box proxies, back faces only (see beam.vert); one such draw per view in a
+// multi-view batch.
 class BeamPass final : public Pass {
  public:
   BeamPass()
@@ -164,7 +177,9 @@ class BeamPass final : public Pass {
     glEnable(GL_DEPTH_CLAMP);  // proxies past the near or far plane still cover their pixels
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(ctx.empty_vao);
-    glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count() * instances(ctx));
+    for_each_view(ctx, program_, [&] {
+      glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count());
+    });
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
     glDisable(GL_DEPTH_CLAMP);
@@ -191,7 +206,7 @@ class TonemapPass final : public Pass {
     glUniform1f(program_.uniform(multi, "u_levels"), out.bit_depth == 16 ? 65535.0f : 255.0f);
     glBindTextureUnit(0, ctx.targets.hdr.get());
     glBindVertexArray(ctx.empty_vao);
-    glDrawArraysInstanced(GL_TRIANGLES, 0, 3, instances(ctx));
+    for_each_view(ctx, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
     gl_check("tonemap pass");
   }
 

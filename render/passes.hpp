@@ -43,10 +43,16 @@ struct FrameContext {
   FrameTargets& targets;
   GLuint empty_vao;
   // 0: one camera (`camera`), the per-camera programs. K >= 1: a multi-view
-  // batch of K views (SceneResources::bind_views, layered targets), drawn by
-  // the multi-view programs with K instances per draw; `camera` is the first.
+  // batch of K <= kMaxBatchViews views (SceneResources::bind_views, layered
+  // targets), drawn by the multi-view programs, each draw once per view with
+  // the uniform u_view; `camera` is the first.
   int views = 0;
 };
+
+// Views in one multi-view batch: the size of the shaders' camera array
+// (BEAMCAST_MAX_VIEWS in shaders/multiview*.glsl; 64 blocks of 176 bytes fit
+// the 16 KiB every GL 4.5 driver must allow a uniform block).
+inline constexpr int kMaxBatchViews = 64;
 
 class Pass {
  public:

@@ -184,10 +184,10 @@ struct Renderer::Impl {
       bases.push_back(camera_basis(cameras[i]));
     }
     const int w = cams[0].width, h = cams[0].height;
-    res.bind_views(cams, bases);
+    res.bind_views(cams, bases, kMaxBatchViews);
     layered.ensure(w, h, scene.output.bit_depth, static_cast<int>(k));
     glViewport(0, 0, w, h);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, res.views_camera_buffer());
+    glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.views_camera_buffer());
     FrameContext ctx{scene, cams[0], bases[0], res, layered, empty_vao.get(), static_cast<int>(k)};
     run_passes(scene, ctx, plan);
 
@@ -288,7 +288,7 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
     for (std::size_t g = 0; g < groups.size(); ++g) {
       const std::int64_t pixels = static_cast<std::int64_t>(sizes[g].first) * sizes[g].second;
       const std::size_t cap = static_cast<std::size_t>(std::max<std::int64_t>(
-          1, std::min<std::int64_t>({opts.max_batch_views, impl_->max_layers,
+          1, std::min<std::int64_t>({opts.max_batch_views, kMaxBatchViews, impl_->max_layers,
                                      opts.max_batch_pixels / std::max<std::int64_t>(1, pixels)})));
       for (std::size_t at = 0; at < groups[g].size(); at += cap) {
         const std::size_t end = std::min(groups[g].size(), at + cap);

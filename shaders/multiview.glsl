@@ -2,3 +2,4 @@
 // draw renders K views into the layers of array targets; each stage picks its
 // view's camera from the Cameras buffer (common.glsl).
 #define BEAMCAST_MULTIVIEW 1
+#define BEAMCAST_MAX_VIEWS 64  // = kMaxBatchViews in render/passes.hpp
