@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 
 #include "protocol/camera.hpp"
@@ -42,8 +43,12 @@ struct Renderer::Impl {
   FrameTargets layered;  // multi-view batches
   GlVertexArray empty_vao;
   std::vector<GlQuery> queries;  // timestamps: frame start, then one after each pass
-  bool multiview = false;
+  bool multiview = true;  // multi-view batches need only GL 4.5
   int max_layers = 0;
+  // Target of the bilinear upscale when FrameOptions::resolution_scale < 1.
+  GlTexture upscaled;
+  GlFramebuffer upscaled_fbo;
+  int up_width = 0, up_height = 0, up_bits = 0;
 
   explicit Impl(const RendererOptions& opts)
       : context(EglContext::create(opts.egl)), tables(opts.table_cache_entries) {
@@ -54,12 +59,6 @@ struct Renderer::Impl {
     // Window depth in [0, 1] with reversed Z keeps float depth precise from
     // near to far.
     glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    GLint count = 0;
-    glGetIntegerv(GL_NUM_EXTENSIONS, &count);
-    for (GLint i = 0; i < count; ++i) {
-      const auto* ext = reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, i));
-      if (ext && std::strcmp(ext, "GL_ARB_shader_viewport_layer_array") == 0) multiview = true;
-    }
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
     gl_check("renderer setup");
   }
@@ -75,7 +74,6 @@ struct Renderer::Impl {
 
   // Clears the targets and runs the passes, with timestamps around each.
   void run_passes(const Scene& scene, FrameContext& ctx, const std::vector<Pass*>& plan) {
-    const GLuint fbo = ctx.targets.scene_fbo.get();
     const float bg[4] = {static_cast<float>(scene.background[0]),
                          static_cast<float>(scene.background[1]),
                          static_cast<float>(scene.background[2]), 0.0f};
@@ -83,9 +81,13 @@ struct Renderer::Impl {
     const float far_depth = 0.0f;  // reversed Z
     glDepthMask(GL_TRUE);
     glQueryCounter(query(0), GL_TIMESTAMP);
-    glClearNamedFramebufferfv(fbo, GL_COLOR, 0, bg);
-    glClearNamedFramebufferfv(fbo, GL_COLOR, 1, no_surface);
-    glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &far_depth);
+    // Single camera: the plain framebuffer (view -1); a batch: each view's.
+    for (int v = ctx.views > 0 ? 0 : -1; v < ctx.views; ++v) {
+      const GLuint fbo = ctx.targets.scene_for(v);
+      glClearNamedFramebufferfv(fbo, GL_COLOR, 0, bg);
+      glClearNamedFramebufferfv(fbo, GL_COLOR, 1, no_surface);
+      glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &far_depth);
+    }
     for (std::size_t i = 0; i < plan.size(); ++i) {
       plan[i]->execute(ctx);
       glQueryCounter(query(i + 1), GL_TIMESTAMP);
@@ -93,24 +95,56 @@ struct Renderer::Impl {
     gl_check("frame");
   }
 
-  // Pass times of the last run_passes (waits for the GPU).
-  BatchTiming read_timings(const std::vector<Pass*>& plan) {
+  // Bilinear upscale of the output (render size) to w x h, into `upscaled`.
+  void upscale(int rw, int rh, int w, int h, int bits) {
+    if (w != up_width || h != up_height || bits != up_bits) {
+      up_width = w;
+      up_height = h;
+      up_bits = bits;
+      upscaled = make_texture_2d(bits == 16 ? GL_RGBA16 : GL_RGBA8, w, h);
+      GLuint id = 0;
+      glCreateFramebuffers(1, &id);
+      upscaled_fbo = GlFramebuffer(id);
+      glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, upscaled.get(), 0);
+      check_framebuffer(id, "upscale framebuffer");
+    }
+    glBlitNamedFramebuffer(targets.output_fbo.get(), upscaled_fbo.get(), 0, 0, rw, rh, 0, 0, w, h,
+                           GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    gl_check("upscale blit");
+  }
+
+  // Pass times of the last run_passes (waits for the GPU); with `upscaled`,
+  // one more stamp after the upscale blit.
+  BatchTiming read_timings(const std::vector<Pass*>& plan, bool upscaled_frame = false) {
+    const std::size_t stamp_count = plan.size() + (upscaled_frame ? 2 : 1);
     GLuint64 stamps[16] = {};
-    for (std::size_t i = 0; i <= plan.size(); ++i) {
+    for (std::size_t i = 0; i < stamp_count; ++i) {
       glGetQueryObjectui64v(query(i), GL_QUERY_RESULT, &stamps[i]);
     }
     BatchTiming t;
     for (std::size_t i = 0; i < plan.size(); ++i) {
       t.passes.push_back({plan[i]->name(), (stamps[i + 1] - stamps[i]) * 1e-6});
     }
-    t.gpu_ms = (stamps[plan.size()] - stamps[0]) * 1e-6;
+    if (upscaled_frame) {
+      t.passes.push_back({"upscale", (stamps[plan.size() + 1] - stamps[plan.size()]) * 1e-6});
+    }
+    t.gpu_ms = (stamps[stamp_count - 1] - stamps[0]) * 1e-6;
     return t;
   }
 
-  FrameResult render_camera(const Scene& scene, const Camera& cam, SceneResources& res,
+  FrameResult render_camera(const Scene& scene, const Camera& full_cam, SceneResources& res,
                             const std::vector<Pass*>& plan, const FrameOptions& opts) {
     const auto wall0 = std::chrono::steady_clock::now();
     FrameResult result;
+    // A scaled frame renders a smaller copy of the camera (same view, fewer pixels).
+    Camera small = full_cam;
+    const bool scaled = opts.resolution_scale > 0.0 && opts.resolution_scale < 1.0;
+    if (scaled) {
+      small.width = std::max(1, static_cast<int>(std::lround(full_cam.width * opts.resolution_scale)));
+      small.height =
+          std::max(1, static_cast<int>(std::lround(full_cam.height * opts.resolution_scale)));
+    }
+    const Camera& cam = small;
     const CameraBasis basis = camera_basis(cam);
     res.bind_camera(cam, basis);
     targets.ensure(cam.width, cam.height, scene.output.bit_depth);
@@ -118,16 +152,22 @@ struct Renderer::Impl {
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.camera_buffer());
     FrameContext ctx{scene, cam, basis, res, targets, empty_vao.get()};
     run_passes(scene, ctx, plan);
+    if (scaled) {
+      upscale(cam.width, cam.height, full_cam.width, full_cam.height, scene.output.bit_depth);
+      glQueryCounter(query(plan.size() + 1), GL_TIMESTAMP);
+      gl_check("frame");
+    }
 
     // Read-back (synchronous: it waits for the GPU to finish the frame).
     const auto rb0 = std::chrono::steady_clock::now();
-    const int w = cam.width, h = cam.height;
+    const int w = full_cam.width, h = full_cam.height;
     result.image.width = w;
     result.image.height = h;
     result.image.bit_depth = scene.output.bit_depth;
     result.image.rgb.resize(3 * static_cast<std::size_t>(w) * h);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, targets.output_fbo.get());
+    glBindFramebuffer(GL_READ_FRAMEBUFFER,
+                      scaled ? upscaled_fbo.get() : targets.output_fbo.get());
     if (scene.output.bit_depth == 16) {
       glReadnPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_SHORT,
                     static_cast<GLsizei>(result.image.rgb.size() * 2), result.image.rgb.data());
@@ -146,21 +186,24 @@ struct Renderer::Impl {
                        result.image.rgb.begin() + (h - 1 - y) * row);
     }
     if (opts.read_hdr) {
-      result.hdr.width = w;
-      result.hdr.height = h;
-      std::vector<float> buf(row * h);
+      // The HDR buffer stays at the render size.
+      const int hw = cam.width, hh = cam.height;
+      const std::size_t hrow = 3 * static_cast<std::size_t>(hw);
+      result.hdr.width = hw;
+      result.hdr.height = hh;
+      std::vector<float> buf(hrow * hh);
       glBindFramebuffer(GL_READ_FRAMEBUFFER, targets.scene_fbo.get());
       glReadBuffer(GL_COLOR_ATTACHMENT0);
-      glReadnPixels(0, 0, w, h, GL_RGB, GL_FLOAT, static_cast<GLsizei>(buf.size() * 4),
+      glReadnPixels(0, 0, hw, hh, GL_RGB, GL_FLOAT, static_cast<GLsizei>(buf.size() * 4),
                     buf.data());
       gl_check("glReadnPixels(hdr)");
       result.hdr.rgb.resize(buf.size());
-      for (int y = 0; y < h; ++y) {
-        std::memcpy(&result.hdr.rgb[y * row], &buf[(h - 1 - y) * row], row * sizeof(float));
+      for (int y = 0; y < hh; ++y) {
+        std::memcpy(&result.hdr.rgb[y * hrow], &buf[(hh - 1 - y) * hrow], hrow * sizeof(float));
       }
     }
 
-    result.batch = read_timings(plan);
+    result.batch = read_timings(plan, scaled);
     result.passes = result.batch.passes;
     result.gpu_ms = result.batch.gpu_ms;
     result.wall_ms = ms_since(wall0);
@@ -270,9 +313,11 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
   std::vector<FrameResult> frames(cameras.size());
   // Batches: cameras of one size, in order of first appearance, split where a
   // batch would pass the view or memory bound. A batch of one takes the
-  // per-camera path.
+  // per-camera path, and so do scaled frames (resolution_scale < 1: the
+  // interactive preview, one camera per request).
   std::vector<std::vector<std::size_t>> batches;
-  if (opts.batch && impl_->multiview) {
+  const bool scaled = opts.resolution_scale > 0.0 && opts.resolution_scale < 1.0;
+  if (opts.batch && impl_->multiview && !scaled) {
     std::vector<std::pair<int, int>> sizes;
     std::vector<std::vector<std::size_t>> groups;
     for (std::size_t i = 0; i < cameras.size(); ++i) {

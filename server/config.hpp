@@ -13,6 +13,9 @@ namespace beamcast {
 struct ServerConfig {
   std::string bind = "127.0.0.1";
   unsigned short port = 7878;  // 0: any free port
+  // HTTP listener (preview page, WebSocket, GET endpoints) on `bind`; -1: none,
+  // 0: any free port. beamcast-server turns it on (7879) by default.
+  int http_port = -1;
   int device_index = -1;       // EGL device; -1: automatic
   std::string egl_platform = "auto";
   int render_workers = 1;  // threads that each own a GL context

@@ -155,7 +155,7 @@ void Session::on_read_deadline(const boost::system::error_code& ec) {
 }
 
 void Session::send(const nlohmann::json& response, std::vector<std::uint8_t> binary) {
-  auto frame = encode_frame(response.dump(), binary);
+  auto frame = encode_frame(response.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), binary);
   core_.stats.count_bytes_out(frame.size());
   asio::post(socket_.get_executor(), [self = shared_from_this(), f = std::move(frame)]() mutable {
     self->enqueue(std::move(f), false);

@@ -26,7 +26,6 @@ void main() {
   int index = gl_InstanceID;
 #ifdef BEAMCAST_MULTIVIEW
   select_view(u_view);
-  gl_Layer = u_view;
   index += u_view * u_view_beams;
 #endif
   BeamData b = beams[index];

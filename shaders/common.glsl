@@ -4,11 +4,11 @@
 
 #ifdef BEAMCAST_MULTIVIEW
 // Multi-view: one camera per view (layer), same layout as CameraBlock below.
-// Each draw renders one view, `u_view`, into layer u_view of the layered
-// targets; stages copy that view's entry into `cam` first (select_view). A
-// uniform view index (rather than one drawn from gl_InstanceID or gl_Layer)
-// keeps every branch on camera values uniform, so the compiler (llvmpipe:
-// NIR divergence analysis) need not run both sides of each.
+// Each draw renders one view, `u_view`, into layer u_view of the array
+// targets (through that layer's framebuffer); stages copy that view's entry
+// into `cam` first (select_view). A uniform view index (rather than one drawn
+// from gl_InstanceID or gl_Layer) keeps every branch on camera values uniform
+// for the compiler.
 struct CameraData {
   mat4 view_proj;    // camera-relative world -> clip, reversed Z (near -> 1, far -> 0)
   vec4 cam_right;    // xyz; w: tan(fov_y / 2) (perspective) or half height (orthographic)

@@ -1,0 +1,74 @@
+// libFuzzer target: one request's JSON text through the same validation the
+// server runs (parse_request, then per method parse_render_params, parse_scene,
+// parse_scene_id, output merging), ending with the response serialized the way
+// Session::send does it. Any exception other than ProtocolError is a finding:
+// the server would answer "internal" (or worse) instead of a clear error.
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "fuzz/fuzz_support.hpp"
+#include "protocol/request.hpp"
+#include "protocol/scene_json.hpp"
+
+using beamcast::ProtocolError;
+using json = nlohmann::json;
+
+namespace {
+
+json handle(const beamcast::Request& req, const beamcast::SceneLoadOptions& opts) {
+  const json& params = req.params;
+  if (req.method == "render") {
+    const beamcast::RenderParams rp = beamcast::parse_render_params(params, opts.limits);
+    json scene_json = rp.scene ? *rp.scene : beamcast::fuzz::base_scene_json();
+    beamcast::Scene scene;
+    try {
+      scene = beamcast::parse_scene(scene_json, opts);
+    } catch (const ProtocolError& e) {
+      throw ProtocolError(beamcast::with_path_prefix(e.info(), "/params/scene"));
+    }
+    if (rp.output) {
+      json merged = scene_json.value("output", json::object());
+      merged.merge_patch(*rp.output);
+      scene.output = beamcast::parse_output_settings(merged, "/params/output");
+    }
+    return {{"frames", rp.cameras ? rp.cameras->size() : scene.cameras.size()}};
+  }
+  if (req.method == "scene.put" || req.method == "scene.update") {
+    const std::string sid = beamcast::parse_scene_id(params, "/params/scene_id");
+    const char* key = req.method == "scene.put" ? "scene" : "patch";
+    auto it = params.find(key);
+    if (it == params.end() || !it->is_object()) {
+      throw ProtocolError({"wrong_type", std::string(key) + " must be an object",
+                           std::string("/params/") + key});
+    }
+    json doc = *it;
+    if (req.method == "scene.update") {
+      doc = beamcast::fuzz::base_scene_json();
+      doc.merge_patch(*it);
+    }
+    beamcast::Scene scene = beamcast::parse_scene(doc, opts);
+    return {{"scene_id", sid}, {"bytes", doc.dump().size()}, {"beams", scene.beams.size()}};
+  }
+  if (req.method == "scene.delete") return {{"deleted", beamcast::parse_scene_id(params, "/p")}};
+  return {{"echo", params}};
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  const beamcast::SceneLoadOptions opts = beamcast::fuzz::load_options();
+  json id;
+  json response;
+  try {
+    const beamcast::Request req = beamcast::parse_request(text, &id);
+    response = beamcast::ok_response(id, handle(req, opts));
+  } catch (const ProtocolError& e) {
+    beamcast::fuzz::check_error(e.info());
+    response = beamcast::error_response(id, e.info());
+  }
+  // Session::send serializes with the strict UTF-8 handler: it must not throw.
+  beamcast::fuzz::serialize(response);
+  return 0;
+}

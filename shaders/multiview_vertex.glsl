@@ -1,6 +1,0 @@
-// Prelude of the multi-view vertex stages: they route each primitive to its
-// view's layer by writing gl_Layer = u_view (ARB_shader_viewport_layer_array, which
-// llvmpipe and current GPU drivers have; the renderer checks before use).
-#extension GL_ARB_shader_viewport_layer_array : require
-#define BEAMCAST_MULTIVIEW 1
-#define BEAMCAST_MAX_VIEWS 64  // = kMaxBatchViews in render/passes.hpp
