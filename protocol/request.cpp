@@ -1,5 +1,7 @@
 #include "protocol/request.hpp"
 
+#include <cstdio>
+
 #include "protocol/utf8.hpp"
 
 namespace beamcast {
@@ -93,12 +95,12 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
   for (const auto& [key, value] : params.items()) {
     (void)value;
     if (key != "scene" && key != "scene_id" && key != "cameras" && key != "output" &&
-        key != "encoding" && key != "quality" && key != "budget_ms" && key != "still_ms" &&
-        key != "motion" && key != "interactive_format" && key != "atlas") {
+        key != "encoding" && key != "atlas" && key != "quality" && key != "budget_ms" &&
+        key != "still_ms" && key != "motion" && key != "interactive_format") {
       fail("unknown_field", "/params/" + key,
            "unknown render parameter \"" + key +
-               "\" (allowed: scene, scene_id, cameras, output, encoding, quality, budget_ms, "
-               "still_ms, motion, interactive_format, atlas)");
+               "\" (allowed: scene, scene_id, cameras, output, encoding, atlas, quality, "
+               "budget_ms, still_ms, motion, interactive_format)");
     }
   }
   bool automatic = false;
@@ -123,8 +125,9 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
       if (!it->is_number()) fail("wrong_type", path, std::string(key) + " must be a number");
       const double v = it->get<double>();
       if (!(v >= lo && v <= hi)) {
-        fail("out_of_range", path,
-             std::string(key) + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        char range[64];
+        std::snprintf(range, sizeof range, " must be in [%g, %g]", lo, hi);
+        fail("out_of_range", path, std::string(key) + range);
       }
       *out = v;
     };

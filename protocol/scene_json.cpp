@@ -325,7 +325,8 @@ OutputSettings parse_output(const Node& n) {
 
 RenderSettings parse_render(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "render settings");
-  o.allow_only({"method", "table_size", "layout", "filter", "f_table", "samples", "rule"});
+  o.allow_only(
+      {"method", "table_size", "layout", "filter", "f_table", "samples", "rule", "near_parallel"});
   RenderSettings r;
   if (auto m = o.optional("method")) {
     r.method = read_enum<IntegrationMethod>(*m, {{"table", IntegrationMethod::kTable},
@@ -345,6 +346,10 @@ RenderSettings parse_render(const Node& n, const SceneLimits& limits) {
   if (auto ru = o.optional("rule")) {
     r.rule = read_enum<MarchRule>(*ru, {{"midpoint", MarchRule::kMidpoint},
                                         {"simpson", MarchRule::kSimpson}});
+  }
+  if (auto np = o.optional("near_parallel")) {
+    r.near_parallel = read_enum<NearParallel>(*np, {{"quadrature", NearParallel::kQuadrature},
+                                                    {"none", NearParallel::kNone}});
   }
   if (auto n_samples = o.optional("samples")) {
     r.samples = read_int_in(*n_samples, 4, 1024);

@@ -189,7 +189,8 @@ class BeamPass final : public Pass {
         {"u_warped", warped ? 1 : 0},
         {"u_shader_filter", rs.filter == TableFilter::kShader ? 1 : 0},
         {"u_samples", rs.samples},
-        {"u_simpson", rs.rule == MarchRule::kSimpson ? 1 : 0}};
+        {"u_simpson", rs.rule == MarchRule::kSimpson ? 1 : 0},
+        {"u_near_parallel", rs.near_parallel == NearParallel::kQuadrature ? 1 : 0}};
     for (const auto& [uniform, value] : knobs) {
       glUniform1i(program_.uniform(multi, uniform), value);
     }

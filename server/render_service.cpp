@@ -142,6 +142,8 @@ void RenderService::worker_main(int index) {
       error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
     } else {
       try {
+        // Jobs share a render only with the same stored scene and default
+        // options (RenderJob::batch_key), so the first job's options hold for all.
         frames = renderer->render(*live.front().scene, cameras, live.front().options);
       } catch (const std::exception& e) {
         std::fprintf(stderr, "beamcast-server: render failed: %s\n", e.what());

@@ -148,8 +148,14 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     std::lock_guard lock(st.mu);
     // Costs are per scene content: a new scene (or new render settings) starts
     // a new controller. Inline scenes are keyed by their JSON.
-    const std::string key = (rp.scene_id ? "id:" + *rp.scene_id : "inline:" + scene_json->dump()) +
-                            "|" + (rp.output ? rp.output->dump() : "");
+    const auto text = [](const json& j) {
+      return j.dump(-1, ' ', false, json::error_handler_t::replace);
+    };
+    // A stored scene is keyed by its entry: scene.put/update make a new one.
+    const std::string key = (rp.scene_id ? "id:" + *rp.scene_id + "@" +
+                                               std::to_string(reinterpret_cast<std::uintptr_t>(stored.get()))
+                                         : "inline:" + text(*scene_json)) +
+                            "|" + (rp.output ? text(*rp.output) : "");
     if (!st.controller || st.scene_key != key) {
       ControllerConfig cfg;
       st.controller = std::make_unique<AccuracyController>(make_accuracy_ladder(scene->render), cfg);
@@ -188,8 +194,8 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     job.jpeg_quality = level.jpeg_quality;
   }
   // Only an unmodified stored scene at full quality may share a render with
-  // other requests (merged jobs share one set of frame options).
-  if (stored && !rp.output && !rp.quality) job.batch_key = stored.get();
+  // other requests (a batch renders with one set of options).
+  if (stored && !rp.output && !decision) job.batch_key = stored.get();
   job.done = [&core, session, id, cameras, arrived, base64 = rp.base64,
               passes = plan_passes(*scene), bit_depth = scene->output.bit_depth, decision, level,
               ladder_size, budget_ms, jpeg = job.jpeg, jpeg_quality = job.jpeg_quality](
@@ -250,6 +256,8 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
                 {"index", i},
                 {"width", cameras[i].width},
                 {"height", cameras[i].height},
+                {"format", !out.atlas && out.is_jpeg[i] ? "jpeg" : "png"},
+                {"bit_depth", bit_depth},
                 {"gpu_ms", fr.gpu_ms},
                 {"pass_ms", pass_ms},
                 {"readback_ms", fr.readback_ms},
@@ -264,12 +272,17 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
         f["x"] = t.x;
         f["y"] = t.y;
       } else {
-        f["format"] = out.is_jpeg[i] ? "jpeg" : "png";
+        f["format"] = "png";
         f["bit_depth"] = bit_depth;
         f["encode_ms"] = out.encode_ms[i];
         attach(f, out.pngs[i]);
       }
       frames.push_back(std::move(f));
+    }
+    std::vector<std::string> frame_passes = passes;
+    if (!out.frames.empty()) {
+      frame_passes.clear();
+      for (const PassTiming& p : out.frames[0].passes) frame_passes.push_back(p.name);
     }
     if (out.atlas) {
       // One image; the frames become its tiles.
@@ -289,11 +302,6 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
                   {"tiles", std::move(frames)}}}};
       attach(f, out.pngs[0]);
       frames = json::array({std::move(f)});
-    }
-    std::vector<std::string> frame_passes = passes;
-    if (!out.frames.empty()) {
-      frame_passes.clear();
-      for (const PassTiming& p : out.frames[0].passes) frame_passes.push_back(p.name);
     }
     json result = {{"passes", frame_passes},
                    {"batched", out.batched_requests > 1},
