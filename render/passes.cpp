@@ -2,6 +2,7 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "shaders/shader_sources.hpp"
 
@@ -42,6 +43,28 @@ void FrameTargets::ensure(int w, int h, int bits, int layer_count) {
   check_framebuffer(ids[0], "scene framebuffer");
   check_framebuffer(ids[1], "beam framebuffer");
   check_framebuffer(ids[2], "output framebuffer");
+  // One framebuffer triple per layer. Rendering each view through its own
+  // (non-layered) framebuffer measured faster on llvmpipe than one layered
+  // framebuffer with gl_Layer routing (docs/performance.md).
+  layer_fbos.clear();
+  layer_fbos.resize(static_cast<std::size_t>(layer_count));
+  for (int v = 0; v < layer_count; ++v) {
+    GLuint l[3];
+    glCreateFramebuffers(3, l);
+    LayerFbos& f = layer_fbos[static_cast<std::size_t>(v)];
+    f.scene = GlFramebuffer(l[0]);
+    f.beam = GlFramebuffer(l[1]);
+    f.output = GlFramebuffer(l[2]);
+    glNamedFramebufferTextureLayer(l[0], GL_COLOR_ATTACHMENT0, hdr.get(), 0, v);
+    glNamedFramebufferTextureLayer(l[0], GL_COLOR_ATTACHMENT1, view_depth.get(), 0, v);
+    glNamedFramebufferTextureLayer(l[0], GL_DEPTH_ATTACHMENT, depth.get(), 0, v);
+    glNamedFramebufferDrawBuffers(l[0], 2, both);
+    glNamedFramebufferTextureLayer(l[1], GL_COLOR_ATTACHMENT0, hdr.get(), 0, v);
+    glNamedFramebufferTextureLayer(l[2], GL_COLOR_ATTACHMENT0, output.get(), 0, v);
+    check_framebuffer(l[0], "scene framebuffer (layer)");
+    check_framebuffer(l[1], "beam framebuffer (layer)");
+    check_framebuffer(l[2], "output framebuffer (layer)");
+  }
   gl_check("FrameTargets::ensure");
 }
 
@@ -60,7 +83,7 @@ class ProgramPair {
     if (!multiview) return single_.get();
     if (!multi_) {
       std::vector<std::string_view> v = vert_, f = frag_;
-      v.insert(v.begin(), "multiview_vertex.glsl");
+      v.insert(v.begin(), "multiview.glsl");
       f.insert(f.begin(), "multiview.glsl");
       multi_ = build_program(name_ + "_multiview", assemble_shader(v), assemble_shader(f));
     }
@@ -76,8 +99,22 @@ class ProgramPair {
   GlProgram single_, multi_;
 };
 
-// Instances per draw: one per view in a multi-view batch.
-GLsizei instances(const FrameContext& ctx) { return ctx.views > 0 ? ctx.views : 1; }
+// Issues `draw` into `fbo(view)` once per view of a multi-view batch (with
+// u_view = the view), or once into the plain framebuffer for a single camera.
+template <class Fbo, class Draw>
+void for_each_view(const FrameContext& ctx, ProgramPair& program, Fbo fbo, Draw draw) {
+  if (ctx.views == 0) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo(-1));
+    draw();
+    return;
+  }
+  const GLint loc = program.uniform(true, "u_view");
+  for (int v = 0; v < ctx.views; ++v) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo(v));
+    glUniform1i(loc, v);
+    draw();
+  }
+}
 
 // Occluders: rasterized triangles (boxes, meshes) and ray-traced planes and
 // spheres, depth-tested together; writes shaded colour and view depth.
@@ -90,25 +127,32 @@ class SurfacePass final : public Pass {
   const char* name() const override { return "surfaces"; }
   void execute(FrameContext& ctx) override {
     const bool multi = ctx.views > 0;
-    glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.scene_fbo.get());
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);  // reversed Z
     glDepthMask(GL_TRUE);
     glDisable(GL_CULL_FACE);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_CLAMP);  // triangles are clipped by the near and far planes
-    if (ctx.resources.triangle_vertex_count() > 0) {
-      glUseProgram(raster_.get(multi));
-      glBindVertexArray(ctx.resources.triangle_vao());
-      glDrawArraysInstanced(GL_TRIANGLES, 0, ctx.resources.triangle_vertex_count(),
-                            instances(ctx));
-    }
-    if (ctx.resources.analytic_count() > 0) {
-      glUseProgram(analytic_.get(multi));
-      glUniform1i(analytic_.uniform(multi, "u_count"), ctx.resources.analytic_count());
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ctx.resources.analytic_buffer());
-      glBindVertexArray(ctx.empty_vao);
-      glDrawArraysInstanced(GL_TRIANGLES, 0, 3, instances(ctx));
+    const bool raster = ctx.resources.triangle_vertex_count() > 0;
+    const bool analytic = ctx.resources.analytic_count() > 0;
+    if (analytic) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ctx.resources.analytic_buffer());
+    // Per view: both draws into the view's framebuffer.
+    const int views = multi ? ctx.views : 1;
+    for (int v = 0; v < views; ++v) {
+      glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.scene_for(multi ? v : -1));
+      if (raster) {
+        glUseProgram(raster_.get(multi));
+        if (multi) glUniform1i(raster_.uniform(true, "u_view"), v);
+        glBindVertexArray(ctx.resources.triangle_vao());
+        glDrawArrays(GL_TRIANGLES, 0, ctx.resources.triangle_vertex_count());
+      }
+      if (analytic) {
+        glUseProgram(analytic_.get(multi));
+        if (multi) glUniform1i(analytic_.uniform(true, "u_view"), v);
+        glUniform1i(analytic_.uniform(multi, "u_count"), ctx.resources.analytic_count());
+        glBindVertexArray(ctx.empty_vao);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+      }
     }
     glDisable(GL_DEPTH_TEST);
     gl_check("surfaces pass");
@@ -120,8 +164,8 @@ class SurfacePass final : public Pass {
 };
 
 // Beams: additive energy from the line-integral tables, one instanced draw of
-// box proxies, back faces only (see beam.vert); a multi-view batch draws
-// views x beams instances.
+// box proxies, back faces only (see beam.vert); one such draw per view in a
+// multi-view batch.
 class BeamPass final : public Pass {
  public:
   BeamPass()
@@ -130,7 +174,6 @@ class BeamPass final : public Pass {
   const char* name() const override { return "beams"; }
   void execute(FrameContext& ctx) override {
     const bool multi = ctx.views > 0;
-    glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.beam_fbo.get());
     glUseProgram(program_.get(multi));
     glUniform3i(program_.uniform(multi, "u_table_size"), ctx.resources.table_d(),
                 ctx.resources.table_s(), ctx.resources.table_f());
@@ -165,7 +208,9 @@ class BeamPass final : public Pass {
     glEnable(GL_DEPTH_CLAMP);  // proxies past the near or far plane still cover their pixels
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(ctx.empty_vao);
-    glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count() * instances(ctx));
+    for_each_view(ctx, program_, [&](int v) { return ctx.targets.beam_for(v); }, [&] {
+      glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count());
+    });
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
     glDisable(GL_DEPTH_CLAMP);
@@ -184,7 +229,6 @@ class TonemapPass final : public Pass {
   const char* name() const override { return "tonemap"; }
   void execute(FrameContext& ctx) override {
     const bool multi = ctx.views > 0;
-    glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.output_fbo.get());
     glUseProgram(program_.get(multi));
     const OutputSettings& out = ctx.scene.output;
     glUniform1f(program_.uniform(multi, "u_exposure"), static_cast<float>(out.exposure));
@@ -192,7 +236,8 @@ class TonemapPass final : public Pass {
     glUniform1f(program_.uniform(multi, "u_levels"), out.bit_depth == 16 ? 65535.0f : 255.0f);
     glBindTextureUnit(0, ctx.targets.hdr.get());
     glBindVertexArray(ctx.empty_vao);
-    glDrawArraysInstanced(GL_TRIANGLES, 0, 3, instances(ctx));
+    for_each_view(ctx, program_, [&](int v) { return ctx.targets.output_for(v); },
+                  [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
     gl_check("tonemap pass");
   }
 

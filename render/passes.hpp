@@ -18,7 +18,8 @@ namespace beamcast {
 // Render targets of one frame size: linear HDR colour, view depth (surfaces'
 // distance along the view axis; cleared to kNoSurface), depth buffer, output.
 // With layers > 0 every target is a 2D array texture of that many layers
-// (one per view of a multi-view batch) attached layered.
+// (one per view of a multi-view batch), with one framebuffer triple per layer
+// (`layer_fbos`); the layered triple (`scene_fbo` ...) is then unused.
 struct FrameTargets {
   static constexpr float kNoSurface = 1e30f;
   int width = 0;
@@ -32,7 +33,21 @@ struct FrameTargets {
   GlFramebuffer scene_fbo;   // hdr + view_depth + depth
   GlFramebuffer beam_fbo;    // hdr only (beams read view_depth as a texture)
   GlFramebuffer output_fbo;  // output
+  struct LayerFbos {
+    GlFramebuffer scene, beam, output;
+  };
+  std::vector<LayerFbos> layer_fbos;
   void ensure(int w, int h, int bits, int layer_count = 0);
+  // The framebuffer of a view (view < 0 or no layers: the plain one).
+  GLuint scene_for(int view) const {
+    return view < 0 || layers == 0 ? scene_fbo.get() : layer_fbos[view].scene.get();
+  }
+  GLuint beam_for(int view) const {
+    return view < 0 || layers == 0 ? beam_fbo.get() : layer_fbos[view].beam.get();
+  }
+  GLuint output_for(int view) const {
+    return view < 0 || layers == 0 ? output_fbo.get() : layer_fbos[view].output.get();
+  }
 };
 
 struct FrameContext {
@@ -43,10 +58,16 @@ struct FrameContext {
   FrameTargets& targets;
   GLuint empty_vao;
   // 0: one camera (`camera`), the per-camera programs. K >= 1: a multi-view
-  // batch of K views (SceneResources::bind_views, layered targets), drawn by
-  // the multi-view programs with K instances per draw; `camera` is the first.
+  // batch of K <= kMaxBatchViews views (SceneResources::bind_views, array
+  // targets), drawn by the multi-view programs, each draw once per view into
+  // that view's layer with the uniform u_view; `camera` is the first.
   int views = 0;
 };
+
+// Views in one multi-view batch: the size of the shaders' camera array
+// (BEAMCAST_MAX_VIEWS in shaders/multiview*.glsl; 64 blocks of 176 bytes fit
+// the 16 KiB every GL 4.5 driver must allow a uniform block).
+inline constexpr int kMaxBatchViews = 64;
 
 class Pass {
  public:

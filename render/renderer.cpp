@@ -43,7 +43,7 @@ struct Renderer::Impl {
   FrameTargets layered;  // multi-view batches
   GlVertexArray empty_vao;
   std::vector<GlQuery> queries;  // timestamps: frame start, then one after each pass
-  bool multiview = false;
+  bool multiview = true;  // multi-view batches need only GL 4.5
   int max_layers = 0;
   // Target of the bilinear upscale when FrameOptions::resolution_scale < 1.
   GlTexture upscaled;
@@ -59,12 +59,6 @@ struct Renderer::Impl {
     // Window depth in [0, 1] with reversed Z keeps float depth precise from
     // near to far.
     glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    GLint count = 0;
-    glGetIntegerv(GL_NUM_EXTENSIONS, &count);
-    for (GLint i = 0; i < count; ++i) {
-      const auto* ext = reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, i));
-      if (ext && std::strcmp(ext, "GL_ARB_shader_viewport_layer_array") == 0) multiview = true;
-    }
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
     gl_check("renderer setup");
   }
@@ -76,6 +70,29 @@ struct Renderer::Impl {
       queries.emplace_back(id);
     }
     return queries[i].get();
+  }
+
+  // Clears the targets and runs the passes, with timestamps around each.
+  void run_passes(const Scene& scene, FrameContext& ctx, const std::vector<Pass*>& plan) {
+    const float bg[4] = {static_cast<float>(scene.background[0]),
+                         static_cast<float>(scene.background[1]),
+                         static_cast<float>(scene.background[2]), 0.0f};
+    const float no_surface[4] = {FrameTargets::kNoSurface, 0.0f, 0.0f, 0.0f};
+    const float far_depth = 0.0f;  // reversed Z
+    glDepthMask(GL_TRUE);
+    glQueryCounter(query(0), GL_TIMESTAMP);
+    // Single camera: the plain framebuffer (view -1); a batch: each view's.
+    for (int v = ctx.views > 0 ? 0 : -1; v < ctx.views; ++v) {
+      const GLuint fbo = ctx.targets.scene_for(v);
+      glClearNamedFramebufferfv(fbo, GL_COLOR, 0, bg);
+      glClearNamedFramebufferfv(fbo, GL_COLOR, 1, no_surface);
+      glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &far_depth);
+    }
+    for (std::size_t i = 0; i < plan.size(); ++i) {
+      plan[i]->execute(ctx);
+      glQueryCounter(query(i + 1), GL_TIMESTAMP);
+    }
+    gl_check("frame");
   }
 
   // Bilinear upscale of the output (render size) to w x h, into `upscaled`.
@@ -96,32 +113,12 @@ struct Renderer::Impl {
     gl_check("upscale blit");
   }
 
-  // Clears the targets and runs the passes, with timestamps around each.
-  void run_passes(const Scene& scene, FrameContext& ctx, const std::vector<Pass*>& plan) {
-    const GLuint fbo = ctx.targets.scene_fbo.get();
-    const float bg[4] = {static_cast<float>(scene.background[0]),
-                         static_cast<float>(scene.background[1]),
-                         static_cast<float>(scene.background[2]), 0.0f};
-    const float no_surface[4] = {FrameTargets::kNoSurface, 0.0f, 0.0f, 0.0f};
-    const float far_depth = 0.0f;  // reversed Z
-    glDepthMask(GL_TRUE);
-    glQueryCounter(query(0), GL_TIMESTAMP);
-    glClearNamedFramebufferfv(fbo, GL_COLOR, 0, bg);
-    glClearNamedFramebufferfv(fbo, GL_COLOR, 1, no_surface);
-    glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &far_depth);
-    for (std::size_t i = 0; i < plan.size(); ++i) {
-      plan[i]->execute(ctx);
-      glQueryCounter(query(i + 1), GL_TIMESTAMP);
-    }
-    gl_check("frame");
-  }
-
-  // Pass times of the last run_passes (waits for the GPU).
-  // `upscaled`: one more timestamp follows the passes, after the upscale.
+  // Pass times of the last run_passes (waits for the GPU); with `upscaled`,
+  // one more stamp after the upscale blit.
   BatchTiming read_timings(const std::vector<Pass*>& plan, bool upscaled_frame = false) {
+    const std::size_t stamp_count = plan.size() + (upscaled_frame ? 2 : 1);
     GLuint64 stamps[16] = {};
-    const std::size_t count = plan.size() + 1 + (upscaled_frame ? 1 : 0);
-    for (std::size_t i = 0; i < count; ++i) {
+    for (std::size_t i = 0; i < stamp_count; ++i) {
       glGetQueryObjectui64v(query(i), GL_QUERY_RESULT, &stamps[i]);
     }
     BatchTiming t;
@@ -131,7 +128,7 @@ struct Renderer::Impl {
     if (upscaled_frame) {
       t.passes.push_back({"upscale", (stamps[plan.size() + 1] - stamps[plan.size()]) * 1e-6});
     }
-    t.gpu_ms = (stamps[count - 1] - stamps[0]) * 1e-6;
+    t.gpu_ms = (stamps[stamp_count - 1] - stamps[0]) * 1e-6;
     return t;
   }
 
@@ -158,6 +155,7 @@ struct Renderer::Impl {
     if (scaled) {
       upscale(cam.width, cam.height, full_cam.width, full_cam.height, scene.output.bit_depth);
       glQueryCounter(query(plan.size() + 1), GL_TIMESTAMP);
+      gl_check("frame");
     }
 
     // Read-back (synchronous: it waits for the GPU to finish the frame).
@@ -188,7 +186,7 @@ struct Renderer::Impl {
                        result.image.rgb.begin() + (h - 1 - y) * row);
     }
     if (opts.read_hdr) {
-      // The HDR buffer is the scene's, at the render size (not upscaled).
+      // The HDR buffer stays at the render size.
       const int hw = cam.width, hh = cam.height;
       const std::size_t hrow = 3 * static_cast<std::size_t>(hw);
       result.hdr.width = hw;
@@ -229,10 +227,10 @@ struct Renderer::Impl {
       bases.push_back(camera_basis(cameras[i]));
     }
     const int w = cams[0].width, h = cams[0].height;
-    res.bind_views(cams, bases);
+    res.bind_views(cams, bases, kMaxBatchViews);
     layered.ensure(w, h, scene.output.bit_depth, static_cast<int>(k));
     glViewport(0, 0, w, h);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, res.views_camera_buffer());
+    glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.views_camera_buffer());
     FrameContext ctx{scene, cams[0], bases[0], res, layered, empty_vao.get(), static_cast<int>(k)};
     run_passes(scene, ctx, plan);
 
@@ -315,9 +313,9 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
   std::vector<FrameResult> frames(cameras.size());
   // Batches: cameras of one size, in order of first appearance, split where a
   // batch would pass the view or memory bound. A batch of one takes the
-  // per-camera path.
+  // per-camera path, and so do scaled frames (resolution_scale < 1: the
+  // interactive preview, one camera per request).
   std::vector<std::vector<std::size_t>> batches;
-  // Scaled (interactive) frames take the per-camera path, which owns the upscale.
   const bool scaled = opts.resolution_scale > 0.0 && opts.resolution_scale < 1.0;
   if (opts.batch && impl_->multiview && !scaled) {
     std::vector<std::pair<int, int>> sizes;
@@ -335,7 +333,7 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
     for (std::size_t g = 0; g < groups.size(); ++g) {
       const std::int64_t pixels = static_cast<std::int64_t>(sizes[g].first) * sizes[g].second;
       const std::size_t cap = static_cast<std::size_t>(std::max<std::int64_t>(
-          1, std::min<std::int64_t>({opts.max_batch_views, impl_->max_layers,
+          1, std::min<std::int64_t>({opts.max_batch_views, kMaxBatchViews, impl_->max_layers,
                                      opts.max_batch_pixels / std::max<std::int64_t>(1, pixels)})));
       for (std::size_t at = 0; at < groups[g].size(); at += cap) {
         const std::size_t end = std::min(groups[g].size(), at + cap);

@@ -26,18 +26,22 @@ struct PassTiming {
 
 struct FrameOptions {
   bool read_hdr = false;  // also read back the linear HDR buffer
-  // Render at this fraction of the camera's width and height, then upscale to
-  // the camera's size with a bilinear blit on the GPU ("upscale" pass); 1 =
-  // native (no extra pass). The HDR buffer, if read, stays at the render size.
-  double resolution_scale = 1.0;
   // Multi-view batching: cameras of one size are rendered together, K views
-  // per draw into layered targets, and read back in one transfer. Off (or
+  // per pass into layered targets, and read back in one transfer. Off (or
   // without layered rendering in the driver): one camera at a time.
   bool batch = true;
-  int max_batch_views = 64;
+  // Views per batch. 4 by measurement on llvmpipe (docs/performance.md,
+  // "Multi-view rendering"): batches of 4 cost what 4 single frames cost,
+  // larger ones grew slower per view (2x at 36 views of 64x64).
+  int max_batch_views = 4;
   // Memory bound of a batch: views * width * height (the targets take about
   // 28 bytes a pixel; 16 Mpx is 448 MB, 64 views of 512x512).
   std::int64_t max_batch_pixels = 16LL << 20;
+  // Render at this fraction of the camera's width and height, then upscale to
+  // the camera's size with a bilinear blit on the GPU ("upscale" pass); 1 =
+  // native (no extra pass). The HDR buffer, if read, stays at the render size.
+  // Scaled frames take the per-camera path (no multi-view batches).
+  double resolution_scale = 1.0;
 };
 
 // The GPU work a frame was part of: a multi-view batch of `views` cameras, or
@@ -71,8 +75,8 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   const std::string& description() const;
-  // True if the context can render several views in one pass (gl_Layer from
-  // the vertex stage: GL_ARB_shader_viewport_layer_array).
+  // True if the context can render multi-view batches (every GL 4.5 context
+  // can: they need array textures and per-layer framebuffers only).
   bool multiview_supported() const;
 
   // Renders every camera of the scene; scene resources (tables, occluder

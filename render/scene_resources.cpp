@@ -354,7 +354,7 @@ void SceneResources::bind_camera(const Camera& cam, const CameraBasis& basis) {
 }
 
 void SceneResources::bind_views(const std::vector<Camera>& cams,
-                                const std::vector<CameraBasis>& bases) {
+                                const std::vector<CameraBasis>& bases, int max_views) {
   const std::size_t k = cams.size();
   const std::size_t nb = scene_.beams.size(), na = analytic_.size();
   if (k > views_capacity_) {
@@ -366,7 +366,8 @@ void SceneResources::bind_views(const std::vector<Camera>& cams,
       glNamedBufferStorage(id, static_cast<GLsizeiptr>(std::max<std::size_t>(bytes, 16)), nullptr,
                            GL_DYNAMIC_STORAGE_BIT);
     };
-    make(views_camera_ssbo_, k * sizeof(CameraBlock));
+    // The shaders declare a fixed array of max_views blocks: the buffer backs all of it.
+    make(views_camera_ubo_, static_cast<std::size_t>(max_views) * sizeof(CameraBlock));
     make(views_beam_ssbo_, k * nb * sizeof(BeamData));
     make(views_analytic_ssbo_, k * na * sizeof(AnalyticData));
     views_capacity_ = k;
@@ -379,7 +380,7 @@ void SceneResources::bind_views(const std::vector<Camera>& cams,
     fill_beams(bases[v].eye, beams.data() + v * nb);
     fill_analytic(bases[v].eye, analytic.data() + v * na);
   }
-  glNamedBufferSubData(views_camera_ssbo_.get(), 0,
+  glNamedBufferSubData(views_camera_ubo_.get(), 0,
                        static_cast<GLsizeiptr>(blocks.size() * sizeof(CameraBlock)),
                        blocks.data());
   if (nb > 0) {

@@ -35,12 +35,13 @@ class SceneResources {
   SceneResources(const Scene& scene, TableCache& tables);
   // Uploads the camera block and camera-relative beam and occluder data.
   void bind_camera(const Camera& cam, const CameraBasis& basis);
-  // Multi-view: uploads one camera block per view (the Cameras buffer at SSBO
-  // binding 4) and view-major camera-relative beams and analytic occluders,
+  // Multi-view: uploads one camera block per view (the CameraBlocks uniform
+  // buffer, room for `max_views`) and view-major camera-relative beams and analytic occluders,
   // the same values bind_camera computes for each camera alone. Until the next
   // bind_camera, beam_buffer() and analytic_buffer() return the multi-view ones.
-  void bind_views(const std::vector<Camera>& cams, const std::vector<CameraBasis>& bases);
-  GLuint views_camera_buffer() const { return views_camera_ssbo_.get(); }
+  void bind_views(const std::vector<Camera>& cams, const std::vector<CameraBasis>& bases,
+                  int max_views);
+  GLuint views_camera_buffer() const { return views_camera_ubo_.get(); }
 
   int table_d() const { return nd_; }
   int table_s() const { return ns_; }
@@ -70,7 +71,7 @@ class SceneResources {
   Vec3 mesh_anchor_{};
   std::vector<const Occluder*> analytic_;  // planes and spheres
   bool views_ = false;  // bind_views was last
-  GlBuffer views_camera_ssbo_, views_beam_ssbo_, views_analytic_ssbo_;
+  GlBuffer views_camera_ubo_, views_beam_ssbo_, views_analytic_ssbo_;
   std::size_t views_capacity_ = 0;  // views the multi-view buffers hold
 
   // The per-camera data of bind_camera, written to `out` (for bind_views).

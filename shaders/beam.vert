@@ -14,7 +14,7 @@ layout(std430, binding = 1) readonly buffer Beams { BeamData beams[]; };
 
 flat out int v_beam;
 #ifdef BEAMCAST_MULTIVIEW
-uniform int u_view_beams;  // beams per view: instance = view * u_view_beams + beam
+uniform int u_view_beams;  // beams per view; view v's copies start at v * u_view_beams
 #endif
 
 // Cube corners (bit 0: x, bit 1: y, bit 2: z) of 12 triangles, counter-clockwise
@@ -23,12 +23,12 @@ const int kCubeIndex[36] = int[36](4, 6, 2, 4, 2, 0, 1, 3, 7, 1, 7, 5, 0, 1, 5, 
                                    6, 7, 3, 6, 3, 2, 2, 3, 1, 2, 1, 0, 4, 5, 7, 4, 7, 6);
 
 void main() {
+  int index = gl_InstanceID;
 #ifdef BEAMCAST_MULTIVIEW
-  int view = gl_InstanceID / u_view_beams;
-  select_view(view);
-  gl_Layer = view;
+  select_view(u_view);
+  index += u_view * u_view_beams;
 #endif
-  BeamData b = beams[gl_InstanceID];
+  BeamData b = beams[index];
   int ci = kCubeIndex[gl_VertexID];
   vec3 c = vec3((ci & 1) != 0 ? 1.0 : -1.0, (ci & 2) != 0 ? 1.0 : -1.0, (ci & 4) != 0 ? 1.0 : -1.0);
   float r = b.p0_radius.w;
@@ -46,6 +46,6 @@ void main() {
     float along = mix(lo, hi, 0.5 * (c.z + 1.0));
     pos = b.p0_radius.xyz + along * w + r * (c.x * u1 + c.y * u2);
   }
-  v_beam = gl_InstanceID;
+  v_beam = index;
   gl_Position = cam.view_proj * vec4(pos, 1.0);
 }

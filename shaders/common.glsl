@@ -3,8 +3,12 @@
 // far-away scenes keep float precision near the camera.
 
 #ifdef BEAMCAST_MULTIVIEW
-// Multi-view: one camera per view (layer), same layout as CameraBlock below;
-// stages copy their view's entry into `cam` first (select_view).
+// Multi-view: one camera per view (layer), same layout as CameraBlock below.
+// Each draw renders one view, `u_view`, into layer u_view of the array
+// targets (through that layer's framebuffer); stages copy that view's entry
+// into `cam` first (select_view). A uniform view index (rather than one drawn
+// from gl_InstanceID or gl_Layer) keeps every branch on camera values uniform
+// for the compiler.
 struct CameraData {
   mat4 view_proj;    // camera-relative world -> clip, reversed Z (near -> 1, far -> 0)
   vec4 cam_right;    // xyz; w: tan(fov_y / 2) (perspective) or half height (orthographic)
@@ -15,12 +19,13 @@ struct CameraData {
   vec4 light_color;  // rgb: light color; w: intensity
   vec4 mesh_offset;  // xyz: mesh anchor minus eye (triangles are stored anchor-relative)
 };
-layout(std430, binding = 4) readonly buffer Cameras { CameraData cams[]; };
+layout(std140, binding = 0) uniform CameraBlocks { CameraData cams[BEAMCAST_MAX_VIEWS]; };
+uniform int u_view;
 CameraData cam;
 void select_view(int view) { cam = cams[view]; }
-int view_index() { return gl_Layer; }  // fragment stages
+int view_index() { return u_view; }
 #define VIEW_SAMPLER sampler2DArray
-#define VIEW_TEXEL(s, p) texelFetch(s, ivec3(p, gl_Layer), 0)
+#define VIEW_TEXEL(s, p) texelFetch(s, ivec3(p, u_view), 0)
 #else
 layout(std140, binding = 0) uniform CameraBlock {
   mat4 view_proj;    // camera-relative world -> clip, reversed Z (near -> 1, far -> 0)

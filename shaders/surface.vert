@@ -9,8 +9,7 @@ out vec3 v_albedo;
 
 void main() {
 #ifdef BEAMCAST_MULTIVIEW
-  select_view(gl_InstanceID);  // one instance per view
-  gl_Layer = gl_InstanceID;
+  select_view(u_view);  // this draw's view
 #endif
   v_position = a_position + cam.mesh_offset.xyz;
   v_normal = a_normal;

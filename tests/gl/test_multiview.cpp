@@ -4,12 +4,13 @@
 //
 // Tolerance: none. Both paths run the same shader source (the multi-view
 // variant only selects the camera block, the beam and occluder copies and the
-// target layer by view index), fed the same float values computed by the same
-// CPU code (SceneResources::fill_*), and rasterize the same triangles at the
-// same viewport size, so every fragment does the same float operations; the
-// 8-bit frames and the HDR buffers are compared bit for bit. (Were a driver to
-// contract multiply-adds differently between the two programs, this test is
-// where it would show, and a tolerance would have to be argued for then.)
+// texture layer by the uniform view index), fed the same float values computed
+// by the same CPU code (SceneResources::fill_*), and rasterize the same
+// triangles at the same viewport size, so every fragment does the same float
+// operations; the 8-bit frames and the HDR buffers are compared bit for bit.
+// (Were a driver to contract multiply-adds differently between the two
+// programs, this test is where it would show, and a tolerance would have to
+// be argued for then.)
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -54,7 +55,9 @@ void expect_batched_equals_single(const nlohmann::json& cameras_json, std::size_
   ASSERT_EQ(scene.cameras.size(), expect_views);
   ASSERT_TRUE(renderer().multiview_supported())
       << "the driver lacks GL_ARB_shader_viewport_layer_array; batches fall back to one view";
-  const auto batched = renderer().render(scene, FrameOptions{.read_hdr = true, .batch = true});
+  // Larger batches than the default, so every rig is one batch.
+  const auto batched = renderer().render(
+      scene, FrameOptions{.read_hdr = true, .batch = true, .max_batch_views = 64});
   const auto single = renderer().render(scene, FrameOptions{.read_hdr = true, .batch = false});
   ASSERT_EQ(batched.size(), expect_views);
   ASSERT_EQ(single.size(), expect_views);

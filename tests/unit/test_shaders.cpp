@@ -30,11 +30,11 @@ const std::vector<Stage> kStages = {
     {{"common.glsl", "beam_math.glsl", "beam.frag"}, "frag"},
     {{"common.glsl", "tonemap.frag"}, "frag"},
     // Multi-view variants (one draw, K layers).
-    {{"multiview_vertex.glsl", "common.glsl", "surface.vert"}, "vert"},
+    {{"multiview.glsl", "common.glsl", "surface.vert"}, "vert"},
     {{"multiview.glsl", "common.glsl", "surface.frag"}, "frag"},
-    {{"multiview_vertex.glsl", "common.glsl", "fullscreen.vert"}, "vert"},
+    {{"multiview.glsl", "common.glsl", "fullscreen.vert"}, "vert"},
     {{"multiview.glsl", "common.glsl", "analytic_occluder.frag"}, "frag"},
-    {{"multiview_vertex.glsl", "common.glsl", "beam.vert"}, "vert"},
+    {{"multiview.glsl", "common.glsl", "beam.vert"}, "vert"},
     {{"multiview.glsl", "common.glsl", "beam_math.glsl", "beam.frag"}, "frag"},
     {{"multiview.glsl", "common.glsl", "tonemap.frag"}, "frag"},
 };
