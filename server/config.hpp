@@ -12,6 +12,11 @@ namespace beamcast {
 
 struct ServerConfig {
   std::string bind = "127.0.0.1";
+  // Shared secret clients present in hello (params.token); empty: no auth.
+  // Required for a non-loopback bind unless insecure_no_token (server/auth.hpp).
+  std::string token;
+  bool insecure_no_token = false;
+  bool request_log = false;  // one JSON line per request on stderr (beamcast-server: on)
   unsigned short port = 7878;  // 0: any free port
   int device_index = -1;       // EGL device; -1: automatic
   std::string egl_platform = "auto";

@@ -37,6 +37,10 @@ class Session : public std::enable_shared_from_this<Session> {
   void end_render();
   std::shared_ptr<const std::atomic<bool>> alive_flag() const { return alive_; }
 
+  // Strand-only: whether this connection passed hello's token check.
+  bool authenticated() const { return authenticated_; }
+  void set_authenticated() { authenticated_ = true; }
+
  private:
   enum class ReadState { kHeader, kBody, kDiscard, kStopped };
 
@@ -72,6 +76,7 @@ class Session : public std::enable_shared_from_this<Session> {
   bool writing_ = false;
   bool close_after_write_ = false;
   bool closed_ = false;
+  bool authenticated_ = false;
 };
 
 }  // namespace beamcast
