@@ -93,11 +93,57 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
   for (const auto& [key, value] : params.items()) {
     (void)value;
     if (key != "scene" && key != "scene_id" && key != "cameras" && key != "output" &&
-        key != "encoding") {
+        key != "encoding" && key != "quality" && key != "budget_ms" && key != "still_ms" &&
+        key != "motion" && key != "interactive_format") {
       fail("unknown_field", "/params/" + key,
            "unknown render parameter \"" + key +
-               "\" (allowed: scene, scene_id, cameras, output, encoding)");
+               "\" (allowed: scene, scene_id, cameras, output, encoding, quality, budget_ms, "
+               "still_ms, motion, interactive_format)");
     }
+  }
+  bool automatic = false;
+  if (auto q = params.find("quality"); q != params.end()) {
+    if (!q->is_string() || (*q != "auto" && *q != "full")) {
+      fail("invalid_value", "/params/quality", "quality must be \"auto\" or \"full\"");
+    }
+    automatic = *q == "auto";
+  }
+  for (const char* key : {"budget_ms", "still_ms", "motion", "interactive_format"}) {
+    if (params.contains(key) && !automatic) {
+      fail("invalid_value", std::string("/params/") + key,
+           std::string(key) + " applies only with \"quality\": \"auto\"");
+    }
+  }
+  if (automatic) {
+    QualityParams qp;
+    auto number = [&](const char* key, double lo, double hi, double* out) {
+      auto it = params.find(key);
+      if (it == params.end()) return;
+      const std::string path = std::string("/params/") + key;
+      if (!it->is_number()) fail("wrong_type", path, std::string(key) + " must be a number");
+      const double v = it->get<double>();
+      if (!(v >= lo && v <= hi)) {
+        fail("out_of_range", path,
+             std::string(key) + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      }
+      *out = v;
+    };
+    number("budget_ms", 1.0, 10000.0, &qp.budget_ms);
+    number("still_ms", 0.0, 60000.0, &qp.still_ms);
+    if (auto m = params.find("motion"); m != params.end()) {
+      if (!m->is_string() || (*m != "infer" && *m != "moving" && *m != "still")) {
+        fail("invalid_value", "/params/motion", "motion must be \"infer\", \"moving\" or \"still\"");
+      }
+      qp.motion = m->get<std::string>();
+    }
+    if (auto f = params.find("interactive_format"); f != params.end()) {
+      if (!f->is_string() || (*f != "jpeg" && *f != "png")) {
+        fail("invalid_value", "/params/interactive_format",
+             "interactive_format must be \"jpeg\" or \"png\"");
+      }
+      qp.jpeg = *f == "jpeg";
+    }
+    rp.quality = qp;
   }
   const bool has_scene = params.contains("scene");
   const bool has_id = params.contains("scene_id");

@@ -35,8 +35,18 @@ nlohmann::json error_response(const nlohmann::json& id, const ErrorInfo& error);
 // "/params/scene" becomes "/params/scene/beams/0".
 ErrorInfo with_path_prefix(ErrorInfo e, std::string_view prefix);
 
+// `quality: "auto"` (PROTOCOL.md, "Interactive quality"): the server's accuracy
+// controller picks each frame's settings from a frame-time budget.
+struct QualityParams {
+  double budget_ms = 33.0;  // frame-time budget while the camera moves
+  double still_ms = 300.0;  // still this long -> a full-accuracy PNG frame
+  std::string motion = "infer";  // "infer" (from successive poses), "moving", "still"
+  bool jpeg = true;              // interactive frames as JPEG ("interactive_format")
+};
+
 // `render` params, validated except for the scene itself (which may be stored).
 struct RenderParams {
+  std::optional<QualityParams> quality;  // set with "quality": "auto"
   std::optional<nlohmann::json> scene;  // inline scene, unparsed
   std::optional<std::string> scene_id;
   std::optional<std::vector<Camera>> cameras;  // replaces the scene's cameras

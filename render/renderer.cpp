@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 
 #include "protocol/camera.hpp"
@@ -26,6 +27,10 @@ struct Renderer::Impl {
   FrameTargets targets;
   GlVertexArray empty_vao;
   std::vector<GlQuery> queries;  // timestamps: frame start, then one after each pass
+  // Target of the bilinear upscale when FrameOptions::resolution_scale < 1.
+  GlTexture upscaled;
+  GlFramebuffer upscaled_fbo;
+  int up_width = 0, up_height = 0, up_bits = 0;
 
   explicit Impl(const RendererOptions& opts)
       : context(EglContext::create(opts.egl)), tables(opts.table_cache_entries) {
@@ -48,10 +53,37 @@ struct Renderer::Impl {
     return queries[i].get();
   }
 
-  FrameResult render_camera(const Scene& scene, const Camera& cam, SceneResources& res,
+  // Bilinear upscale of the output (render size) to w x h, into `upscaled`.
+  void upscale(int rw, int rh, int w, int h, int bits) {
+    if (w != up_width || h != up_height || bits != up_bits) {
+      up_width = w;
+      up_height = h;
+      up_bits = bits;
+      upscaled = make_texture_2d(bits == 16 ? GL_RGBA16 : GL_RGBA8, w, h);
+      GLuint id = 0;
+      glCreateFramebuffers(1, &id);
+      upscaled_fbo = GlFramebuffer(id);
+      glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, upscaled.get(), 0);
+      check_framebuffer(id, "upscale framebuffer");
+    }
+    glBlitNamedFramebuffer(targets.output_fbo.get(), upscaled_fbo.get(), 0, 0, rw, rh, 0, 0, w, h,
+                           GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    gl_check("upscale blit");
+  }
+
+  FrameResult render_camera(const Scene& scene, const Camera& full_cam, SceneResources& res,
                             const std::vector<Pass*>& plan, const FrameOptions& opts) {
     const auto wall0 = std::chrono::steady_clock::now();
     FrameResult result;
+    // A scaled frame renders a smaller copy of the camera (same view, fewer pixels).
+    Camera small = full_cam;
+    const bool scaled = opts.resolution_scale > 0.0 && opts.resolution_scale < 1.0;
+    if (scaled) {
+      small.width = std::max(1, static_cast<int>(std::lround(full_cam.width * opts.resolution_scale)));
+      small.height =
+          std::max(1, static_cast<int>(std::lround(full_cam.height * opts.resolution_scale)));
+    }
+    const Camera& cam = small;
     const CameraBasis basis = camera_basis(cam);
     res.bind_camera(cam, basis);
     targets.ensure(cam.width, cam.height, scene.output.bit_depth);
@@ -75,17 +107,23 @@ struct Renderer::Impl {
       plan[i]->execute(ctx);
       glQueryCounter(query(i + 1), GL_TIMESTAMP);
     }
+    std::size_t stamp_count = plan.size() + 1;
+    if (scaled) {
+      upscale(cam.width, cam.height, full_cam.width, full_cam.height, scene.output.bit_depth);
+      glQueryCounter(query(stamp_count++), GL_TIMESTAMP);
+    }
     gl_check("frame");
 
     // Read-back (synchronous: it waits for the GPU to finish the frame).
     const auto rb0 = std::chrono::steady_clock::now();
-    const int w = cam.width, h = cam.height;
+    const int w = full_cam.width, h = full_cam.height;
     result.image.width = w;
     result.image.height = h;
     result.image.bit_depth = scene.output.bit_depth;
     result.image.rgb.resize(3 * static_cast<std::size_t>(w) * h);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, targets.output_fbo.get());
+    glBindFramebuffer(GL_READ_FRAMEBUFFER,
+                      scaled ? upscaled_fbo.get() : targets.output_fbo.get());
     if (scene.output.bit_depth == 16) {
       glReadnPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_SHORT,
                     static_cast<GLsizei>(result.image.rgb.size() * 2), result.image.rgb.data());
@@ -104,28 +142,33 @@ struct Renderer::Impl {
                        result.image.rgb.begin() + (h - 1 - y) * row);
     }
     if (opts.read_hdr) {
-      result.hdr.width = w;
-      result.hdr.height = h;
-      std::vector<float> buf(row * h);
+      const int hw = cam.width, hh = cam.height;
+      const std::size_t hrow = 3 * static_cast<std::size_t>(hw);
+      result.hdr.width = hw;
+      result.hdr.height = hh;
+      std::vector<float> buf(hrow * hh);
       glBindFramebuffer(GL_READ_FRAMEBUFFER, targets.scene_fbo.get());
       glReadBuffer(GL_COLOR_ATTACHMENT0);
-      glReadnPixels(0, 0, w, h, GL_RGB, GL_FLOAT, static_cast<GLsizei>(buf.size() * 4),
+      glReadnPixels(0, 0, hw, hh, GL_RGB, GL_FLOAT, static_cast<GLsizei>(buf.size() * 4),
                     buf.data());
       gl_check("glReadnPixels(hdr)");
       result.hdr.rgb.resize(buf.size());
-      for (int y = 0; y < h; ++y) {
-        std::memcpy(&result.hdr.rgb[y * row], &buf[(h - 1 - y) * row], row * sizeof(float));
+      for (int y = 0; y < hh; ++y) {
+        std::memcpy(&result.hdr.rgb[y * hrow], &buf[(hh - 1 - y) * hrow], hrow * sizeof(float));
       }
     }
 
     GLuint64 stamps[16] = {};
-    for (std::size_t i = 0; i <= plan.size(); ++i) {
+    for (std::size_t i = 0; i < stamp_count; ++i) {
       glGetQueryObjectui64v(query(i), GL_QUERY_RESULT, &stamps[i]);
     }
     for (std::size_t i = 0; i < plan.size(); ++i) {
       result.passes.push_back({plan[i]->name(), (stamps[i + 1] - stamps[i]) * 1e-6});
     }
-    result.gpu_ms = (stamps[plan.size()] - stamps[0]) * 1e-6;
+    if (scaled) {
+      result.passes.push_back({"upscale", (stamps[plan.size() + 1] - stamps[plan.size()]) * 1e-6});
+    }
+    result.gpu_ms = (stamps[stamp_count - 1] - stamps[0]) * 1e-6;
     result.wall_ms = ms_since(wall0);
     return result;
   }

@@ -25,6 +25,10 @@ struct PassTiming {
 
 struct FrameOptions {
   bool read_hdr = false;  // also read back the linear HDR buffer
+  // Render at this fraction of the camera's width and height, then upscale to
+  // the camera's size with a bilinear blit on the GPU ("upscale" pass); 1 =
+  // native (no extra pass). The HDR buffer, if read, stays at the render size.
+  double resolution_scale = 1.0;
 };
 
 struct FrameResult {

@@ -7,17 +7,22 @@ PACKAGES=(
   cmake ninja-build g++ pkg-config
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri   # EGL + OpenGL (llvmpipe without a GPU)
   libglm-dev nlohmann-json3-dev libpng-dev libtinyobjloader-dev libcli11-dev
+  libturbojpeg0-dev                                   # JPEG frames of the interactive preview
   glslang-tools                                       # shader compile check in the tests
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev libboost-system-dev
   clang-14 libclang-rt-14-dev                         # libFuzzer targets (fuzz/, --preset fuzz)
   python3 python3-numpy python3-matplotlib            # plots and analysis scripts
+  nodejs chromium                                     # the preview page's browser test (ctest -L preview)
 )
 
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# npm: Debian's package, unless the installed nodejs already brings its own
+# (NodeSource's nodejs does, and conflicts with Debian's npm).
+command -v npm >/dev/null 2>&1 || missing+=(npm)
 if [ ${#missing[@]} -eq 0 ]; then
   exit 0
 fi

@@ -18,6 +18,9 @@ struct ServerConfig {
   bool insecure_no_token = false;
   bool request_log = false;  // one JSON line per request on stderr (beamcast-server: on)
   unsigned short port = 7878;  // 0: any free port
+  // HTTP listener (preview page, WebSocket, GET endpoints) on `bind`; -1: none,
+  // 0: any free port. beamcast-server turns it on (7879) by default.
+  int http_port = -1;
   int device_index = -1;       // EGL device; -1: automatic
   std::string egl_platform = "auto";
   int render_workers = 1;  // threads that each own a GL context

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   using namespace beamcast;
   ServerConfig c;
   c.assets_dir = BEAMCAST_DEFAULT_ASSETS;
+  c.http_port = 7879;
   std::string assets = c.assets_dir.string();
   bool no_demo = false;
   SceneLimits& l = c.scene_limits;
@@ -27,6 +28,10 @@ int main(int argc, char** argv) {
                "render; docs/security.md)");
   app.add_option("--port", c.port, "TCP port; 0 picks a free one (printed on the first line)")
       ->capture_default_str();
+  app.add_option("--http-port", c.http_port,
+                 "HTTP port of the preview page and WebSocket (same address as --bind); "
+                 "0 picks a free one, -1 turns HTTP off")
+      ->check(CLI::Range(-1, 65535))->capture_default_str();
   app.add_option("--device", c.device_index, "EGL device index (-1: automatic)")->capture_default_str();
   app.add_option("--platform", c.egl_platform, "EGL platform: auto, device or surfaceless")
       ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
@@ -82,6 +87,11 @@ int main(int argc, char** argv) {
     const unsigned short port = server.start();
     // First line of output: tools and tests read the port from it.
     std::printf("beamcast-server listening on %s:%u\n", c.bind.c_str(), port);
+    if (c.http_port >= 0) {
+      const bool v6 = c.bind.find(':') != std::string::npos;
+      std::printf("beamcast-server preview: http://%s%s%s:%u/\n", v6 ? "[" : "", c.bind.c_str(),
+                  v6 ? "]" : "", server.http_port());
+    }
     std::fflush(stdout);
     std::fprintf(stderr, "beamcast-server: renderer: %s\n",
                  server.core().renderer_description.c_str());

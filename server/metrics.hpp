@@ -65,6 +65,11 @@ Metrics::Gauges sample_gauges(const ServerCore& core);
 void log_request(const ServerCore& core, const nlohmann::json& id, const std::string& method,
                  const std::string& outcome, const nlohmann::json& timings = nullptr);
 
+// GET /metrics (Prometheus text) and GET /health (the health JSON; 503 while
+// draining) on the HTTP listener (server/http_server.hpp).
+class HttpServer;
+void register_metrics_routes(HttpServer& http, ServerCore& core);
+
 // The health document: {"status": "ok"|"draining", ...}.
 nlohmann::json health_json(bool shutting_down, const Metrics::Gauges& g, const std::string& renderer);
 

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 
+#include "server/http_server.hpp"
 #include "server/metrics.hpp"
 #include "server/server_core.hpp"
 
@@ -38,6 +39,18 @@ void log_request(const ServerCore& core, const nlohmann::json& id, const std::st
   const std::string text =
       line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   std::fwrite(text.data(), 1, text.size(), stderr);
+}
+
+void register_metrics_routes(HttpServer& http, ServerCore& core) {
+  http.add_get("/metrics", [&core] {
+    return HttpReply{200, "text/plain; version=0.0.4; charset=utf-8",
+                     core.metrics.prometheus(sample_gauges(core))};
+  });
+  http.add_get("/health", [&core] {
+    const bool draining = core.shutting_down.load();
+    const nlohmann::json h = health_json(draining, sample_gauges(core), core.renderer_description);
+    return HttpReply{draining ? 503 : 200, "application/json", h.dump() + "\n"};
+  });
 }
 
 }  // namespace beamcast

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "render/image.hpp"
+#include "render/jpeg.hpp"
 
 namespace beamcast {
 namespace {
@@ -21,6 +22,10 @@ class GlFrameRenderer final : public FrameRenderer {
   std::string description() const override { return renderer_.description(); }
   std::vector<FrameResult> render(const Scene& scene, const std::vector<Camera>& cameras) override {
     return renderer_.render(scene, cameras);
+  }
+  std::vector<FrameResult> render(const Scene& scene, const std::vector<Camera>& cameras,
+                                  const FrameOptions& options) override {
+    return renderer_.render(scene, cameras, options);
   }
 
  private:
@@ -125,7 +130,7 @@ void RenderService::worker_main(int index) {
       continue;
     }
     try {
-      out.frames = renderer->render(*job.scene, job.cameras);
+      out.frames = renderer->render(*job.scene, job.cameras, job.options);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "beamcast-server: render failed: %s\n", e.what());
       out.error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
@@ -147,6 +152,7 @@ void RenderService::worker_main(int index) {
     st->out = std::move(out);
     st->out.pngs.resize(n);
     st->out.encode_ms.resize(n);
+    st->out.is_jpeg.assign(n, 0);
     st->remaining = n;
     st->start = Clock::now();
     st->job = std::move(job);
@@ -154,7 +160,18 @@ void RenderService::worker_main(int index) {
       boost::asio::post(encoders_, [this, st, i] {
         const auto t0 = Clock::now();
         Image& img = st->out.frames[i].image;
-        st->out.pngs[i] = encode_png(img, png_level_, png_filters_);
+        bool png = !st->job.jpeg || img.rgb.empty();
+        if (!png) {
+          try {
+            st->out.pngs[i] = encode_jpeg(img, st->job.jpeg_quality);
+          } catch (const std::exception& e) {
+            // Never expected of a valid image; the frame still goes out, as PNG.
+            std::fprintf(stderr, "beamcast-server: %s; sending PNG\n", e.what());
+            png = true;
+          }
+        }
+        if (png) st->out.pngs[i] = encode_png(img, png_level_, png_filters_);
+        st->out.is_jpeg[i] = png ? 0 : 1;
         st->out.encode_ms[i] = ms_between(t0, Clock::now());
         img.rgb = {};  // the PNG is what travels; free the pixels now
         if (st->remaining.fetch_sub(1) == 1) {

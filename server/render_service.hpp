@@ -30,6 +30,12 @@ class FrameRenderer {
   virtual ~FrameRenderer() = default;
   virtual std::string description() const = 0;
   virtual std::vector<FrameResult> render(const Scene& scene, const std::vector<Camera>& cameras) = 0;
+  // With frame options (resolution scale); a renderer without them ignores them.
+  virtual std::vector<FrameResult> render(const Scene& scene, const std::vector<Camera>& cameras,
+                                          const FrameOptions& options) {
+    (void)options;
+    return render(scene, cameras);
+  }
 };
 
 // Called on each worker thread, so a GL context is created on the thread that uses it.
@@ -41,7 +47,8 @@ struct RenderOutcome {
   bool dropped = false;  // the client went away before the job reached the GPU
   std::optional<ErrorInfo> error;
   std::vector<FrameResult> frames;  // images released after encoding
-  std::vector<std::vector<std::uint8_t>> pngs;
+  std::vector<std::vector<std::uint8_t>> pngs;  // encoded frames (JPEG when RenderJob::jpeg)
+  std::vector<char> is_jpeg;      // per frame: 1 if encoded as JPEG
   std::vector<double> encode_ms;  // per frame
   double queue_ms = 0.0;
   double render_ms = 0.0;
@@ -51,6 +58,9 @@ struct RenderOutcome {
 struct RenderJob {
   std::shared_ptr<const Scene> scene;
   std::vector<Camera> cameras;
+  FrameOptions options;    // resolution scale of `quality: "auto"` frames
+  bool jpeg = false;       // encode as JPEG (interactive frames) instead of PNG
+  int jpeg_quality = 90;
   std::shared_ptr<const std::atomic<bool>> client_alive;
   std::chrono::steady_clock::time_point arrived;
   // Called exactly once, on a worker or encoder thread.

@@ -8,6 +8,8 @@
 #include "render/pass_plan.hpp"
 #include "server/auth.hpp"
 #include "server/session.hpp"
+#include "server/accuracy_controller.hpp"
+#include "server/connection.hpp"
 
 namespace beamcast {
 namespace {
@@ -17,6 +19,11 @@ using json = nlohmann::json;
 
 [[noreturn]] void fail(std::string code, std::string path, std::string message) {
   throw ProtocolError(ErrorInfo{std::move(code), std::move(message), std::move(path)});
+}
+
+// Milliseconds on the steady clock: the accuracy controller's time axis.
+double steady_ms(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(t.time_since_epoch()).count();
 }
 
 double ms_since(Clock::time_point t) {
@@ -82,7 +89,8 @@ json hello_result(const ServerCore& core, const json& params) {
           {"renderer", core.renderer_description},
           {"methods", {"hello", "ping", "render", "scene.put", "scene.update", "scene.delete", "stats"}},
           {"capabilities",
-           {{"formats", {"png"}},
+           {{"formats", {"png", "jpeg"}},
+            {"quality", {"full", "auto"}},
             {"encodings", {"binary", "base64"}},
             {"beam_types", {"sphere", "capsule"}},
             {"densities", {"abe", "shell", "linear", "quadratic", "gaussian", "table"}},
@@ -115,7 +123,7 @@ json frame_name(const Camera& cam, std::size_t i) {
   return cam.name.empty() ? "camera_" + std::to_string(i) : cam.name;
 }
 
-void handle_render(ServerCore& core, const std::shared_ptr<Session>& session, const json& id,
+void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session, const json& id,
                    const json& params, Clock::time_point arrived) {
   const RenderParams rp = parse_render_params(params, core.config.scene_limits);
   std::shared_ptr<const Scene> scene;
@@ -139,6 +147,40 @@ void handle_render(ServerCore& core, const std::shared_ptr<Session>& session, co
   }
   std::vector<Camera> cameras = rp.cameras ? *rp.cameras : scene->cameras;
 
+  // quality "auto": the connection's accuracy controller picks this frame's level.
+  std::optional<ControllerDecision> decision;
+  AccuracyLevel level;
+  std::size_t ladder_size = 0;
+  double budget_ms = 0.0;
+  if (rp.quality) {
+    const QualityParams& q = *rp.quality;
+    InteractiveState& st = session->interactive();
+    std::lock_guard lock(st.mu);
+    // Costs are per scene content: a new scene (or new render settings) starts
+    // a new controller. Inline scenes are keyed by their JSON.
+    const std::string key = (rp.scene_id ? "id:" + *rp.scene_id : "inline:" + scene_json->dump()) +
+                            "|" + (rp.output ? rp.output->dump() : "");
+    if (!st.controller || st.scene_key != key) {
+      ControllerConfig cfg;
+      st.controller = std::make_unique<AccuracyController>(make_accuracy_ladder(scene->render), cfg);
+      st.scene_key = key;
+    }
+    st.controller->set_budget(q.budget_ms);
+    st.controller->set_still_ms(q.still_ms);
+    const Motion motion = q.motion == "moving"  ? Motion::kMoving
+                          : q.motion == "still" ? Motion::kStill
+                                                : Motion::kInfer;
+    decision = st.controller->decide(steady_ms(arrived), pose_key(cameras), motion);
+    level = st.controller->ladder()[decision->level];
+    ladder_size = st.controller->ladder().size();
+    budget_ms = q.budget_ms;
+    if (decision->level != 0) {
+      auto copy = std::make_shared<Scene>(*scene);
+      copy->render = level.render;
+      scene = std::move(copy);
+    }
+  }
+
   if (!session->try_begin_render()) {
     fail("busy", "", "max_inflight_per_connection (" +
                          std::to_string(core.config.max_inflight_per_connection) +
@@ -149,8 +191,14 @@ void handle_render(ServerCore& core, const std::shared_ptr<Session>& session, co
   job.cameras = cameras;
   job.client_alive = session->alive_flag();
   job.arrived = arrived;
+  if (decision) {
+    job.options.resolution_scale = decision->still ? 1.0 : level.scale;
+    job.jpeg = !decision->still && rp.quality->jpeg;
+    job.jpeg_quality = level.jpeg_quality;
+  }
   job.done = [&core, session, id, cameras, arrived, base64 = rp.base64,
-              passes = plan_passes(*scene), bit_depth = scene->output.bit_depth](
+              passes = plan_passes(*scene), bit_depth = scene->output.bit_depth, decision, level,
+              ladder_size, budget_ms, jpeg = job.jpeg, jpeg_quality = job.jpeg_quality](
                  RenderOutcome&& out) {
     session->end_render();
     if (out.dropped) return;
@@ -159,6 +207,37 @@ void handle_render(ServerCore& core, const std::shared_ptr<Session>& session, co
       log_request(core, id, "render", out.error->code);
       session->send_error(id, *out.error);
       return;
+    }
+    json quality;
+    if (decision) {
+      // What this frame cost the server: rendering (with read-back) and encoding.
+      const double frame_ms = out.render_ms + out.encode_wall_ms;
+      {
+        InteractiveState& st = session->interactive();
+        std::lock_guard lock(st.mu);
+        if (st.controller) {
+          st.controller->observe(decision->level, frame_ms, steady_ms(Clock::now()));
+        }
+      }
+      const RenderSettings& r = level.render;
+      quality = {{"mode", "auto"},
+                 {"level", decision->level},
+                 {"levels", ladder_size},
+                 {"label", level.label},
+                 {"reason", decision->reason},
+                 {"still", decision->still},
+                 {"moving", decision->moving},
+                 {"scale", decision->still ? 1.0 : level.scale},
+                 {"method", r.method == IntegrationMethod::kTable        ? "table"
+                            : r.method == IntegrationMethod::kClosedForm ? "closed_form"
+                                                                         : "march"},
+                 {"table", {r.table_d, r.table_s}},
+                 {"samples", r.samples},
+                 {"format", jpeg ? "jpeg" : "png"},
+                 {"budget_ms", budget_ms},
+                 {"estimate_ms", decision->estimate_ms},
+                 {"frame_ms", frame_ms}};
+      if (jpeg) quality["jpeg_quality"] = jpeg_quality;
     }
     json frames = json::array();
     std::vector<std::uint8_t> binary;
@@ -171,7 +250,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Session>& session, co
                 {"index", i},
                 {"width", cameras[i].width},
                 {"height", cameras[i].height},
-                {"format", "png"},
+                {"format", out.is_jpeg[i] ? "jpeg" : "png"},
                 {"bit_depth", bit_depth},
                 {"gpu_ms", fr.gpu_ms},
                 {"pass_ms", pass_ms},
@@ -186,7 +265,12 @@ void handle_render(ServerCore& core, const std::shared_ptr<Session>& session, co
       }
       frames.push_back(std::move(f));
     }
-    json result = {{"passes", passes},
+    std::vector<std::string> frame_passes = passes;
+    if (!out.frames.empty()) {
+      frame_passes.clear();
+      for (const PassTiming& p : out.frames[0].passes) frame_passes.push_back(p.name);
+    }
+    json result = {{"passes", frame_passes},
                    {"frames", std::move(frames)},
                    {"timings",
                     {{"queue_ms", out.queue_ms},
@@ -194,6 +278,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Session>& session, co
                      {"readback_ms", readback_ms},
                      {"encode_ms", out.encode_wall_ms},
                      {"server_ms", ms_since(arrived)}}}};
+    if (decision) result["quality"] = std::move(quality);
     core.stats.count_frames(out.frames.size());
     core.metrics.count_request("render", true);
     core.metrics.observe(Metrics::kQueue, out.queue_ms);
@@ -235,7 +320,7 @@ std::string base64_encode(const std::vector<std::uint8_t>& in) {
   return out;
 }
 
-void handle_message(ServerCore& core, const std::shared_ptr<Session>& session,
+void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
                     std::string_view json_text, Clock::time_point arrived) {
   json id;
   std::string method = "(invalid)";  // metrics key: a known method or a fixed placeholder

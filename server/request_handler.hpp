@@ -10,9 +10,9 @@
 
 namespace beamcast {
 
-class Session;
+class Connection;
 
-void handle_message(ServerCore& core, const std::shared_ptr<Session>& session,
+void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
                     std::string_view json_text, std::chrono::steady_clock::time_point arrived);
 
 // Standard base64 (RFC 4648) for the "base64" encoding of frames.

@@ -36,6 +36,13 @@ std::shared_ptr<const StoredScene> SceneStore::get(const std::string& id) {
   return nullptr;
 }
 
+std::vector<std::string> SceneStore::ids() const {
+  std::lock_guard lock(mu_);
+  std::vector<std::string> out;
+  for (const auto& [id, scene] : lru_) out.push_back(id);
+  return out;
+}
+
 bool SceneStore::erase(const std::string& id) {
   std::lock_guard lock(mu_);
   for (auto it = lru_.begin(); it != lru_.end(); ++it) {

@@ -30,6 +30,7 @@ class SceneStore {
   std::vector<std::string> put(const std::string& id, std::shared_ptr<const StoredScene> scene);
   std::shared_ptr<const StoredScene> get(const std::string& id);  // null if absent
   bool erase(const std::string& id);
+  std::vector<std::string> ids() const;  // most recently used first
   std::size_t count() const;
   std::uint64_t bytes() const;
 

@@ -22,7 +22,11 @@ Server::Server(const ServerConfig& config, RendererFactory renderers)
       factory_(std::move(renderers)),
       acceptor_(io_),
       signals_(io_),
-      drain_timer_(io_) {}
+      drain_timer_(io_),
+      http_(std::make_unique<HttpServer>(io_, core_)) {
+  register_preview_routes(*http_, core_);
+  register_metrics_routes(*http_, core_);
+}
 
 Server::~Server() {
   // Workers and encoders call into sessions; stop them before the io_context
@@ -43,6 +47,9 @@ unsigned short Server::start() {
   acceptor_.bind(ep);
   acceptor_.listen(asio::socket_base::max_listen_connections);
   do_accept();
+  if (c.http_port >= 0) {
+    http_port_ = http_->start(c.bind, static_cast<unsigned short>(c.http_port));
+  }
   return acceptor_.local_endpoint().port();
 }
 
@@ -106,6 +113,7 @@ void Server::shutdown() {
     if (core_.shutting_down.exchange(true)) return;
     boost::system::error_code ignored;
     acceptor_.close(ignored);
+    http_->stop_accepting();
     signals_.cancel(ignored);
     drain_step(std::chrono::steady_clock::now() +
                std::chrono::milliseconds(core_.config.drain_timeout_ms));
@@ -136,6 +144,7 @@ void Server::drain_step(std::chrono::steady_clock::time_point deadline) {
       sessions_.clear();
     }
     for (auto& s : open) s->close();
+    http_->close_all();
     core_.renders->stop();
     io_.stop();
   });

@@ -12,6 +12,7 @@
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
 
+#include "server/http_server.hpp"
 #include "server/render_service.hpp"
 #include "server/server_core.hpp"
 
@@ -35,6 +36,10 @@ class Server {
   void shutdown();
 
   ServerCore& core() { return core_; }
+  // The HTTP listener: register GET routes before start().
+  HttpServer& http() { return *http_; }
+  // Its bound port once started (0 when config.http_port is -1).
+  unsigned short http_port() const { return http_port_; }
 
  private:
   void do_accept();
@@ -46,6 +51,8 @@ class Server {
   boost::asio::ip::tcp::acceptor acceptor_;
   boost::asio::signal_set signals_;
   boost::asio::steady_timer drain_timer_;
+  std::unique_ptr<HttpServer> http_;
+  unsigned short http_port_ = 0;
   std::mutex sessions_mu_;
   std::vector<std::weak_ptr<Session>> sessions_;
 };

@@ -16,30 +16,27 @@
 
 #include "protocol/errors.hpp"
 #include "protocol/framing.hpp"
+#include "server/connection.hpp"
 #include "server/server_core.hpp"
 
 namespace beamcast {
 
-class Session : public std::enable_shared_from_this<Session> {
+class Session : public Connection, public std::enable_shared_from_this<Session> {
  public:
   Session(boost::asio::ip::tcp::socket socket, ServerCore& core);
   ~Session();
 
   void start();
   // Thread-safe: queues one response frame for writing.
-  void send(const nlohmann::json& response, std::vector<std::uint8_t> binary = {});
-  void send_error(const nlohmann::json& id, const ErrorInfo& error);
+  void send(const nlohmann::json& response, std::vector<std::uint8_t> binary = {}) override;
+  void send_error(const nlohmann::json& id, const ErrorInfo& error) override;
   // Thread-safe: closes the connection (pending writes are dropped).
-  void close();
+  void close() override;
 
   // Per-connection admission of render work (thread-safe).
-  bool try_begin_render();
-  void end_render();
-  std::shared_ptr<const std::atomic<bool>> alive_flag() const { return alive_; }
-
-  // Strand-only: whether this connection passed hello's token check.
-  bool authenticated() const { return authenticated_; }
-  void set_authenticated() { authenticated_ = true; }
+  bool try_begin_render() override;
+  void end_render() override;
+  std::shared_ptr<const std::atomic<bool>> alive_flag() const override { return alive_; }
 
  private:
   enum class ReadState { kHeader, kBody, kDiscard, kStopped };
@@ -76,7 +73,6 @@ class Session : public std::enable_shared_from_this<Session> {
   bool writing_ = false;
   bool close_after_write_ = false;
   bool closed_ = false;
-  bool authenticated_ = false;
 };
 
 }  // namespace beamcast

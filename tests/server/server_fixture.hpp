@@ -30,6 +30,7 @@ class LocalServer {
   LocalServer(const LocalServer&) = delete;
   LocalServer& operator=(const LocalServer&) = delete;
   unsigned short port() const { return port_; }
+  unsigned short http_port() const { return server_->http_port(); }
   ServerCore& core() { return server_->core(); }
 
  private:

@@ -91,6 +91,20 @@ TEST(Access, ServerOnNonLoopbackBindRefusesRequestsWithoutTheToken) {
   EXPECT_EQ(s.core().stats.errors("unauthorized"), 6u);
 }
 
+TEST(Access, HttpDataRoutesNeedTheBearerToken) {
+  ServerConfig c;
+  EXPECT_TRUE(http_request_authorized(c, "/api/scenes", ""));  // no token configured
+  c.token = "tok-123";
+  EXPECT_FALSE(http_request_authorized(c, "/api/scenes", ""));
+  EXPECT_FALSE(http_request_authorized(c, "/api/scenes/demo", "Bearer tok-12"));
+  EXPECT_FALSE(http_request_authorized(c, "/metrics", "Basic tok-123"));
+  EXPECT_TRUE(http_request_authorized(c, "/api/scenes", "Bearer tok-123"));
+  EXPECT_TRUE(http_request_authorized(c, "/metrics", "Bearer tok-123"));
+  // The page's static files and /health carry no data.
+  EXPECT_TRUE(http_request_authorized(c, "/", ""));
+  EXPECT_TRUE(http_request_authorized(c, "/health", ""));
+}
+
 TEST(Access, LoopbackServerWithoutTokenNeedsNoHello) {
   LocalServer s;  // 127.0.0.1, no token
   Conn conn(s.port(), 30);

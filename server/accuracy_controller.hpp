@@ -1,0 +1,92 @@
+// The accuracy controller of `quality: "auto"` renders (issue 7): per client,
+// picks the most accurate rendering that fits a frame-time budget while the
+// camera moves, changes it at most one step per frame, and asks for a
+// full-accuracy frame once the camera has been still long enough.
+//
+// Pure: no GL, no sockets, no clock of its own (callers pass the time), so it
+// is unit-tested directly (tests/unit/test_accuracy_controller.cpp).
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol/scene.hpp"
+
+namespace beamcast {
+
+// One rung of the ladder: how a frame is rendered.
+struct AccuracyLevel {
+  std::string label;      // e.g. "full", "table32", "table32@1/2"
+  double scale = 1.0;     // resolution scale: render smaller, upscale bilinearly on the GPU
+  RenderSettings render;  // integration settings
+  int jpeg_quality = 90;  // interactive frames are JPEG at this quality
+};
+
+// The ladder for a scene whose full-accuracy settings are `full`, ordered from
+// most accurate (index 0: exactly `full` at scale 1) to cheapest.
+std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full);
+
+struct ControllerConfig {
+  double budget_ms = 33.0;  // frame-time budget while the camera moves
+  double still_ms = 300.0;  // still this long -> one full-accuracy frame
+  double ewma_alpha = 0.3;  // weight of the newest observed frame time
+  // Climb to a more accurate level only if its estimate is below this share of
+  // the budget, so measurement noise does not flip between two levels.
+  double climb_margin = 0.85;
+  // A level's own measurement older than this is replaced by a prediction from
+  // the freshest level (load on a shared machine changes).
+  double stale_ms = 2000.0;
+};
+
+enum class Motion { kInfer, kMoving, kStill };
+
+// A camera pose, compared exactly: any change counts as motion.
+using PoseKey = std::vector<double>;
+PoseKey pose_key(const std::vector<Camera>& cameras);
+
+struct ControllerDecision {
+  int level = 0;
+  bool still = false;   // the full-accuracy still frame (PNG, pixel-exact)
+  std::string reason;   // still | moving | over_budget | under_budget | settling | first_frame
+  bool moving = false;  // motion as seen (given or inferred)
+  double estimate_ms = 0.0;  // predicted frame time of the chosen level (0 if unknown)
+};
+
+class AccuracyController {
+ public:
+  AccuracyController(std::vector<AccuracyLevel> ladder, ControllerConfig config);
+
+  // Decides the next frame at time `now_ms` (any monotonic clock, in ms) for
+  // the camera pose `pose`; with Motion::kInfer motion is a pose change since
+  // the previous frame.
+  ControllerDecision decide(double now_ms, const PoseKey& pose, Motion motion);
+  // Reports the measured cost of a frame rendered at `level`.
+  void observe(int level, double frame_ms, double now_ms);
+
+  // Predicted frame time of `level` at `now_ms`; nullopt before any measurement.
+  std::optional<double> estimate(int level, double now_ms) const;
+  const std::vector<AccuracyLevel>& ladder() const { return ladder_; }
+  const ControllerConfig& config() const { return config_; }
+  void set_budget(double budget_ms) { config_.budget_ms = budget_ms; }
+  void set_still_ms(double still_ms) { config_.still_ms = still_ms; }
+  int interactive_level() const { return level_; }
+
+ private:
+  struct Cost {
+    double ewma_ms = 0.0;
+    double last_ms = -1.0;  // time of the last observation; < 0: never
+  };
+  double pixels(int level) const;
+
+  std::vector<AccuracyLevel> ladder_;
+  ControllerConfig config_;
+  std::vector<Cost> costs_;
+  int level_ = -1;  // interactive level; -1 until the first moving frame
+  std::optional<PoseKey> last_pose_;
+  double last_motion_ms_ = 0.0;
+  bool ever_moved_ = false;
+};
+
+}  // namespace beamcast

@@ -1,0 +1,62 @@
+// The HTTP listener of beamcast-server: GET routes registered by name (the
+// preview page, its scene lists, and whatever else a component adds, e.g.
+// /metrics), and WebSocket connections on /ws that speak the same JSON
+// requests as the BCP1 TCP protocol (protocol/PROTOCOL.md, "WebSocket").
+//
+// Routes are registered before start(); handlers run on a network thread and
+// must be thread-safe. Binds loopback by default, like the TCP port.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include <boost/asio/io_context.hpp>
+
+namespace beamcast {
+
+struct ServerCore;
+
+struct HttpReply {
+  int status = 200;
+  std::string content_type = "text/plain; charset=utf-8";
+  std::string body;
+};
+
+class HttpServer {
+ public:
+  using Handler = std::function<HttpReply()>;
+  // Gets the rest of the path after the prefix (already checked to be non-empty).
+  using PrefixHandler = std::function<HttpReply(std::string_view rest)>;
+
+  HttpServer(boost::asio::io_context& io, ServerCore& core);
+  ~HttpServer();
+  HttpServer(const HttpServer&) = delete;
+  HttpServer& operator=(const HttpServer&) = delete;
+
+  // Exact path (the query string is ignored when matching). A later
+  // registration of the same path replaces the earlier one.
+  void add_get(std::string path, Handler handler);
+  // Every path that starts with `prefix` (e.g. "/api/examples/") and has more after it.
+  void add_get_prefix(std::string prefix, PrefixHandler handler);
+
+  // Binds and starts accepting; returns the bound port (useful with port 0).
+  unsigned short start(const std::string& bind, unsigned short port);
+  // Stops accepting new connections (shutdown, first step).
+  void stop_accepting();
+  // Closes every open WebSocket (shutdown, last step).
+  void close_all();
+
+  struct Impl;
+
+ private:
+  std::shared_ptr<Impl> impl_;
+};
+
+// The preview page (server/preview/) and the small JSON API it uses:
+// GET /, /preview.js, /preview.css, /api/scenes, /api/scenes/<id>,
+// /api/examples/<name>.json.
+void register_preview_routes(HttpServer& http, ServerCore& core);
+
+}  // namespace beamcast

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Runs the preview page's browser test: installs playwright-core (pinned by
+# package-lock.json, into tests/preview/node_modules, never a browser) if it
+# is not there yet, then drives Debian's /usr/bin/chromium.
+# Missing node, npm or chromium is a failure, not a skip.
+set -euo pipefail
+cd "$(dirname "$0")"
+for tool in node npm; do
+  command -v "$tool" >/dev/null || { echo "FAIL: $tool is missing (scripts/install-deps.sh)" >&2; exit 1; }
+done
+if [ ! -f node_modules/playwright-core/package.json ]; then
+  # PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD: playwright-core downloads nothing, but be explicit.
+  PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error
+fi
+exec node preview_test.mjs "$@"

@@ -1,0 +1,210 @@
+// The accuracy controller (server/accuracy_controller.hpp) without GL: fed
+// synthetic frame costs and a synthetic clock.
+#include <gtest/gtest.h>
+
+#include "server/accuracy_controller.hpp"
+
+namespace beamcast {
+namespace {
+
+PoseKey pose(double x) { return {x, 0.0, 5.0}; }
+
+// Per-level cost model for the tests: 100 ms at full accuracy, 90 ms for the
+// cheap table at scale 1, then proportional to pixel count.
+double cost(const AccuracyLevel& l, bool full) { return (full ? 100.0 : 90.0) * l.scale * l.scale; }
+
+TEST(AccuracyLadder, StartsAtTheSceneSettingsAndGetsCheaper) {
+  const RenderSettings full;  // chord_warped 128x128
+  const auto ladder = make_accuracy_ladder(full);
+  ASSERT_GE(ladder.size(), 4u);
+  EXPECT_EQ(ladder[0].scale, 1.0);
+  EXPECT_EQ(ladder[0].render.table_d, full.table_d);
+  EXPECT_EQ(ladder[0].label, "full");
+  for (std::size_t i = 1; i < ladder.size(); ++i) {
+    EXPECT_LE(ladder[i].scale, ladder[i - 1].scale) << i;
+    EXPECT_LE(ladder[i].render.table_d, ladder[i - 1].render.table_d) << i;
+    EXPECT_LE(ladder[i].jpeg_quality, ladder[i - 1].jpeg_quality) << i;
+  }
+  EXPECT_EQ(ladder.back().scale, 0.25);
+}
+
+TEST(AccuracyLadder, MarchingSceneGetsATableAsItsCheapIntegration) {
+  RenderSettings full;
+  full.method = IntegrationMethod::kMarch;
+  full.samples = 256;
+  const auto ladder = make_accuracy_ladder(full);
+  EXPECT_EQ(ladder[0].render.method, IntegrationMethod::kMarch);
+  EXPECT_EQ(ladder[1].render.method, IntegrationMethod::kTable);
+  EXPECT_EQ(ladder[1].scale, 1.0);
+}
+
+TEST(AccuracyLadder, SmallTableSceneSkipsTheEqualLevel) {
+  RenderSettings full;
+  full.table_d = full.table_s = 32;
+  const auto ladder = make_accuracy_ladder(full);
+  ASSERT_EQ(ladder.size(), 4u);  // full, 3/4, 1/2, 1/4
+  EXPECT_EQ(ladder[1].scale, 0.75);
+}
+
+TEST(AccuracyController, FirstFrameIsFullAccuracy) {
+  AccuracyController c(make_accuracy_ladder({}), {});
+  const auto d = c.decide(0.0, pose(0), Motion::kInfer);
+  EXPECT_TRUE(d.still);
+  EXPECT_EQ(d.level, 0);
+  EXPECT_EQ(d.reason, "first_frame");
+}
+
+// Runs `frames` moving frames at 20 ms spacing, feeding the cost model back.
+int drive(AccuracyController& c, double& t, int frames, std::vector<int>* levels = nullptr) {
+  int level = -1;
+  for (int i = 0; i < frames; ++i) {
+    t += 20.0;
+    const auto d = c.decide(t, pose(t), Motion::kInfer);
+    EXPECT_TRUE(d.moving);
+    EXPECT_FALSE(d.still);
+    if (levels && !levels->empty()) {
+      EXPECT_LE(std::abs(d.level - levels->back()), 1) << "jumped more than one level at " << i;
+    }
+    if (levels) levels->push_back(d.level);
+    c.observe(d.level, cost(c.ladder()[d.level], d.level == 0), t);
+    level = d.level;
+  }
+  return level;
+}
+
+TEST(AccuracyController, SettlesOnTheMostAccurateLevelThatFitsOneStepAtATime) {
+  ControllerConfig cfg;
+  cfg.budget_ms = 33.0;
+  AccuracyController c(make_accuracy_ladder({}), cfg);
+  double t = 0.0;
+  const auto first = c.decide(t, pose(-1), Motion::kInfer);
+  c.observe(first.level, cost(c.ladder()[0], true), t);  // 100 ms full frame
+  std::vector<int> levels;
+  const int settled = drive(c, t, 30, &levels);
+  // Levels: full 100, table 90, 3/4 50.6, 1/2 22.5, 1/4 5.6 ms: 1/2 is the
+  // most accurate under 33 ms.
+  EXPECT_EQ(c.ladder()[settled].scale, 0.5);
+  EXPECT_EQ(levels.back(), settled);
+}
+
+TEST(AccuracyController, LargerBudgetGivesMoreAccurateLevel) {
+  ControllerConfig cfg;
+  cfg.budget_ms = 70.0;  // fits 3/4 (50.6 ms) with the climb margin, not scale 1 (90 ms)
+  AccuracyController c(make_accuracy_ladder({}), cfg);
+  double t = 0.0;
+  c.observe(c.decide(t, pose(-1), Motion::kInfer).level, 100.0, t);
+  EXPECT_EQ(c.ladder()[drive(c, t, 30)].scale, 0.75);
+}
+
+TEST(AccuracyController, StepsDownWhenFramesGetSlowerAndBackUpWhenFaster) {
+  AccuracyController c(make_accuracy_ladder({}), {});
+  double t = 0.0;
+  c.observe(c.decide(t, pose(-1), Motion::kInfer).level, 100.0, t);
+  const int settled = drive(c, t, 20);
+  // The machine gets busy: the settled level now costs 3x its budget.
+  t += 20.0;
+  auto d = c.decide(t, pose(t), Motion::kInfer);
+  EXPECT_EQ(d.level, settled);
+  c.observe(d.level, 200.0, t);
+  c.observe(d.level, 200.0, t);
+  c.observe(d.level, 200.0, t);
+  t += 20.0;
+  d = c.decide(t, pose(t), Motion::kInfer);
+  EXPECT_EQ(d.level, settled + 1);
+  EXPECT_EQ(d.reason, "over_budget");
+  // Still busy a moment later: the slow measurement of the finer level is
+  // fresh (within stale_ms), so the controller does not climb back yet.
+  c.observe(d.level, 2.0, t);
+  t += 20.0;
+  d = c.decide(t, pose(t), Motion::kInfer);
+  EXPECT_EQ(d.level, settled + 1);
+  // Quiet again for longer than stale_ms: the finer level is predicted from
+  // the cheap measurements, and the controller climbs one step.
+  for (int i = 0; i < 6; ++i) c.observe(d.level, 2.0, t += 400.0);
+  t += 20.0;
+  d = c.decide(t, pose(t), Motion::kInfer);
+  EXPECT_EQ(d.level, settled);
+  EXPECT_EQ(d.reason, "under_budget");
+}
+
+TEST(AccuracyController, StillCameraGetsFullAccuracyAfterTheStillTime) {
+  ControllerConfig cfg;
+  cfg.still_ms = 300.0;
+  AccuracyController c(make_accuracy_ladder({}), cfg);
+  double t = 0.0;
+  c.observe(c.decide(t, pose(-1), Motion::kInfer).level, 100.0, t);
+  const int settled = drive(c, t, 10);
+  const double stopped = t;
+  const PoseKey last = pose(t);
+  // Same pose, before the still time: interactive frames, "settling".
+  t = stopped + 100.0;
+  auto d = c.decide(t, last, Motion::kInfer);
+  EXPECT_FALSE(d.moving);
+  EXPECT_FALSE(d.still);
+  EXPECT_EQ(d.reason, "settling");
+  // At the still time: the full-accuracy frame.
+  t = stopped + 300.0;
+  d = c.decide(t, last, Motion::kInfer);
+  EXPECT_TRUE(d.still);
+  EXPECT_EQ(d.level, 0);
+  EXPECT_EQ(d.reason, "still");
+  // Moving again resumes at the interactive level, not at full accuracy.
+  t += 20.0;
+  d = c.decide(t, pose(t), Motion::kInfer);
+  EXPECT_EQ(d.level, settled);
+  EXPECT_FALSE(d.still);
+}
+
+TEST(AccuracyController, ExplicitMotionOverridesInference) {
+  AccuracyController c(make_accuracy_ladder({}), {});
+  double t = 0.0;
+  c.decide(t, pose(0), Motion::kInfer);
+  // Same pose but the client says it is moving (e.g. the scene changes).
+  auto d = c.decide(t += 20.0, pose(0), Motion::kMoving);
+  EXPECT_TRUE(d.moving);
+  EXPECT_FALSE(d.still);
+  // A different pose but the client says still: full accuracy now.
+  d = c.decide(t += 20.0, pose(1), Motion::kStill);
+  EXPECT_TRUE(d.still);
+  EXPECT_EQ(d.level, 0);
+}
+
+TEST(AccuracyController, UnmeasuredLevelsArePredictedFromPixelCount) {
+  AccuracyController c(make_accuracy_ladder({}), {});
+  EXPECT_FALSE(c.estimate(0, 0.0).has_value());
+  c.observe(0, 80.0, 0.0);
+  const int last = static_cast<int>(c.ladder().size()) - 1;
+  // 1/4 scale: 1/16 of the pixels.
+  EXPECT_DOUBLE_EQ(*c.estimate(last, 0.0), 5.0);
+  // Its own measurement replaces the prediction.
+  c.observe(last, 9.0, 1.0);
+  EXPECT_DOUBLE_EQ(*c.estimate(last, 1.0), 9.0);
+}
+
+TEST(AccuracyController, EwmaFollowsTheMeasurements) {
+  ControllerConfig cfg;
+  cfg.ewma_alpha = 0.5;
+  AccuracyController c(make_accuracy_ladder({}), cfg);
+  c.observe(1, 10.0, 0.0);
+  c.observe(1, 20.0, 1.0);
+  EXPECT_DOUBLE_EQ(*c.estimate(1, 1.0), 15.0);
+  c.observe(1, 20.0, 2.0);
+  EXPECT_DOUBLE_EQ(*c.estimate(1, 2.0), 17.5);
+}
+
+TEST(AccuracyController, PoseKeySeesEveryCameraChange) {
+  Camera a;
+  Camera b = a;
+  EXPECT_EQ(pose_key({a}), pose_key({b}));
+  b.position[0] += 1e-9;
+  EXPECT_NE(pose_key({a}), pose_key({b}));
+  b = a;
+  b.width = 256;
+  EXPECT_NE(pose_key({a}), pose_key({b}));
+  b = a;
+  b.target = Vec3{0, 0, 0};
+  EXPECT_NE(pose_key({a}), pose_key({b}));
+}
+
+}  // namespace
+}  // namespace beamcast
