@@ -1,5 +1,7 @@
 #include "protocol/request.hpp"
 
+#include <cstdio>
+
 #include "protocol/utf8.hpp"
 
 namespace beamcast {
@@ -93,12 +95,12 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
   for (const auto& [key, value] : params.items()) {
     (void)value;
     if (key != "scene" && key != "scene_id" && key != "cameras" && key != "output" &&
-        key != "encoding" && key != "quality" && key != "budget_ms" && key != "still_ms" &&
-        key != "motion" && key != "interactive_format") {
+        key != "encoding" && key != "atlas" && key != "quality" && key != "budget_ms" &&
+        key != "still_ms" && key != "motion" && key != "interactive_format") {
       fail("unknown_field", "/params/" + key,
            "unknown render parameter \"" + key +
-               "\" (allowed: scene, scene_id, cameras, output, encoding, quality, budget_ms, "
-               "still_ms, motion, interactive_format)");
+               "\" (allowed: scene, scene_id, cameras, output, encoding, atlas, quality, "
+               "budget_ms, still_ms, motion, interactive_format)");
     }
   }
   bool automatic = false;
@@ -123,8 +125,9 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
       if (!it->is_number()) fail("wrong_type", path, std::string(key) + " must be a number");
       const double v = it->get<double>();
       if (!(v >= lo && v <= hi)) {
-        fail("out_of_range", path,
-             std::string(key) + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        char range[64];
+        std::snprintf(range, sizeof range, " must be in [%g, %g]", lo, hi);
+        fail("out_of_range", path, std::string(key) + range);
       }
       *out = v;
     };
@@ -160,20 +163,16 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
   if (auto c = params.find("cameras"); c != params.end()) {
     if (!c->is_array()) fail("wrong_type", "/params/cameras", "cameras must be an array");
     if (c->empty()) fail("invalid_value", "/params/cameras", "cameras must not be empty");
-    if (static_cast<int>(c->size()) > limits.max_cameras) {
-      fail("limit_exceeded", "/params/cameras",
-           "max_cameras is " + std::to_string(limits.max_cameras) + ", got " +
-               std::to_string(c->size()));
-    }
-    std::vector<Camera> cams;
-    for (std::size_t i = 0; i < c->size(); ++i) {
-      cams.push_back(parse_camera((*c)[i], "/params/cameras/" + std::to_string(i), limits));
-    }
+    std::vector<Camera> cams = parse_camera_list(*c, "/params/cameras", limits);
     rp.cameras = std::move(cams);
   }
   if (auto o = params.find("output"); o != params.end()) {
     if (!o->is_object()) fail("wrong_type", "/params/output", "output must be an object");
     rp.output = *o;
+  }
+  if (auto a = params.find("atlas"); a != params.end()) {
+    if (!a->is_boolean()) fail("wrong_type", "/params/atlas", "atlas must be true or false");
+    rp.atlas = a->get<bool>();
   }
   if (auto e = params.find("encoding"); e != params.end()) {
     if (!e->is_string() || (*e != "binary" && *e != "base64")) {

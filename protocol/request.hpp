@@ -52,6 +52,7 @@ struct RenderParams {
   std::optional<std::vector<Camera>> cameras;  // replaces the scene's cameras
   std::optional<nlohmann::json> output;  // merged over the scene's "output"
   bool base64 = false;
+  bool atlas = false;  // one atlas image of all frames instead of one image each
 };
 RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits& limits);
 

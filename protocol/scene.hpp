@@ -116,6 +116,13 @@ enum class TableFilter {
   kShader,    // four texel fetches, weights in full float precision
 };
 enum class MarchRule { kMidpoint, kSimpson };
+// Capsule cylinders where the ray's s-interval is short (rays nearly parallel
+// to the axis; docs/stability.md).
+enum class NearParallel {
+  kQuadrature,  // composite Gauss rule on f there, blended with the table (the default)
+  kNone,        // the paper's form everywhere: [g(s1) - g(s0)] / sin(theta); streaks as
+                // theta -> 0 (its fig 3.4); for comparison only
+};
 
 struct RenderSettings {
   IntegrationMethod method = IntegrationMethod::kTable;
@@ -129,6 +136,7 @@ struct RenderSettings {
   int f_table = 1024;  // samples of the 1D table of f (near-parallel path, user tables)
   int samples = 64;    // kMarch: sub-intervals per beam piece (even for Simpson)
   MarchRule rule = MarchRule::kMidpoint;
+  NearParallel near_parallel = NearParallel::kQuadrature;  // kTable and kClosedForm
 };
 
 struct Scene {

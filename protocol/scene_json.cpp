@@ -10,6 +10,7 @@
 #include "protocol/camera.hpp"
 #include "protocol/json_reader.hpp"
 #include "protocol/mesh_obj.hpp"
+#include "protocol/rigs.hpp"
 
 namespace beamcast {
 
@@ -324,7 +325,8 @@ OutputSettings parse_output(const Node& n) {
 
 RenderSettings parse_render(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "render settings");
-  o.allow_only({"method", "table_size", "layout", "filter", "f_table", "samples", "rule"});
+  o.allow_only(
+      {"method", "table_size", "layout", "filter", "f_table", "samples", "rule", "near_parallel"});
   RenderSettings r;
   if (auto m = o.optional("method")) {
     r.method = read_enum<IntegrationMethod>(*m, {{"table", IntegrationMethod::kTable},
@@ -344,6 +346,10 @@ RenderSettings parse_render(const Node& n, const SceneLimits& limits) {
   if (auto ru = o.optional("rule")) {
     r.rule = read_enum<MarchRule>(*ru, {{"midpoint", MarchRule::kMidpoint},
                                         {"simpson", MarchRule::kSimpson}});
+  }
+  if (auto np = o.optional("near_parallel")) {
+    r.near_parallel = read_enum<NearParallel>(*np, {{"quadrature", NearParallel::kQuadrature},
+                                                    {"none", NearParallel::kNone}});
   }
   if (auto n_samples = o.optional("samples")) {
     r.samples = read_int_in(*n_samples, 4, 1024);
@@ -471,6 +477,176 @@ Camera parse_camera(const json& j, const std::string& path, const SceneLimits& l
   return c;
 }
 
+namespace {
+
+// ---- Camera rigs (expansion math in rigs.cpp) ---------------------------------------
+
+// The camera fields a rig copies to every camera it makes.
+const std::initializer_list<std::string_view> kIntrinsics = {
+    "projection", "fov_y", "ortho_height", "near", "far", "width", "height"};
+
+// Reads the rig's intrinsic fields through parse_camera, so they get the same
+// rules and the same error paths as in a plain camera.
+Camera read_rig_base(const json& j, const std::string& path, const SceneLimits& limits) {
+  json subset = json::object();
+  for (std::string_view key : kIntrinsics) {
+    if (auto it = j.find(key); it != j.end()) subset[std::string(key)] = *it;
+  }
+  return parse_camera(subset, path, limits);
+}
+
+int read_rig_count(const ObjectReader& o, const SceneLimits& limits) {
+  const Node n = o.required("count");
+  return read_int_limited(n, 1, limits.max_cameras, "max_cameras");
+}
+
+std::vector<Camera> parse_orbit(const ObjectReader& o, const json& j, const std::string& prefix,
+                                const SceneLimits& limits) {
+  o.allow_only({"rig", "name", "count", "target", "radius", "axis", "layout", "elevation", "start",
+                "projection", "fov_y", "ortho_height", "near", "far", "width", "height"});
+  OrbitRig rig;
+  rig.count = read_rig_count(o, limits);
+  if (auto v = o.optional("target")) rig.target = read_point(*v, limits);
+  if (auto v = o.optional("radius")) rig.radius = read_size(*v, limits);
+  if (auto v = o.optional("axis")) rig.axis = normalize(read_direction(*v));
+  if (auto v = o.optional("layout")) {
+    rig.layout = read_enum<OrbitRig::Layout>(
+        *v, {{"circle", OrbitRig::Layout::kCircle}, {"sphere", OrbitRig::Layout::kSphere}});
+  }
+  if (auto v = o.optional("elevation")) {
+    if (rig.layout != OrbitRig::Layout::kCircle) {
+      fail("conflicting_fields", v->path, "elevation applies to the circle layout only");
+    }
+    // At +-90 degrees every camera sits on the axis and looks along its own up.
+    rig.elevation_deg = check_open(*v, read_number(*v), -90.0, 90.0);
+  }
+  if (auto v = o.optional("start")) rig.start_deg = read_number(*v);
+  std::vector<Camera> cams = expand_orbit(rig, read_rig_base(j, o.path(), limits), prefix);
+  for (const Camera& c : cams) {
+    // Rounding can still bring a camera within 1e-6 of its up axis (elevation
+    // a hair under 90); the same rule as a plain look-at camera.
+    if (length(cross(normalize(*c.target - c.position), rig.axis)) < 1e-6) {
+      fail("invalid_value", o.path_of("elevation"),
+           "orbit camera " + c.name + " looks along the axis (its up direction)");
+    }
+  }
+  return cams;
+}
+
+std::vector<Camera> parse_cubemap(const ObjectReader& o, const json& j, const std::string& prefix,
+                                  const SceneLimits& limits) {
+  o.allow_only({"rig", "name", "position", "size", "near", "far"});
+  CubemapRig rig;
+  if (auto v = o.optional("position")) rig.position = read_point(*v, limits);
+  Camera base = read_rig_base(j, o.path(), limits);
+  if (auto v = o.optional("size")) {
+    base.width = read_int_limited(*v, 1, std::min(limits.max_width, limits.max_height),
+                                  "max_width, max_height");
+    if (static_cast<std::int64_t>(base.width) * base.width > limits.max_pixels) {
+      fail("limit_exceeded", v->path,
+           "size * size is over the limit max_pixels = " + std::to_string(limits.max_pixels));
+    }
+  }
+  return expand_cubemap(rig, base, prefix);
+}
+
+std::vector<Camera> parse_stereo(const ObjectReader& o, const json& j, const std::string& prefix,
+                                 const SceneLimits& limits) {
+  o.allow_only({"rig", "name", "position", "target", "up", "eye_separation", "convergence",
+                "projection", "fov_y", "ortho_height", "near", "far", "width", "height"});
+  StereoRig rig;
+  Camera centre;
+  if (auto v = o.optional("position")) rig.position = centre.position = read_point(*v, limits);
+  const Node target = o.required("target");
+  rig.target = read_point(target, limits);
+  centre.target = rig.target;
+  const auto up = o.optional("up");
+  if (up) rig.up = centre.up = read_vec3(*up);
+  check_look_at(centre, &target, up ? &*up : nullptr);
+  if (auto v = o.optional("eye_separation")) {
+    rig.separation = check_non_negative(*v, read_number(*v));
+    if (rig.separation > limits.max_abs_coordinate) {
+      fail("out_of_range", v->path,
+           "eye_separation must be <= " + format_number(limits.max_abs_coordinate));
+    }
+  }
+  if (auto v = o.optional("convergence")) rig.convergence = read_size(*v, limits);
+  return expand_stereo(rig, read_rig_base(j, o.path(), limits), prefix);
+}
+
+}  // namespace
+
+std::vector<Camera> parse_camera_entry(const json& j, const std::string& path,
+                                       const SceneLimits& limits) {
+  if (!j.is_object() || !j.contains("rig")) return {parse_camera(j, path, limits)};
+  const Node n{&j, path};
+  ObjectReader o(n, "a camera rig");
+  const Node kind = o.required("rig");
+  enum class Kind { kOrbit, kCubemap, kStereo };
+  const Kind k = read_enum<Kind>(
+      kind, {{"orbit", Kind::kOrbit}, {"cubemap", Kind::kCubemap}, {"stereo", Kind::kStereo}});
+  std::string prefix = read_string(kind);
+  if (auto v = o.optional("name")) prefix = read_camera_name(*v);
+  switch (k) {
+    case Kind::kOrbit:
+      return parse_orbit(o, j, prefix, limits);
+    case Kind::kCubemap:
+      return parse_cubemap(o, j, prefix, limits);
+    case Kind::kStereo:
+      break;
+  }
+  return parse_stereo(o, j, prefix, limits);
+}
+
+json camera_to_json(const Camera& c) {
+  json j = {{"position", c.position},
+            {"projection", c.projection == Projection::kOrthographic ? "orthographic" : "perspective"},
+            {"fov_y", c.fov_y_deg},
+            {"ortho_height", c.ortho_height},
+            {"near", c.near_plane},
+            {"far", c.far_plane},
+            {"width", c.width},
+            {"height", c.height}};
+  if (!c.name.empty()) j["name"] = c.name;
+  if (c.rotation) {
+    j["rotation"] = *c.rotation;
+  } else {
+    if (c.target) j["target"] = *c.target;
+    j["up"] = c.up;
+  }
+  return j;
+}
+
+std::vector<Camera> parse_camera_list(const json& j, const std::string& path,
+                                      const SceneLimits& limits) {
+  const Node cameras{&j, path};
+  const auto items = read_array(cameras, limits.max_cameras, "max_cameras");
+  if (items.empty()) {
+    fail("invalid_value", cameras.path, "cameras must hold at least one camera, got none");
+  }
+  std::vector<Camera> out;
+  std::set<std::string> names;
+  for (const Node& item : items) {
+    const std::size_t first = out.size();
+    for (Camera& c : parse_camera_entry(item.json(), item.path, limits)) {
+      out.push_back(std::move(c));
+    }
+    if (static_cast<std::int64_t>(out.size()) > limits.max_cameras) {
+      fail("limit_exceeded", item.path,
+           "the cameras and rigs expand to " + std::to_string(out.size()) +
+               " cameras, over the limit max_cameras = " + std::to_string(limits.max_cameras));
+    }
+    for (std::size_t i = first; i < out.size(); ++i) {
+      const std::string& name = out[i].name;
+      if (!name.empty() && !names.insert(name).second) {
+        fail("duplicate_name", child_path(item.path, "name"),
+             "camera name \"" + name + "\" is used by more than one camera");
+      }
+    }
+  }
+  return out;
+}
+
 // The closed form exists only for densities with a known antiderivative.
 void check_method_fits_densities(const Scene& scene) {
   if (scene.render.method != IntegrationMethod::kClosedForm) return;
@@ -516,19 +692,7 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   }
 
   const Node cameras = o.required("cameras");
-  const auto items = read_array(cameras, limits.max_cameras, "max_cameras");
-  if (items.empty()) {
-    fail("invalid_value", cameras.path, "cameras must hold at least one camera, got none");
-  }
-  std::set<std::string> names;
-  for (const Node& item : items) {
-    scene.cameras.push_back(parse_camera(item.json(), item.path, limits));
-    const std::string& name = scene.cameras.back().name;
-    if (!name.empty() && !names.insert(name).second) {
-      fail("duplicate_name", child_path(item.path, "name"),
-           "camera name \"" + name + "\" is used by more than one camera");
-    }
-  }
+  scene.cameras = parse_camera_list(cameras.json(), cameras.path, limits);
   check_method_fits_densities(scene);
   return scene;
 }

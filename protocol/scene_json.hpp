@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -41,6 +42,17 @@ Scene parse_scene(const nlohmann::json& j, const SceneLoadOptions& opts);
 // One camera object (used by requests that send only camera poses); `path` is
 // the JSON pointer of `j` for error messages.
 Camera parse_camera(const nlohmann::json& j, const std::string& path, const SceneLimits& limits);
+// One entry of a "cameras" array: a camera, or a rig ({"rig": "orbit" | "cubemap" |
+// "stereo", ...}) expanded to its cameras (docs/scene-format.md#camera-rigs).
+std::vector<Camera> parse_camera_entry(const nlohmann::json& j, const std::string& path,
+                                       const SceneLimits& limits);
+// A whole "cameras" array at `path`: nonempty, rigs expanded, at most
+// max_cameras after expansion, names unique.
+std::vector<Camera> parse_camera_list(const nlohmann::json& j, const std::string& path,
+                                      const SceneLimits& limits);
+// A camera as scene JSON (parse_camera of the result gives the camera back;
+// numbers are written with full double precision).
+nlohmann::json camera_to_json(const Camera& c);
 // An "output" object (exposure, tone, bit_depth); missing fields take defaults.
 OutputSettings parse_output_settings(const nlohmann::json& j, const std::string& path);
 // Reads and parses a scene file; JSON syntax errors become code "bad_json".

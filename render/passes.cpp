@@ -1,23 +1,37 @@
 #include "render/passes.hpp"
 
+#include <string>
+#include <utility>
+
 #include "shaders/shader_sources.hpp"
 
 namespace beamcast {
 
-void FrameTargets::ensure(int w, int h, int bits) {
-  if (w == width && h == height && bits == bit_depth) return;
+void FrameTargets::ensure(int w, int h, int bits, int layer_count) {
+  if (w == width && h == height && bits == bit_depth && layer_count == layers) return;
   width = w;
   height = h;
   bit_depth = bits;
-  hdr = make_texture_2d(GL_RGBA32F, w, h);
-  view_depth = make_texture_2d(GL_R32F, w, h);
-  depth = make_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
-  output = make_texture_2d(bits == 16 ? GL_RGBA16 : GL_RGBA8, w, h);
+  layers = layer_count;
+  auto make = [&](GLenum format) {
+    if (layer_count == 0) return make_texture_2d(format, w, h);
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+    glTextureStorage3D(id, 1, format, w, h, layer_count);
+    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return GlTexture(id);
+  };
+  hdr = make(GL_RGBA32F);
+  view_depth = make(GL_R32F);
+  depth = make(GL_DEPTH_COMPONENT32F);
+  output = make(bits == 16 ? GL_RGBA16 : GL_RGBA8);
   GLuint ids[3];
   glCreateFramebuffers(3, ids);
   scene_fbo = GlFramebuffer(ids[0]);
   beam_fbo = GlFramebuffer(ids[1]);
   output_fbo = GlFramebuffer(ids[2]);
+  // glNamedFramebufferTexture attaches every layer of an array texture (layered).
   glNamedFramebufferTexture(ids[0], GL_COLOR_ATTACHMENT0, hdr.get(), 0);
   glNamedFramebufferTexture(ids[0], GL_COLOR_ATTACHMENT1, view_depth.get(), 0);
   glNamedFramebufferTexture(ids[0], GL_DEPTH_ATTACHMENT, depth.get(), 0);
@@ -33,20 +47,49 @@ void FrameTargets::ensure(int w, int h, int bits) {
 
 namespace {
 
+// A program in its per-camera and its multi-view variant (the latter built on
+// first use; see shaders/multiview*.glsl).
+class ProgramPair {
+ public:
+  ProgramPair(std::string name, std::vector<std::string_view> vert,
+              std::vector<std::string_view> frag)
+      : name_(std::move(name)), vert_(std::move(vert)), frag_(std::move(frag)) {
+    single_ = build_program(name_, assemble_shader(vert_), assemble_shader(frag_));
+  }
+  GLuint get(bool multiview) {
+    if (!multiview) return single_.get();
+    if (!multi_) {
+      std::vector<std::string_view> v = vert_, f = frag_;
+      v.insert(v.begin(), "multiview_vertex.glsl");
+      f.insert(f.begin(), "multiview.glsl");
+      multi_ = build_program(name_ + "_multiview", assemble_shader(v), assemble_shader(f));
+    }
+    return multi_.get();
+  }
+  GLint uniform(bool multiview, const char* name) {
+    return glGetUniformLocation(get(multiview), name);
+  }
+
+ private:
+  std::string name_;
+  std::vector<std::string_view> vert_, frag_;
+  GlProgram single_, multi_;
+};
+
+// Instances per draw: one per view in a multi-view batch.
+GLsizei instances(const FrameContext& ctx) { return ctx.views > 0 ? ctx.views : 1; }
+
 // Occluders: rasterized triangles (boxes, meshes) and ray-traced planes and
 // spheres, depth-tested together; writes shaded colour and view depth.
 class SurfacePass final : public Pass {
  public:
   SurfacePass()
-      : raster_(build_program("surface", assemble_shader({"common.glsl", "surface.vert"}),
-                              assemble_shader({"common.glsl", "surface.frag"}))),
-        analytic_(build_program("analytic_occluder",
-                                assemble_shader({"common.glsl", "fullscreen.vert"}),
-                                assemble_shader({"common.glsl", "analytic_occluder.frag"}))) {
-    count_loc_ = glGetUniformLocation(analytic_.get(), "u_count");
-  }
+      : raster_("surface", {"common.glsl", "surface.vert"}, {"common.glsl", "surface.frag"}),
+        analytic_("analytic_occluder", {"common.glsl", "fullscreen.vert"},
+                  {"common.glsl", "analytic_occluder.frag"}) {}
   const char* name() const override { return "surfaces"; }
   void execute(FrameContext& ctx) override {
+    const bool multi = ctx.views > 0;
     glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.scene_fbo.get());
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);  // reversed Z
@@ -55,59 +98,59 @@ class SurfacePass final : public Pass {
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_CLAMP);  // triangles are clipped by the near and far planes
     if (ctx.resources.triangle_vertex_count() > 0) {
-      glUseProgram(raster_.get());
+      glUseProgram(raster_.get(multi));
       glBindVertexArray(ctx.resources.triangle_vao());
-      glDrawArrays(GL_TRIANGLES, 0, ctx.resources.triangle_vertex_count());
+      glDrawArraysInstanced(GL_TRIANGLES, 0, ctx.resources.triangle_vertex_count(),
+                            instances(ctx));
     }
     if (ctx.resources.analytic_count() > 0) {
-      glUseProgram(analytic_.get());
-      glUniform1i(count_loc_, ctx.resources.analytic_count());
+      glUseProgram(analytic_.get(multi));
+      glUniform1i(analytic_.uniform(multi, "u_count"), ctx.resources.analytic_count());
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ctx.resources.analytic_buffer());
       glBindVertexArray(ctx.empty_vao);
-      glDrawArrays(GL_TRIANGLES, 0, 3);
+      glDrawArraysInstanced(GL_TRIANGLES, 0, 3, instances(ctx));
     }
     glDisable(GL_DEPTH_TEST);
     gl_check("surfaces pass");
   }
 
  private:
-  GlProgram raster_;
-  GlProgram analytic_;
-  GLint count_loc_ = -1;
+  ProgramPair raster_;
+  ProgramPair analytic_;
 };
 
 // Beams: additive energy from the line-integral tables, one instanced draw of
-// box proxies, back faces only (see beam.vert).
+// box proxies, back faces only (see beam.vert); a multi-view batch draws
+// views x beams instances.
 class BeamPass final : public Pass {
  public:
   BeamPass()
-      : program_(build_program("beam", assemble_shader({"common.glsl", "beam.vert"}),
-                               assemble_shader({"common.glsl", "beam_math.glsl", "beam.frag"}))) {
-    table_loc_ = glGetUniformLocation(program_.get(), "u_table_size");
-    surfaces_loc_ = glGetUniformLocation(program_.get(), "u_has_surfaces");
-    for (const char* name : {"u_warp_size", "u_method", "u_chord", "u_warped", "u_shader_filter",
-                             "u_samples", "u_simpson"}) {
-      knob_loc_.push_back(glGetUniformLocation(program_.get(), name));
-    }
-  }
+      : program_("beam", {"common.glsl", "beam.vert"},
+                 {"common.glsl", "beam_math.glsl", "beam.frag"}) {}
   const char* name() const override { return "beams"; }
   void execute(FrameContext& ctx) override {
+    const bool multi = ctx.views > 0;
     glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.beam_fbo.get());
-    glUseProgram(program_.get());
-    glUniform3i(table_loc_, ctx.resources.table_d(), ctx.resources.table_s(),
-                ctx.resources.table_f());
-    glUniform1i(surfaces_loc_, ctx.scene.occluders.empty() ? 0 : 1);
+    glUseProgram(program_.get(multi));
+    glUniform3i(program_.uniform(multi, "u_table_size"), ctx.resources.table_d(),
+                ctx.resources.table_s(), ctx.resources.table_f());
+    glUniform1i(program_.uniform(multi, "u_has_surfaces"), ctx.scene.occluders.empty() ? 0 : 1);
+    if (multi) glUniform1i(program_.uniform(multi, "u_view_beams"), ctx.resources.beam_count());
     const RenderSettings& rs = ctx.scene.render;
     const bool chord = rs.layout == TableLayout::kChord || rs.layout == TableLayout::kChordWarped;
     const bool warped = rs.layout == TableLayout::kWarped || rs.layout == TableLayout::kChordWarped;
-    const int knobs[] = {ctx.resources.warp_size(),
-                         static_cast<int>(rs.method),
-                         chord ? 1 : 0,
-                         warped ? 1 : 0,
-                         rs.filter == TableFilter::kShader ? 1 : 0,
-                         rs.samples,
-                         rs.rule == MarchRule::kSimpson ? 1 : 0};
-    for (std::size_t k = 0; k < knob_loc_.size(); ++k) glUniform1i(knob_loc_[k], knobs[k]);
+    const std::pair<const char*, int> knobs[] = {
+        {"u_warp_size", ctx.resources.warp_size()},
+        {"u_method", static_cast<int>(rs.method)},
+        {"u_chord", chord ? 1 : 0},
+        {"u_warped", warped ? 1 : 0},
+        {"u_shader_filter", rs.filter == TableFilter::kShader ? 1 : 0},
+        {"u_samples", rs.samples},
+        {"u_simpson", rs.rule == MarchRule::kSimpson ? 1 : 0},
+        {"u_near_parallel", rs.near_parallel == NearParallel::kQuadrature ? 1 : 0}};
+    for (const auto& [uniform, value] : knobs) {
+      glUniform1i(program_.uniform(multi, uniform), value);
+    }
     glBindTextureUnit(0, ctx.resources.g_texture());
     glBindTextureUnit(1, ctx.resources.f_texture());
     glBindTextureUnit(2, ctx.targets.view_depth.get());
@@ -122,7 +165,7 @@ class BeamPass final : public Pass {
     glEnable(GL_DEPTH_CLAMP);  // proxies past the near or far plane still cover their pixels
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(ctx.empty_vao);
-    glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count());
+    glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count() * instances(ctx));
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
     glDisable(GL_DEPTH_CLAMP);
@@ -130,39 +173,31 @@ class BeamPass final : public Pass {
   }
 
  private:
-  GlProgram program_;
-  GLint table_loc_ = -1;
-  GLint surfaces_loc_ = -1;
-  std::vector<GLint> knob_loc_;  // same order as `knobs` in execute
+  ProgramPair program_;
 };
 
 // HDR -> display values in the output's bit depth.
 class TonemapPass final : public Pass {
  public:
   TonemapPass()
-      : program_(build_program("tonemap", assemble_shader({"common.glsl", "fullscreen.vert"}),
-                               assemble_shader({"common.glsl", "tonemap.frag"}))) {
-    exposure_loc_ = glGetUniformLocation(program_.get(), "u_exposure");
-    curve_loc_ = glGetUniformLocation(program_.get(), "u_curve");
-    levels_loc_ = glGetUniformLocation(program_.get(), "u_levels");
-  }
+      : program_("tonemap", {"common.glsl", "fullscreen.vert"}, {"common.glsl", "tonemap.frag"}) {}
   const char* name() const override { return "tonemap"; }
   void execute(FrameContext& ctx) override {
+    const bool multi = ctx.views > 0;
     glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.output_fbo.get());
-    glUseProgram(program_.get());
+    glUseProgram(program_.get(multi));
     const OutputSettings& out = ctx.scene.output;
-    glUniform1f(exposure_loc_, static_cast<float>(out.exposure));
-    glUniform1i(curve_loc_, static_cast<int>(out.tone));
-    glUniform1f(levels_loc_, out.bit_depth == 16 ? 65535.0f : 255.0f);
+    glUniform1f(program_.uniform(multi, "u_exposure"), static_cast<float>(out.exposure));
+    glUniform1i(program_.uniform(multi, "u_curve"), static_cast<int>(out.tone));
+    glUniform1f(program_.uniform(multi, "u_levels"), out.bit_depth == 16 ? 65535.0f : 255.0f);
     glBindTextureUnit(0, ctx.targets.hdr.get());
     glBindVertexArray(ctx.empty_vao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDrawArraysInstanced(GL_TRIANGLES, 0, 3, instances(ctx));
     gl_check("tonemap pass");
   }
 
  private:
-  GlProgram program_;
-  GLint exposure_loc_ = -1, curve_loc_ = -1, levels_loc_ = -1;
+  ProgramPair program_;
 };
 
 }  // namespace

@@ -17,11 +17,14 @@ namespace beamcast {
 
 // Render targets of one frame size: linear HDR colour, view depth (surfaces'
 // distance along the view axis; cleared to kNoSurface), depth buffer, output.
+// With layers > 0 every target is a 2D array texture of that many layers
+// (one per view of a multi-view batch) attached layered.
 struct FrameTargets {
   static constexpr float kNoSurface = 1e30f;
   int width = 0;
   int height = 0;
   int bit_depth = 0;
+  int layers = 0;  // 0: plain 2D textures
   GlTexture hdr;         // RGBA32F
   GlTexture view_depth;  // R32F
   GlTexture depth;       // DEPTH32F, reversed Z
@@ -29,7 +32,7 @@ struct FrameTargets {
   GlFramebuffer scene_fbo;   // hdr + view_depth + depth
   GlFramebuffer beam_fbo;    // hdr only (beams read view_depth as a texture)
   GlFramebuffer output_fbo;  // output
-  void ensure(int w, int h, int bits);
+  void ensure(int w, int h, int bits, int layer_count = 0);
 };
 
 struct FrameContext {
@@ -39,6 +42,10 @@ struct FrameContext {
   SceneResources& resources;
   FrameTargets& targets;
   GLuint empty_vao;
+  // 0: one camera (`camera`), the per-camera programs. K >= 1: a multi-view
+  // batch of K views (SceneResources::bind_views, layered targets), drawn by
+  // the multi-view programs with K instances per draw; `camera` is the first.
+  int views = 0;
 };
 
 class Pass {
@@ -49,7 +56,8 @@ class Pass {
 };
 
 // Every pass, in execution order (the order of pass_catalog()); programs are
-// compiled here, so a GL context must be current.
+// compiled here, so a GL context must be current. Multi-view programs are
+// compiled on first use, so a context without layered rendering never needs them.
 std::vector<std::unique_ptr<Pass>> make_passes();
 
 }  // namespace beamcast

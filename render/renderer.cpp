@@ -20,13 +20,31 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
+// Copies `views` images of w x h (GL rows bottom-up, RGB) from `src` into
+// top-down frames.
+template <class T, class Dst>
+void split_views(const std::vector<T>& src, int w, int h, std::size_t first, std::size_t views,
+                 Dst dst) {
+  const std::size_t row = 3 * static_cast<std::size_t>(w);
+  for (std::size_t v = 0; v < views; ++v) {
+    auto* out = dst(first + v);
+    const T* layer = src.data() + v * row * h;
+    for (int y = 0; y < h; ++y) {
+      std::copy(layer + (h - 1 - y) * row, layer + (h - y) * row, out + y * row);
+    }
+  }
+}
+
 struct Renderer::Impl {
   std::unique_ptr<EglContext> context;
   std::vector<std::unique_ptr<Pass>> passes;
   TableCache tables;
   FrameTargets targets;
+  FrameTargets layered;  // multi-view batches
   GlVertexArray empty_vao;
   std::vector<GlQuery> queries;  // timestamps: frame start, then one after each pass
+  bool multiview = false;
+  int max_layers = 0;
   // Target of the bilinear upscale when FrameOptions::resolution_scale < 1.
   GlTexture upscaled;
   GlFramebuffer upscaled_fbo;
@@ -41,6 +59,13 @@ struct Renderer::Impl {
     // Window depth in [0, 1] with reversed Z keeps float depth precise from
     // near to far.
     glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    GLint count = 0;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &count);
+    for (GLint i = 0; i < count; ++i) {
+      const auto* ext = reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, i));
+      if (ext && std::strcmp(ext, "GL_ARB_shader_viewport_layer_array") == 0) multiview = true;
+    }
+    glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
     gl_check("renderer setup");
   }
 
@@ -71,6 +96,45 @@ struct Renderer::Impl {
     gl_check("upscale blit");
   }
 
+  // Clears the targets and runs the passes, with timestamps around each.
+  void run_passes(const Scene& scene, FrameContext& ctx, const std::vector<Pass*>& plan) {
+    const GLuint fbo = ctx.targets.scene_fbo.get();
+    const float bg[4] = {static_cast<float>(scene.background[0]),
+                         static_cast<float>(scene.background[1]),
+                         static_cast<float>(scene.background[2]), 0.0f};
+    const float no_surface[4] = {FrameTargets::kNoSurface, 0.0f, 0.0f, 0.0f};
+    const float far_depth = 0.0f;  // reversed Z
+    glDepthMask(GL_TRUE);
+    glQueryCounter(query(0), GL_TIMESTAMP);
+    glClearNamedFramebufferfv(fbo, GL_COLOR, 0, bg);
+    glClearNamedFramebufferfv(fbo, GL_COLOR, 1, no_surface);
+    glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &far_depth);
+    for (std::size_t i = 0; i < plan.size(); ++i) {
+      plan[i]->execute(ctx);
+      glQueryCounter(query(i + 1), GL_TIMESTAMP);
+    }
+    gl_check("frame");
+  }
+
+  // Pass times of the last run_passes (waits for the GPU).
+  // `upscaled`: one more timestamp follows the passes, after the upscale.
+  BatchTiming read_timings(const std::vector<Pass*>& plan, bool upscaled_frame = false) {
+    GLuint64 stamps[16] = {};
+    const std::size_t count = plan.size() + 1 + (upscaled_frame ? 1 : 0);
+    for (std::size_t i = 0; i < count; ++i) {
+      glGetQueryObjectui64v(query(i), GL_QUERY_RESULT, &stamps[i]);
+    }
+    BatchTiming t;
+    for (std::size_t i = 0; i < plan.size(); ++i) {
+      t.passes.push_back({plan[i]->name(), (stamps[i + 1] - stamps[i]) * 1e-6});
+    }
+    if (upscaled_frame) {
+      t.passes.push_back({"upscale", (stamps[plan.size() + 1] - stamps[plan.size()]) * 1e-6});
+    }
+    t.gpu_ms = (stamps[count - 1] - stamps[0]) * 1e-6;
+    return t;
+  }
+
   FrameResult render_camera(const Scene& scene, const Camera& full_cam, SceneResources& res,
                             const std::vector<Pass*>& plan, const FrameOptions& opts) {
     const auto wall0 = std::chrono::steady_clock::now();
@@ -89,30 +153,12 @@ struct Renderer::Impl {
     targets.ensure(cam.width, cam.height, scene.output.bit_depth);
     glViewport(0, 0, cam.width, cam.height);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.camera_buffer());
-
-    const GLuint fbo = targets.scene_fbo.get();
-    const float bg[4] = {static_cast<float>(scene.background[0]),
-                         static_cast<float>(scene.background[1]),
-                         static_cast<float>(scene.background[2]), 0.0f};
-    const float no_surface[4] = {FrameTargets::kNoSurface, 0.0f, 0.0f, 0.0f};
-    const float far_depth = 0.0f;  // reversed Z
-    glDepthMask(GL_TRUE);
-    glQueryCounter(query(0), GL_TIMESTAMP);
-    glClearNamedFramebufferfv(fbo, GL_COLOR, 0, bg);
-    glClearNamedFramebufferfv(fbo, GL_COLOR, 1, no_surface);
-    glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &far_depth);
-
     FrameContext ctx{scene, cam, basis, res, targets, empty_vao.get()};
-    for (std::size_t i = 0; i < plan.size(); ++i) {
-      plan[i]->execute(ctx);
-      glQueryCounter(query(i + 1), GL_TIMESTAMP);
-    }
-    std::size_t stamp_count = plan.size() + 1;
+    run_passes(scene, ctx, plan);
     if (scaled) {
       upscale(cam.width, cam.height, full_cam.width, full_cam.height, scene.output.bit_depth);
-      glQueryCounter(query(stamp_count++), GL_TIMESTAMP);
+      glQueryCounter(query(plan.size() + 1), GL_TIMESTAMP);
     }
-    gl_check("frame");
 
     // Read-back (synchronous: it waits for the GPU to finish the frame).
     const auto rb0 = std::chrono::steady_clock::now();
@@ -142,6 +188,7 @@ struct Renderer::Impl {
                        result.image.rgb.begin() + (h - 1 - y) * row);
     }
     if (opts.read_hdr) {
+      // The HDR buffer is the scene's, at the render size (not upscaled).
       const int hw = cam.width, hh = cam.height;
       const std::size_t hrow = 3 * static_cast<std::size_t>(hw);
       result.hdr.width = hw;
@@ -158,19 +205,90 @@ struct Renderer::Impl {
       }
     }
 
-    GLuint64 stamps[16] = {};
-    for (std::size_t i = 0; i < stamp_count; ++i) {
-      glGetQueryObjectui64v(query(i), GL_QUERY_RESULT, &stamps[i]);
-    }
-    for (std::size_t i = 0; i < plan.size(); ++i) {
-      result.passes.push_back({plan[i]->name(), (stamps[i + 1] - stamps[i]) * 1e-6});
-    }
-    if (scaled) {
-      result.passes.push_back({"upscale", (stamps[plan.size() + 1] - stamps[plan.size()]) * 1e-6});
-    }
-    result.gpu_ms = (stamps[stamp_count - 1] - stamps[0]) * 1e-6;
+    result.batch = read_timings(plan, scaled);
+    result.passes = result.batch.passes;
+    result.gpu_ms = result.batch.gpu_ms;
     result.wall_ms = ms_since(wall0);
+    result.batch.readback_ms = result.readback_ms;
+    result.batch.wall_ms = result.wall_ms;
     return result;
+  }
+
+  // Renders cameras[idx[0..]] (all one size) in one multi-view pass set into
+  // frames[idx[...]]; one read-back transfers every view.
+  void render_batch(const Scene& scene, const std::vector<Camera>& cameras,
+                    const std::vector<std::size_t>& idx, SceneResources& res,
+                    const std::vector<Pass*>& plan, const FrameOptions& opts,
+                    std::vector<FrameResult>& frames) {
+    const auto wall0 = std::chrono::steady_clock::now();
+    const std::size_t k = idx.size();
+    std::vector<Camera> cams;
+    std::vector<CameraBasis> bases;
+    for (std::size_t i : idx) {
+      cams.push_back(cameras[i]);
+      bases.push_back(camera_basis(cameras[i]));
+    }
+    const int w = cams[0].width, h = cams[0].height;
+    res.bind_views(cams, bases);
+    layered.ensure(w, h, scene.output.bit_depth, static_cast<int>(k));
+    glViewport(0, 0, w, h);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, res.views_camera_buffer());
+    FrameContext ctx{scene, cams[0], bases[0], res, layered, empty_vao.get(), static_cast<int>(k)};
+    run_passes(scene, ctx, plan);
+
+    // One read-back of every layer (synchronous: waits for the passes).
+    const auto rb0 = std::chrono::steady_clock::now();
+    const std::size_t per_view = 3 * static_cast<std::size_t>(w) * h;
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    for (std::size_t v = 0; v < k; ++v) {
+      FrameResult& f = frames[idx[v]];
+      f.image.width = w;
+      f.image.height = h;
+      f.image.bit_depth = scene.output.bit_depth;
+      f.image.rgb.resize(per_view);
+    }
+    auto image_of = [&](std::size_t v) { return frames[idx[v]].image.rgb.data(); };
+    if (scene.output.bit_depth == 16) {
+      std::vector<std::uint16_t> all(per_view * k);
+      glGetTextureImage(layered.output.get(), 0, GL_RGB, GL_UNSIGNED_SHORT,
+                        static_cast<GLsizei>(all.size() * 2), all.data());
+      split_views(all, w, h, 0, k, image_of);
+    } else {
+      std::vector<std::uint8_t> all(per_view * k);
+      glGetTextureImage(layered.output.get(), 0, GL_RGB, GL_UNSIGNED_BYTE,
+                        static_cast<GLsizei>(all.size()), all.data());
+      split_views(all, w, h, 0, k, image_of);
+    }
+    gl_check("glGetTextureImage(output layers)");
+    const double readback_ms = ms_since(rb0);
+    if (opts.read_hdr) {
+      std::vector<float> all(per_view * k);
+      glGetTextureImage(layered.hdr.get(), 0, GL_RGB, GL_FLOAT,
+                        static_cast<GLsizei>(all.size() * sizeof(float)), all.data());
+      gl_check("glGetTextureImage(hdr layers)");
+      for (std::size_t v = 0; v < k; ++v) {
+        HdrImage& hdr = frames[idx[v]].hdr;
+        hdr.width = w;
+        hdr.height = h;
+        hdr.rgb.resize(per_view);
+      }
+      split_views(all, w, h, 0, k, [&](std::size_t v) { return frames[idx[v]].hdr.rgb.data(); });
+    }
+
+    BatchTiming batch = read_timings(plan);
+    batch.views = static_cast<int>(k);
+    batch.readback_ms = readback_ms;
+    batch.wall_ms = ms_since(wall0);
+    const double share = 1.0 / static_cast<double>(k);
+    for (std::size_t v = 0; v < k; ++v) {
+      FrameResult& f = frames[idx[v]];
+      f.batch = batch;
+      f.gpu_ms = batch.gpu_ms * share;
+      f.readback_ms = batch.readback_ms * share;
+      f.wall_ms = batch.wall_ms * share;
+      f.passes = batch.passes;
+      for (PassTiming& p : f.passes) p.gpu_ms *= share;
+    }
   }
 };
 
@@ -178,6 +296,8 @@ Renderer::Renderer(const RendererOptions& opts) : impl_(std::make_unique<Impl>(o
 Renderer::~Renderer() = default;
 
 const std::string& Renderer::description() const { return impl_->context->description(); }
+
+bool Renderer::multiview_supported() const { return impl_->multiview; }
 
 std::vector<FrameResult> Renderer::render(const Scene& scene, const FrameOptions& opts) {
   return render(scene, scene.cameras, opts);
@@ -192,10 +312,48 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
     }
   }
   SceneResources res(scene, impl_->tables);
-  std::vector<FrameResult> frames;
-  frames.reserve(cameras.size());
-  for (const Camera& cam : cameras) {
-    frames.push_back(impl_->render_camera(scene, cam, res, plan, opts));
+  std::vector<FrameResult> frames(cameras.size());
+  // Batches: cameras of one size, in order of first appearance, split where a
+  // batch would pass the view or memory bound. A batch of one takes the
+  // per-camera path.
+  std::vector<std::vector<std::size_t>> batches;
+  // Scaled (interactive) frames take the per-camera path, which owns the upscale.
+  const bool scaled = opts.resolution_scale > 0.0 && opts.resolution_scale < 1.0;
+  if (opts.batch && impl_->multiview && !scaled) {
+    std::vector<std::pair<int, int>> sizes;
+    std::vector<std::vector<std::size_t>> groups;
+    for (std::size_t i = 0; i < cameras.size(); ++i) {
+      const std::pair<int, int> size{cameras[i].width, cameras[i].height};
+      auto it = std::find(sizes.begin(), sizes.end(), size);
+      if (it == sizes.end()) {
+        sizes.push_back(size);
+        groups.emplace_back();
+        it = sizes.end() - 1;
+      }
+      groups[static_cast<std::size_t>(it - sizes.begin())].push_back(i);
+    }
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      const std::int64_t pixels = static_cast<std::int64_t>(sizes[g].first) * sizes[g].second;
+      const std::size_t cap = static_cast<std::size_t>(std::max<std::int64_t>(
+          1, std::min<std::int64_t>({opts.max_batch_views, impl_->max_layers,
+                                     opts.max_batch_pixels / std::max<std::int64_t>(1, pixels)})));
+      for (std::size_t at = 0; at < groups[g].size(); at += cap) {
+        const std::size_t end = std::min(groups[g].size(), at + cap);
+        batches.emplace_back(groups[g].begin() + static_cast<std::ptrdiff_t>(at),
+                             groups[g].begin() + static_cast<std::ptrdiff_t>(end));
+      }
+    }
+  } else {
+    for (std::size_t i = 0; i < cameras.size(); ++i) batches.push_back({i});
+  }
+  for (std::size_t b = 0; b < batches.size(); ++b) {
+    const auto& idx = batches[b];
+    if (idx.size() == 1) {
+      frames[idx[0]] = impl_->render_camera(scene, cameras[idx[0]], res, plan, opts);
+    } else {
+      impl_->render_batch(scene, cameras, idx, res, plan, opts, frames);
+    }
+    for (std::size_t i : idx) frames[i].batch.index = static_cast<int>(b);
   }
   return frames;
 }

@@ -2,6 +2,7 @@
 // into frames. The passes that run are chosen from the scene's content.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,6 +30,26 @@ struct FrameOptions {
   // the camera's size with a bilinear blit on the GPU ("upscale" pass); 1 =
   // native (no extra pass). The HDR buffer, if read, stays at the render size.
   double resolution_scale = 1.0;
+  // Multi-view batching: cameras of one size are rendered together, K views
+  // per draw into layered targets, and read back in one transfer. Off (or
+  // without layered rendering in the driver): one camera at a time.
+  bool batch = true;
+  int max_batch_views = 64;
+  // Memory bound of a batch: views * width * height (the targets take about
+  // 28 bytes a pixel; 16 Mpx is 448 MB, 64 views of 512x512).
+  std::int64_t max_batch_pixels = 16LL << 20;
+};
+
+// The GPU work a frame was part of: a multi-view batch of `views` cameras, or
+// a single camera (views = 1). Frames' own gpu_ms, readback_ms and pass times
+// are their share (batch / views).
+struct BatchTiming {
+  int index = 0;  // batches in render order
+  int views = 1;
+  double gpu_ms = 0.0;
+  double readback_ms = 0.0;
+  double wall_ms = 0.0;
+  std::vector<PassTiming> passes;
 };
 
 struct FrameResult {
@@ -37,7 +58,8 @@ struct FrameResult {
   std::vector<PassTiming> passes;
   double gpu_ms = 0.0;       // whole frame on the GPU
   double readback_ms = 0.0;  // glReadPixels, wall clock
-  double wall_ms = 0.0;      // the whole call for this camera, wall clock
+  double wall_ms = 0.0;      // the whole call for this camera, wall clock (batch share)
+  BatchTiming batch;
 };
 
 class Renderer {
@@ -49,6 +71,9 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   const std::string& description() const;
+  // True if the context can render several views in one pass (gl_Layer from
+  // the vertex stage: GL_ARB_shader_viewport_layer_array).
+  bool multiview_supported() const;
 
   // Renders every camera of the scene; scene resources (tables, occluder
   // geometry) are uploaded once and shared by the cameras.

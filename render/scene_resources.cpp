@@ -265,9 +265,10 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables) : scene_(
   gl_check("create scene buffers");
 }
 
-void SceneResources::bind_camera(const Camera& cam, const CameraBasis& basis) {
+void SceneResources::fill_camera(const Camera& cam, const CameraBasis& basis, void* block) const {
   const Vec3& eye = basis.eye;
-  CameraBlock cb{};
+  CameraBlock& cb = *static_cast<CameraBlock*>(block);
+  cb = CameraBlock{};
   view_projection(cam, basis, cb.view_proj);
   const bool ortho = cam.projection == Projection::kOrthographic;
   set3(cb.right, basis.right,
@@ -282,57 +283,116 @@ void SceneResources::bind_camera(const Camera& cam, const CameraBasis& basis) {
   set3(cb.light_dir, normalize(-1.0 * light.direction), static_cast<float>(light.ambient));
   set3(cb.light_color, light.color, static_cast<float>(light.intensity));
   set3(cb.mesh_offset, mesh_anchor_ - eye, 0.0f);
-  glNamedBufferSubData(camera_ubo_.get(), 0, sizeof cb, &cb);
+}
 
+void SceneResources::fill_beams(const Vec3& eye, void* beams) const {
+  auto* data = static_cast<BeamData*>(beams);
+  for (std::size_t i = 0; i < scene_.beams.size(); ++i) {
+    const Beam& beam = scene_.beams[i];
+    BeamData& d = data[i];
+    d = BeamData{};
+    const auto r = static_cast<float>(beam.radius);
+    const Color c = (beam.intensity) * beam.color;
+    set3(d.color_layer, c, beam_layers_[i]);
+    d.density[0] = static_cast<float>(static_cast<int>(beam.density.kind));
+    d.density[1] = static_cast<float>(beam.density.sigma);
+    if (const auto* s = std::get_if<SphereBeam>(&beam.shape)) {
+      set3(d.p0_radius, s->center - eye, r);
+      set3(d.axis_length, {0.0, 0.0, 1.0}, 0.0f);
+      set3(d.caps_kind, {0.0, 0.0, 0.0}, 0.0f);
+    } else {
+      const auto& cap = std::get<CapsuleBeam>(beam.shape);
+      const Vec3 axis = cap.p1 - cap.p0;
+      const double len = length(axis);
+      set3(d.p0_radius, cap.p0 - eye, r);
+      set3(d.axis_length, (1.0 / len) * axis, static_cast<float>(len));
+      set3(d.caps_kind, {cap.cap0 ? 1.0 : 0.0, cap.cap1 ? 1.0 : 0.0, 1.0}, 0.0f);
+    }
+  }
+}
+
+void SceneResources::fill_analytic(const Vec3& eye, void* analytic) const {
+  auto* data = static_cast<AnalyticData*>(analytic);
+  for (std::size_t i = 0; i < analytic_.size(); ++i) {
+    const Occluder& occ = *analytic_[i];
+    AnalyticData& d = data[i];
+    d = AnalyticData{};
+    set3(d.albedo, occ.albedo, 1.0f);
+    if (const auto* plane = std::get_if<PlaneOccluder>(&occ.shape)) {
+      // The plane's point nearest the eye, computed in double, keeps the
+      // plane exact near the camera whatever point the scene gave.
+      const Vec3 n = normalize(plane->normal);
+      set3(d.a, dot(plane->point - eye, n) * n, 0.0f);
+      set3(d.b, n, 0.0f);
+    } else {
+      const auto& sphere = std::get<SphereOccluder>(occ.shape);
+      set3(d.a, sphere.center - eye, static_cast<float>(sphere.radius));
+      set3(d.b, {0.0, 0.0, 0.0}, 1.0f);
+    }
+  }
+}
+
+void SceneResources::bind_camera(const Camera& cam, const CameraBasis& basis) {
+  views_ = false;
+  CameraBlock cb;
+  fill_camera(cam, basis, &cb);
+  glNamedBufferSubData(camera_ubo_.get(), 0, sizeof cb, &cb);
   if (beam_ssbo_) {
     std::vector<BeamData> data(scene_.beams.size());
-    for (std::size_t i = 0; i < scene_.beams.size(); ++i) {
-      const Beam& beam = scene_.beams[i];
-      BeamData& d = data[i];
-      const auto r = static_cast<float>(beam.radius);
-      const Color c = (beam.intensity) * beam.color;
-      set3(d.color_layer, c, beam_layers_[i]);
-      d.density[0] = static_cast<float>(static_cast<int>(beam.density.kind));
-      d.density[1] = static_cast<float>(beam.density.sigma);
-      if (const auto* s = std::get_if<SphereBeam>(&beam.shape)) {
-        set3(d.p0_radius, s->center - eye, r);
-        set3(d.axis_length, {0.0, 0.0, 1.0}, 0.0f);
-        set3(d.caps_kind, {0.0, 0.0, 0.0}, 0.0f);
-      } else {
-        const auto& cap = std::get<CapsuleBeam>(beam.shape);
-        const Vec3 axis = cap.p1 - cap.p0;
-        const double len = length(axis);
-        set3(d.p0_radius, cap.p0 - eye, r);
-        set3(d.axis_length, (1.0 / len) * axis, static_cast<float>(len));
-        set3(d.caps_kind, {cap.cap0 ? 1.0 : 0.0, cap.cap1 ? 1.0 : 0.0, 1.0}, 0.0f);
-      }
-    }
+    fill_beams(basis.eye, data.data());
     glNamedBufferSubData(beam_ssbo_.get(), 0,
                          static_cast<GLsizeiptr>(data.size() * sizeof(BeamData)), data.data());
   }
   if (analytic_ssbo_) {
     std::vector<AnalyticData> data(analytic_.size());
-    for (std::size_t i = 0; i < analytic_.size(); ++i) {
-      const Occluder& occ = *analytic_[i];
-      AnalyticData& d = data[i];
-      set3(d.albedo, occ.albedo, 1.0f);
-      if (const auto* plane = std::get_if<PlaneOccluder>(&occ.shape)) {
-        // The plane's point nearest the eye, computed in double, keeps the
-        // plane exact near the camera whatever point the scene gave.
-        const Vec3 n = normalize(plane->normal);
-        set3(d.a, dot(plane->point - eye, n) * n, 0.0f);
-        set3(d.b, n, 0.0f);
-      } else {
-        const auto& sphere = std::get<SphereOccluder>(occ.shape);
-        set3(d.a, sphere.center - eye, static_cast<float>(sphere.radius));
-        set3(d.b, {0.0, 0.0, 0.0}, 1.0f);
-      }
-    }
+    fill_analytic(basis.eye, data.data());
     glNamedBufferSubData(analytic_ssbo_.get(), 0,
                          static_cast<GLsizeiptr>(data.size() * sizeof(AnalyticData)),
                          data.data());
   }
   gl_check("bind_camera");
+}
+
+void SceneResources::bind_views(const std::vector<Camera>& cams,
+                                const std::vector<CameraBasis>& bases) {
+  const std::size_t k = cams.size();
+  const std::size_t nb = scene_.beams.size(), na = analytic_.size();
+  if (k > views_capacity_) {
+    // Sized for the largest batch seen; a buffer of zero bytes is not allowed.
+    auto make = [](GlBuffer& buf, std::size_t bytes) {
+      GLuint id = 0;
+      glCreateBuffers(1, &id);
+      buf = GlBuffer(id);
+      glNamedBufferStorage(id, static_cast<GLsizeiptr>(std::max<std::size_t>(bytes, 16)), nullptr,
+                           GL_DYNAMIC_STORAGE_BIT);
+    };
+    make(views_camera_ssbo_, k * sizeof(CameraBlock));
+    make(views_beam_ssbo_, k * nb * sizeof(BeamData));
+    make(views_analytic_ssbo_, k * na * sizeof(AnalyticData));
+    views_capacity_ = k;
+  }
+  std::vector<CameraBlock> blocks(k);
+  std::vector<BeamData> beams(k * nb);
+  std::vector<AnalyticData> analytic(k * na);
+  for (std::size_t v = 0; v < k; ++v) {
+    fill_camera(cams[v], bases[v], &blocks[v]);
+    fill_beams(bases[v].eye, beams.data() + v * nb);
+    fill_analytic(bases[v].eye, analytic.data() + v * na);
+  }
+  glNamedBufferSubData(views_camera_ssbo_.get(), 0,
+                       static_cast<GLsizeiptr>(blocks.size() * sizeof(CameraBlock)),
+                       blocks.data());
+  if (nb > 0) {
+    glNamedBufferSubData(views_beam_ssbo_.get(), 0,
+                         static_cast<GLsizeiptr>(beams.size() * sizeof(BeamData)), beams.data());
+  }
+  if (na > 0) {
+    glNamedBufferSubData(views_analytic_ssbo_.get(), 0,
+                         static_cast<GLsizeiptr>(analytic.size() * sizeof(AnalyticData)),
+                         analytic.data());
+  }
+  views_ = true;
+  gl_check("bind_views");
 }
 
 }  // namespace beamcast

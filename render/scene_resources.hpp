@@ -35,6 +35,12 @@ class SceneResources {
   SceneResources(const Scene& scene, TableCache& tables);
   // Uploads the camera block and camera-relative beam and occluder data.
   void bind_camera(const Camera& cam, const CameraBasis& basis);
+  // Multi-view: uploads one camera block per view (the Cameras buffer at SSBO
+  // binding 4) and view-major camera-relative beams and analytic occluders,
+  // the same values bind_camera computes for each camera alone. Until the next
+  // bind_camera, beam_buffer() and analytic_buffer() return the multi-view ones.
+  void bind_views(const std::vector<Camera>& cams, const std::vector<CameraBasis>& bases);
+  GLuint views_camera_buffer() const { return views_camera_ssbo_.get(); }
 
   int table_d() const { return nd_; }
   int table_s() const { return ns_; }
@@ -43,12 +49,14 @@ class SceneResources {
   GLuint f_texture() const { return f_tex_.get(); }
   GLuint warp_texture() const { return warp_tex_.get(); }
   int warp_size() const { return nw_; }
-  GLuint beam_buffer() const { return beam_ssbo_.get(); }
+  GLuint beam_buffer() const { return views_ ? views_beam_ssbo_.get() : beam_ssbo_.get(); }
   GLsizei beam_count() const { return static_cast<GLsizei>(beam_layers_.size()); }
   GLuint camera_buffer() const { return camera_ubo_.get(); }
   GLuint triangle_vao() const { return tri_vao_.get(); }
   GLsizei triangle_vertex_count() const { return tri_vertices_; }
-  GLuint analytic_buffer() const { return analytic_ssbo_.get(); }
+  GLuint analytic_buffer() const {
+    return views_ ? views_analytic_ssbo_.get() : analytic_ssbo_.get();
+  }
   GLsizei analytic_count() const { return static_cast<GLsizei>(analytic_.size()); }
 
  private:
@@ -61,6 +69,14 @@ class SceneResources {
   GLsizei tri_vertices_ = 0;
   Vec3 mesh_anchor_{};
   std::vector<const Occluder*> analytic_;  // planes and spheres
+  bool views_ = false;  // bind_views was last
+  GlBuffer views_camera_ssbo_, views_beam_ssbo_, views_analytic_ssbo_;
+  std::size_t views_capacity_ = 0;  // views the multi-view buffers hold
+
+  // The per-camera data of bind_camera, written to `out` (for bind_views).
+  void fill_camera(const Camera& cam, const CameraBasis& basis, void* block) const;
+  void fill_beams(const Vec3& eye, void* beams) const;
+  void fill_analytic(const Vec3& eye, void* analytic) const;
 };
 
 }  // namespace beamcast

@@ -10,7 +10,7 @@ namespace {
 bool same_settings(const RenderSettings& a, const RenderSettings& b) {
   return a.method == b.method && a.table_d == b.table_d && a.table_s == b.table_s &&
          a.layout == b.layout && a.filter == b.filter && a.f_table == b.f_table &&
-         a.samples == b.samples && a.rule == b.rule;
+         a.samples == b.samples && a.rule == b.rule && a.near_parallel == b.near_parallel;
 }
 
 std::string settings_label(const RenderSettings& r) {
@@ -90,9 +90,26 @@ std::optional<double> AccuracyController::estimate(int level, double now_ms) con
     }
   }
   if (freshest < 0) return std::nullopt;
-  // Prediction from the freshest measurement: cost follows pixel count (the
-  // fragment shaders dominate; docs/performance.md measures each level).
-  const double predicted = costs_[freshest].ewma_ms * pixels(level) / pixels(freshest);
+  // Prediction from measurements: cost = fixed + per_pixel * scale². With a
+  // fresh measurement at a second scale both terms are fitted (the fixed part
+  // is read-back and encoding at the output size, which scaling does not
+  // shrink); with one, cost is taken as proportional to pixel count.
+  const Cost& a = costs_[freshest];
+  int second = -1;
+  for (int k = 0; k < static_cast<int>(costs_.size()); ++k) {
+    if (costs_[k].last_ms < 0 || pixels(k) == pixels(freshest)) continue;
+    if (now_ms - costs_[k].last_ms > config_.stale_ms) continue;
+    if (second < 0 || costs_[k].last_ms > costs_[second].last_ms) second = k;
+  }
+  double predicted = a.ewma_ms * pixels(level) / pixels(freshest);
+  if (second >= 0) {
+    const double per_pixel =
+        (a.ewma_ms - costs_[second].ewma_ms) / (pixels(freshest) - pixels(second));
+    if (per_pixel > 0.0) {
+      const double fixed = std::max(0.0, a.ewma_ms - per_pixel * pixels(freshest));
+      predicted = fixed + per_pixel * pixels(level);
+    }
+  }
   const Cost& own = costs_[level];
   if (own.last_ms < 0) return predicted;
   if (now_ms - own.last_ms <= config_.stale_ms || level == freshest) return own.ewma_ms;

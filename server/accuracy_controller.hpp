@@ -65,7 +65,10 @@ class AccuracyController {
   // Reports the measured cost of a frame rendered at `level`.
   void observe(int level, double frame_ms, double now_ms);
 
-  // Predicted frame time of `level` at `now_ms`; nullopt before any measurement.
+  // Predicted frame time of `level` at `now_ms`: its own recent measurement,
+  // else a fit of fixed + per-pixel cost to the freshest measurements (the
+  // first full frame and the first scaled one are the calibration); nullopt
+  // before any measurement.
   std::optional<double> estimate(int level, double now_ms) const;
   const std::vector<AccuracyLevel>& ladder() const { return ladder_; }
   const ControllerConfig& config() const { return config_; }

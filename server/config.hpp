@@ -26,6 +26,9 @@ struct ServerConfig {
   int render_workers = 1;  // threads that each own a GL context
   int encode_threads = 2;  // PNG encoding pool
   int network_threads = 1;
+  // Cross-connection batching: renders of one stored scene arriving within this
+  // many ms are rendered as one multi-view pass. 0: off (lowest latency).
+  int batch_window_ms = 0;
   // PNG zlib level and libpng filter mask (PNG_FILTER_SUB = 0x10), chosen by
   // measurement: docs/performance.md, "PNG encoding".
   int png_level = 2;

@@ -102,7 +102,8 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
   }
 
   void send(const nlohmann::json& response, std::vector<std::uint8_t> binary) override {
-    std::string text = response.dump();
+    // As Session::send: never throw on bytes a client smuggled into a message.
+    std::string text = response.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     core_.stats.count_bytes_out(text.size() + binary.size());
     asio::post(ws_.get_executor(), [self = shared_from_this(), t = std::move(text),
                                     b = std::move(binary)]() mutable {
@@ -247,6 +248,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     if (websocket::is_upgrade(req)) {
       if (req.target().substr(0, req.target().find('?')) != "/ws") {
         return reply_error(http::status::not_found, "WebSocket endpoint is /ws\n");
+      }
+      if (owner_->core.stats.connections_open() >= owner_->core.config.max_connections ||
+          owner_->core.shutting_down.load()) {
+        // The TCP port's rule: over max_connections, refuse and let the others carry on.
+        owner_->core.stats.count_error("busy");
+        return reply_error(http::status::service_unavailable,
+                           "max_connections reached or shutting down; retry later\n");
       }
       stream_.expires_never();  // the WebSocket has its own timeouts
       auto ws = std::make_shared<WsSession>(stream_.release_socket(), owner_->core);

@@ -39,6 +39,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--encode-threads", c.encode_threads, "PNG encoding threads")
       ->check(CLI::Range(1, 256))->capture_default_str();
+  app.add_option("--batch-window-ms", c.batch_window_ms,
+                 "Batch renders of one stored scene arriving within this window into one "
+                 "multi-view pass (0: off)")
+      ->check(CLI::Range(0, 10000))->capture_default_str();
   app.add_option("--network-threads", c.network_threads, "Threads running connections")
       ->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--png-level", c.png_level, "zlib level of PNG frames (docs/performance.md)")

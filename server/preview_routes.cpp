@@ -47,6 +47,8 @@ void register_preview_routes(HttpServer& http, ServerCore& core) {
     http.add_get("/" + name, [reply] { return reply; });
     if (name == "index.html") http.add_get("/", [reply] { return reply; });
   }
+  // Browsers ask for it; no icon, and no 404 in their consoles.
+  http.add_get("/favicon.ico", [] { return HttpReply{204, "image/x-icon", ""}; });
   http.add_get("/api/scenes", [&core] {
     return json_reply({{"stored", core.scenes.ids()},
                        {"examples", example_names(core.config.assets_dir)}});

@@ -2,7 +2,10 @@
 
 #include <boost/asio/post.hpp>
 
+#include <algorithm>
 #include <cstdio>
+#include <iterator>
+#include <optional>
 
 #include "render/image.hpp"
 #include "render/jpeg.hpp"
@@ -107,81 +110,148 @@ void RenderService::worker_main(int index) {
   ready_cv_.notify_all();
 
   for (;;) {
-    RenderJob job;
+    std::vector<RenderJob> jobs;
     {
       std::unique_lock lock(mu_);
       cv_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
       if (queue_.empty()) return;  // stopping
-      job = std::move(queue_.front());
+      RenderJob first = std::move(queue_.front());
       queue_.pop_front();
+      jobs = gather_batch(std::move(first), lock);
     }
-    RenderOutcome out;
     const auto start = Clock::now();
-    out.queue_ms = ms_between(job.arrived, start);
-    if (!job.client_alive->load()) {
-      out.dropped = true;  // a disconnected client costs no GPU time
-      dropped_.fetch_add(1);
-      finish(job, std::move(out));
-      continue;
+    // Jobs whose client went away cost no GPU time.
+    std::vector<RenderJob> live;
+    for (RenderJob& job : jobs) {
+      if (!job.client_alive->load()) {
+        RenderOutcome out;
+        out.queue_ms = ms_between(job.arrived, start);
+        out.dropped = true;
+        dropped_.fetch_add(1);
+        finish(job, std::move(out));
+      } else {
+        live.push_back(std::move(job));
+      }
     }
+    if (live.empty()) continue;
+    std::vector<Camera> cameras;
+    for (const RenderJob& job : live) cameras.insert(cameras.end(), job.cameras.begin(), job.cameras.end());
+    std::optional<ErrorInfo> error;
+    std::vector<FrameResult> frames;
     if (!renderer) {
-      out.error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
-      finish(job, std::move(out));
-      continue;
+      error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
+    } else {
+      try {
+        // Jobs share a render only with the same stored scene and default
+        // options (RenderJob::batch_key), so the first job's options hold for all.
+        frames = renderer->render(*live.front().scene, cameras, live.front().options);
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "beamcast-server: render failed: %s\n", e.what());
+        error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
+      }
     }
-    try {
-      out.frames = renderer->render(*job.scene, job.cameras, job.options);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "beamcast-server: render failed: %s\n", e.what());
-      out.error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
-      finish(job, std::move(out));
-      continue;
-    }
-    out.render_ms = ms_between(start, Clock::now());
-
-    // Encode every frame in parallel on the CPU pool; the last one to finish
-    // completes the job, while this worker moves on to the next render.
-    struct EncodeState {
-      RenderJob job;
+    const double render_ms = ms_between(start, Clock::now());
+    std::size_t at = 0;
+    for (RenderJob& job : live) {
       RenderOutcome out;
-      std::atomic<std::size_t> remaining;
-      Clock::time_point start;
-    };
-    const std::size_t n = out.frames.size();
-    auto st = std::make_shared<EncodeState>();
-    st->out = std::move(out);
-    st->out.pngs.resize(n);
-    st->out.encode_ms.resize(n);
-    st->out.is_jpeg.assign(n, 0);
-    st->remaining = n;
-    st->start = Clock::now();
-    st->job = std::move(job);
-    for (std::size_t i = 0; i < n; ++i) {
-      boost::asio::post(encoders_, [this, st, i] {
-        const auto t0 = Clock::now();
-        Image& img = st->out.frames[i].image;
-        bool png = !st->job.jpeg || img.rgb.empty();
-        if (!png) {
-          try {
-            st->out.pngs[i] = encode_jpeg(img, st->job.jpeg_quality);
-          } catch (const std::exception& e) {
-            // Never expected of a valid image; the frame still goes out, as PNG.
-            std::fprintf(stderr, "beamcast-server: %s; sending PNG\n", e.what());
-            png = true;
-          }
-        }
-        if (png) st->out.pngs[i] = encode_png(img, png_level_, png_filters_);
-        st->out.is_jpeg[i] = png ? 0 : 1;
-        st->out.encode_ms[i] = ms_between(t0, Clock::now());
-        img.rgb = {};  // the PNG is what travels; free the pixels now
-        if (st->remaining.fetch_sub(1) == 1) {
-          st->out.encode_wall_ms = ms_between(st->start, Clock::now());
-          finish(st->job, std::move(st->out));
-        }
-      });
+      out.queue_ms = ms_between(job.arrived, start);
+      out.batched_requests = static_cast<int>(live.size());
+      out.batched_views = static_cast<int>(cameras.size());
+      if (error) {
+        out.error = error;
+        finish(job, std::move(out));
+        continue;
+      }
+      out.render_ms = render_ms;
+      const std::size_t n = job.cameras.size();
+      out.frames.assign(std::make_move_iterator(frames.begin() + static_cast<std::ptrdiff_t>(at)),
+                        std::make_move_iterator(frames.begin() + static_cast<std::ptrdiff_t>(at + n)));
+      at += n;
+      encode_and_finish(std::move(job), std::move(out));
     }
-    if (n == 0) finish(st->job, std::move(st->out));
   }
+}
+
+std::vector<RenderJob> RenderService::gather_batch(RenderJob first,
+                                                   std::unique_lock<std::mutex>& lock) {
+  std::vector<RenderJob> jobs;
+  const void* key = first.batch_key;
+  const auto deadline = first.arrived + batch_window_;
+  int views = static_cast<int>(first.cameras.size());
+  jobs.push_back(std::move(first));
+  if (key == nullptr || batch_window_.count() <= 0) return jobs;
+  // Wait out the window on a condition of its own (so this worker swallows no
+  // wake-up meant for an idle one), then take the matching jobs.
+  window_cv_.wait_until(lock, deadline, [&] { return stopping_; });
+  for (auto it = queue_.begin(); it != queue_.end();) {
+    const int n = static_cast<int>(it->cameras.size());
+    if (it->batch_key == key && views + n <= batch_max_views_) {
+      views += n;
+      jobs.push_back(std::move(*it));
+      it = queue_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  return jobs;
+}
+
+void RenderService::set_batch_window(std::chrono::milliseconds window, int max_views) {
+  std::lock_guard lock(mu_);
+  batch_window_ = window;
+  batch_max_views_ = std::max(1, max_views);
+}
+
+// Encodes every frame in parallel on the CPU pool; the last one to finish
+// completes the job, while the worker moves on to the next render.
+void RenderService::encode_and_finish(RenderJob job, RenderOutcome out) {
+  struct EncodeState {
+    RenderJob job;
+    RenderOutcome out;
+    std::atomic<std::size_t> remaining;
+    Clock::time_point start;
+  };
+  if (job.atlas && !out.frames.empty()) {
+    std::vector<const Image*> images;
+    for (const FrameResult& f : out.frames) images.push_back(&f.image);
+    out.atlas = make_atlas(images);
+    for (FrameResult& f : out.frames) f.image.rgb = {};
+  }
+  // One PNG per frame, or the atlas alone.
+  const std::size_t n = out.atlas ? 1 : out.frames.size();
+  auto st = std::make_shared<EncodeState>();
+  st->out = std::move(out);
+  st->out.pngs.resize(n);
+  st->out.encode_ms.resize(n);
+  st->out.is_jpeg.assign(n, 0);
+  st->remaining = n;
+  st->start = Clock::now();
+  st->job = std::move(job);
+  for (std::size_t i = 0; i < n; ++i) {
+    boost::asio::post(encoders_, [this, st, i] {
+      const auto t0 = Clock::now();
+      Image& img = st->out.atlas ? st->out.atlas->image : st->out.frames[i].image;
+      bool png = !st->job.jpeg || img.rgb.empty();
+      if (!png) {
+        try {
+          st->out.pngs[i] = encode_jpeg(img, st->job.jpeg_quality);
+        } catch (const std::exception& e) {
+          // Never expected of a valid image; the frame still goes out, as PNG.
+          std::fprintf(stderr, "beamcast-server: %s; sending PNG\n", e.what());
+          png = true;
+        }
+      }
+      if (png) st->out.pngs[i] = encode_png(img, png_level_, png_filters_);
+      st->out.is_jpeg[i] = png ? 0 : 1;
+      st->out.encode_ms[i] = ms_between(t0, Clock::now());
+      img.rgb = {};  // the PNG is what travels; free the pixels now
+      if (st->remaining.fetch_sub(1) == 1) {
+        st->out.encode_wall_ms = ms_between(st->start, Clock::now());
+        finish(st->job, std::move(st->out));
+      }
+    });
+  }
+  if (n == 0) finish(st->job, std::move(st->out));
 }
 
 void RenderService::stop() {
@@ -193,6 +263,7 @@ void RenderService::stop() {
     left.swap(queue_);
   }
   cv_.notify_all();
+  window_cv_.notify_all();
   for (auto& t : workers_) t.join();
   workers_.clear();
   encoders_.join();

@@ -19,6 +19,7 @@
 
 #include "protocol/errors.hpp"
 #include "protocol/scene.hpp"
+#include "render/atlas.hpp"
 #include "render/renderer.hpp"
 
 namespace beamcast {
@@ -53,6 +54,14 @@ struct RenderOutcome {
   double queue_ms = 0.0;
   double render_ms = 0.0;
   double encode_wall_ms = 0.0;
+  // Cross-request batching (RenderService::set_batch_window): how many
+  // requests and views shared this job's render call (1 and its own cameras'
+  // count when it rendered alone).
+  int batched_requests = 1;
+  int batched_views = 0;
+  // With RenderJob::atlas: the layout (its image released after encoding);
+  // `pngs` then holds the one atlas PNG.
+  std::optional<Atlas> atlas;
 };
 
 struct RenderJob {
@@ -63,6 +72,10 @@ struct RenderJob {
   int jpeg_quality = 90;
   std::shared_ptr<const std::atomic<bool>> client_alive;
   std::chrono::steady_clock::time_point arrived;
+  // Jobs with the same non-null key (one stored scene, unmodified) that arrive
+  // within the batch window are rendered in one call; null: never merged.
+  const void* batch_key = nullptr;
+  bool atlas = false;  // encode the frames as one atlas image (render/atlas.hpp)
   // Called exactly once, on a worker or encoder thread.
   std::function<void(RenderOutcome&&)> done;
 };
@@ -77,6 +90,12 @@ class RenderService {
   // the first renderer's description, throws if none could be created.
   std::string wait_ready();
 
+  // Batching across requests: a worker that takes a job with a batch key waits
+  // until `window` after the job's arrival and renders every queued job of the
+  // same key with it, up to `max_views` cameras in all. 0 (default): off, each
+  // job renders as soon as a worker is free.
+  void set_batch_window(std::chrono::milliseconds window, int max_views);
+
   // False if `max_inflight` jobs are already accepted and unanswered (busy).
   bool submit(RenderJob job);
   int inflight() const { return inflight_.load(); }
@@ -90,15 +109,22 @@ class RenderService {
  private:
   void worker_main(int index);
   void finish(RenderJob& job, RenderOutcome&& outcome);
+  // Takes the queued jobs that may join `first` (same batch key) once its
+  // window has passed; called with `lock` held, may wait on it.
+  std::vector<RenderJob> gather_batch(RenderJob first, std::unique_lock<std::mutex>& lock);
+  void encode_and_finish(RenderJob job, RenderOutcome out);
 
   RendererFactory factory_;
   int png_level_;
   int png_filters_;
   int max_inflight_;
+  std::chrono::milliseconds batch_window_{0};
+  int batch_max_views_ = 64;
   std::atomic<int> inflight_{0};
   std::atomic<std::uint64_t> dropped_{0};
   mutable std::mutex mu_;
   std::condition_variable cv_;
+  std::condition_variable window_cv_;  // batch windows wait here (stop() wakes them)
   std::deque<RenderJob> queue_;
   bool stopping_ = false;
   int ready_ = 0;

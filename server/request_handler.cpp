@@ -95,6 +95,8 @@ json hello_result(const ServerCore& core, const json& params) {
             {"beam_types", {"sphere", "capsule"}},
             {"densities", {"abe", "shell", "linear", "quadratic", "gaussian", "table"}},
             {"occluder_types", {"plane", "box", "sphere", "mesh"}},
+            {"camera_rigs", {"orbit", "cubemap", "stereo"}},
+            {"batch_window_ms", core.config.batch_window_ms},
             {"passes", passes}}},
           {"limits", limits_json(core.config)}};
 }
@@ -158,8 +160,14 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     std::lock_guard lock(st.mu);
     // Costs are per scene content: a new scene (or new render settings) starts
     // a new controller. Inline scenes are keyed by their JSON.
-    const std::string key = (rp.scene_id ? "id:" + *rp.scene_id : "inline:" + scene_json->dump()) +
-                            "|" + (rp.output ? rp.output->dump() : "");
+    const auto text = [](const json& j) {
+      return j.dump(-1, ' ', false, json::error_handler_t::replace);
+    };
+    // A stored scene is keyed by its entry: scene.put/update make a new one.
+    const std::string key = (rp.scene_id ? "id:" + *rp.scene_id + "@" +
+                                               std::to_string(reinterpret_cast<std::uintptr_t>(stored.get()))
+                                         : "inline:" + text(*scene_json)) +
+                            "|" + (rp.output ? text(*rp.output) : "");
     if (!st.controller || st.scene_key != key) {
       ControllerConfig cfg;
       st.controller = std::make_unique<AccuracyController>(make_accuracy_ladder(scene->render), cfg);
@@ -190,12 +198,16 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   job.scene = scene;
   job.cameras = cameras;
   job.client_alive = session->alive_flag();
+  job.atlas = rp.atlas;
   job.arrived = arrived;
   if (decision) {
     job.options.resolution_scale = decision->still ? 1.0 : level.scale;
     job.jpeg = !decision->still && rp.quality->jpeg;
     job.jpeg_quality = level.jpeg_quality;
   }
+  // Only an unmodified stored scene at full quality may share a render with
+  // other requests (a batch renders with one set of options).
+  if (stored && !rp.output && !decision) job.batch_key = stored.get();
   job.done = [&core, session, id, cameras, arrived, base64 = rp.base64,
               passes = plan_passes(*scene), bit_depth = scene->output.bit_depth, decision, level,
               ladder_size, budget_ms, jpeg = job.jpeg, jpeg_quality = job.jpeg_quality](
@@ -242,6 +254,14 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     json frames = json::array();
     std::vector<std::uint8_t> binary;
     double readback_ms = 0.0;
+    auto attach = [&](json& f, const std::vector<std::uint8_t>& png) {
+      if (base64) {
+        f["data_base64"] = base64_encode(png);
+      } else {
+        f["attachment"] = {{"offset", binary.size()}, {"length", png.size()}};
+        binary.insert(binary.end(), png.begin(), png.end());
+      }
+    };
     for (std::size_t i = 0; i < out.frames.size(); ++i) {
       const FrameResult& fr = out.frames[i];
       json pass_ms = json::object();
@@ -250,18 +270,26 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
                 {"index", i},
                 {"width", cameras[i].width},
                 {"height", cameras[i].height},
-                {"format", out.is_jpeg[i] ? "jpeg" : "png"},
+                {"format", !out.atlas && out.is_jpeg[i] ? "jpeg" : "png"},
                 {"bit_depth", bit_depth},
                 {"gpu_ms", fr.gpu_ms},
                 {"pass_ms", pass_ms},
                 {"readback_ms", fr.readback_ms},
-                {"encode_ms", out.encode_ms[i]}};
+                {"gpu_batch",
+                 {{"index", fr.batch.index},
+                  {"views", fr.batch.views},
+                  {"gpu_ms", fr.batch.gpu_ms},
+                  {"readback_ms", fr.batch.readback_ms}}}};
       readback_ms += fr.readback_ms;
-      if (base64) {
-        f["data_base64"] = base64_encode(out.pngs[i]);
+      if (out.atlas) {
+        const AtlasTile& t = out.atlas->tiles[i];
+        f["x"] = t.x;
+        f["y"] = t.y;
       } else {
-        f["attachment"] = {{"offset", binary.size()}, {"length", out.pngs[i].size()}};
-        binary.insert(binary.end(), out.pngs[i].begin(), out.pngs[i].end());
+        f["format"] = "png";
+        f["bit_depth"] = bit_depth;
+        f["encode_ms"] = out.encode_ms[i];
+        attach(f, out.pngs[i]);
       }
       frames.push_back(std::move(f));
     }
@@ -270,7 +298,28 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
       frame_passes.clear();
       for (const PassTiming& p : out.frames[0].passes) frame_passes.push_back(p.name);
     }
+    if (out.atlas) {
+      // One image; the frames become its tiles.
+      const Atlas& a = *out.atlas;
+      json f = {{"camera", "atlas"},
+                {"index", 0},
+                {"width", a.columns * a.cell_width},
+                {"height", a.rows * a.cell_height},
+                {"format", out.is_jpeg[0] ? "jpeg" : "png"},
+                {"bit_depth", bit_depth},
+                {"encode_ms", out.encode_ms[0]},
+                {"atlas",
+                 {{"columns", a.columns},
+                  {"rows", a.rows},
+                  {"cell_width", a.cell_width},
+                  {"cell_height", a.cell_height},
+                  {"tiles", std::move(frames)}}}};
+      attach(f, out.pngs[0]);
+      frames = json::array({std::move(f)});
+    }
     json result = {{"passes", frame_passes},
+                   {"batched", out.batched_requests > 1},
+                   {"batch", {{"requests", out.batched_requests}, {"views", out.batched_views}}},
                    {"frames", std::move(frames)},
                    {"timings",
                     {{"queue_ms", out.queue_ms},

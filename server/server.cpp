@@ -40,6 +40,8 @@ unsigned short Server::start() {
   core_.renders = std::make_unique<RenderService>(factory_, c.render_workers, c.encode_threads,
                                                   c.png_level, c.png_filters,
                                                   c.max_inflight_total);
+  core_.renders->set_batch_window(std::chrono::milliseconds(c.batch_window_ms),
+                                  c.scene_limits.max_cameras);
   core_.renderer_description = core_.renders->wait_ready();
   const tcp::endpoint ep(asio::ip::make_address(c.bind), c.port);
   acceptor_.open(ep.protocol());

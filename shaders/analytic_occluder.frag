@@ -8,18 +8,20 @@ struct AnalyticOccluder {
   vec4 albedo;  // rgb
 };
 layout(std430, binding = 2) readonly buffer Analytic { AnalyticOccluder occ[]; };
-uniform int u_count;
+uniform int u_count;  // per view; view v's occluders start at v * u_count
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_view_depth;
 
 void main() {
+  select_view(view_index());
+  int first = view_index() * u_count;
   ViewRay ray = view_ray(gl_FragCoord.xy);
   float best = ray.t_max;
   int hit = -1;
   vec3 normal = vec3(0.0);
   for (int i = 0; i < u_count; ++i) {
-    AnalyticOccluder o = occ[i];
+    AnalyticOccluder o = occ[first + i];
     if (o.b.w < 0.5) {
       float denom = dot(o.b.xyz, ray.dir);
       if (denom == 0.0) continue;
@@ -45,7 +47,7 @@ void main() {
     }
   }
   if (hit < 0) discard;
-  out_color = vec4(lambert(occ[hit].albedo.rgb, normal, ray.dir), 0.0);
+  out_color = vec4(lambert(occ[first + hit].albedo.rgb, normal, ray.dir), 0.0);
   float z = best * ray.cos_axis;
   out_view_depth = z;
   gl_FragDepth = window_depth(z);

@@ -11,9 +11,9 @@
 //   d = |(o - A).c^|, s(t) = (sin(theta) t + ((w x (o - A)).c^)) / r + 1,
 //   E = [g(d/r, s(t1)) - g(d/r, s(t0))] / sin(theta)
 // (docs/beam-math.md derives both; the paper's eq 2.8/2.9 are wrong).
-// Where the s-interval is under about a texel (rays near-parallel to the axis)
-// the difference divided by sin(theta) amplifies interpolation error, so a
-// 3-point Gauss rule on f takes over, blended smoothly.
+// Where the s-interval is short (rays near-parallel to the axis) the difference
+// divided by sin(theta) amplifies interpolation error, so a composite Gauss
+// rule on f takes over, blended smoothly (docs/stability.md).
 
 struct BeamData {
   vec4 p0_radius;
@@ -24,7 +24,7 @@ struct BeamData {
 };
 layout(std430, binding = 1) readonly buffer Beams { BeamData beams[]; };
 
-layout(binding = 2) uniform sampler2D u_view_depth;  // surfaces' view depth (huge: none)
+layout(binding = 2) uniform VIEW_SAMPLER u_view_depth;  // surfaces' view depth (huge: none)
 uniform int u_has_surfaces;
 
 flat in int v_beam;
@@ -90,7 +90,11 @@ float cylinder_energy(vec3 o, vec3 v, vec3 a, vec3 w, float r, float t0, float t
   float dt = t1 - t0;
   float ds = sin_t * dt / r;
   float threshold = parallel_threshold();
-  float alpha = smoothstep(0.5 * threshold, threshold, ds);
+  // u_near_parallel == 0: the paper's form at every angle; it divides by
+  // sin(theta) = 0 for an exactly parallel ray, which contributes nothing.
+  float alpha = u_near_parallel == 0 ? (sin_t > 0.0 ? 1.0 : 0.0)
+                                     : smoothstep(0.5 * threshold, threshold, ds);
+  if (u_near_parallel == 0 && alpha == 0.0) return 0.0;
   float e = 0.0;
   if (alpha > 0.0) {
     vec3 ch = c / sin_t;
@@ -103,21 +107,37 @@ float cylinder_energy(vec3 o, vec3 v, vec3 a, vec3 w, float r, float t0, float t
     }
   }
   if (alpha < 1.0) {
-    // Composite Gauss-Legendre, 3 nodes per panel, panels no wider than 0.02
-    // in s (a fraction of the thin shell's width), at most 16; rho measured
-    // directly to the axis, f exact for built-in densities.
-    const float xk[3] = float[3](-0.7745966692414834, 0.0, 0.7745966692414834);
-    const float wk[3] = float[3](0.5555555555555556, 0.8888888888888888, 0.5555555555555556);
-    int panels = clamp(int(ceil(ds / 0.02)), 1, 16);
-    float h = dt / float(panels);
-    float sum = 0.0;
-    for (int p = 0; p < panels; ++p) {
-      for (int k = 0; k < 3; ++k) {
-        float t = t0 + h * (float(p) + 0.5 * (1.0 + xk[k]));
-        sum += wk[k] * f_eval(piece_distance(true, m, v, w, t) / r);
-      }
+    // Only the part of [t0, t1] inside the cylinder (rho < 1): a density cut
+    // at x = 1 (gaussian, user tables) jumps to 0 there, which a Gauss panel
+    // straddling the crossing would smear over the whole panel. The chord from
+    // d is trustworthy once sin(theta) >= 1e-4 (c = w x v known to ~1e-3
+    // relative); below that rho changes by under 1e-4 per radius of path.
+    float ga = t0, gb = t1;
+    if (sin_t >= 1e-4) {
+      vec3 ch = c / sin_t;
+      float d = abs(dot(m, ch)) / r;
+      float tc = -dot(cross(w, m), ch) / sin_t;
+      float half_len = r * sqrt(max((1.0 - d) * (1.0 + d), 0.0)) / sin_t;
+      ga = max(t0, tc - half_len);
+      gb = min(t1, tc + half_len);
     }
-    e += (1.0 - alpha) * 0.5 * h / r * sum;
+    if (gb > ga) {
+      // Composite Gauss-Legendre, 3 nodes per panel, panels no wider than
+      // 0.02 in s (a fraction of the thin shell's width), at most 16; rho
+      // measured directly to the axis, f exact for built-in densities.
+      const float xk[3] = float[3](-0.7745966692414834, 0.0, 0.7745966692414834);
+      const float wk[3] = float[3](0.5555555555555556, 0.8888888888888888, 0.5555555555555556);
+      int panels = clamp(int(ceil(sin_t * (gb - ga) / r / 0.02)), 1, 16);
+      float h = (gb - ga) / float(panels);
+      float sum = 0.0;
+      for (int p = 0; p < panels; ++p) {
+        for (int k = 0; k < 3; ++k) {
+          float t = ga + h * (float(p) + 0.5 * (1.0 + xk[k]));
+          sum += wk[k] * f_eval(piece_distance(true, m, v, w, t) / r);
+        }
+      }
+      e += (1.0 - alpha) * 0.5 * h / r * sum;
+    }
   }
   return e;
 }
@@ -140,6 +160,7 @@ void clip_plane(float u0, float du, float bound, bool above, inout float t0, ino
 }
 
 void main() {
+  select_view(view_index());
   BeamData b = beams[v_beam];
   g_layer = b.color_layer.w;
   g_kind = int(b.density.x);
@@ -148,7 +169,7 @@ void main() {
   float t0 = ray.t_min;
   float t1 = ray.t_max;
   if (u_has_surfaces != 0) {
-    float z = texelFetch(u_view_depth, ivec2(gl_FragCoord.xy), 0).r;
+    float z = VIEW_TEXEL(u_view_depth, ivec2(gl_FragCoord.xy)).r;
     t1 = min(t1, z / ray.cos_axis);
   }
   float r = b.p0_radius.w;

@@ -13,6 +13,9 @@ struct BeamData {
 layout(std430, binding = 1) readonly buffer Beams { BeamData beams[]; };
 
 flat out int v_beam;
+#ifdef BEAMCAST_MULTIVIEW
+uniform int u_view_beams;  // beams per view: instance = view * u_view_beams + beam
+#endif
 
 // Cube corners (bit 0: x, bit 1: y, bit 2: z) of 12 triangles, counter-clockwise
 // seen from outside.
@@ -20,6 +23,11 @@ const int kCubeIndex[36] = int[36](4, 6, 2, 4, 2, 0, 1, 3, 7, 1, 7, 5, 0, 1, 5, 
                                    6, 7, 3, 6, 3, 2, 2, 3, 1, 2, 1, 0, 4, 5, 7, 4, 7, 6);
 
 void main() {
+#ifdef BEAMCAST_MULTIVIEW
+  int view = gl_InstanceID / u_view_beams;
+  select_view(view);
+  gl_Layer = view;
+#endif
   BeamData b = beams[gl_InstanceID];
   int ci = kCubeIndex[gl_VertexID];
   vec3 c = vec3((ci & 1) != 0 ? 1.0 : -1.0, (ci & 2) != 0 ? 1.0 : -1.0, (ci & 4) != 0 ? 1.0 : -1.0);

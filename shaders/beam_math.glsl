@@ -14,6 +14,7 @@ uniform int u_warped;        // table rows placed by W(d)
 uniform int u_shader_filter; // bilinear weights in the shader instead of the texture unit
 uniform int u_samples;       // march: sub-intervals per piece
 uniform int u_simpson;       // march: Simpson's rule instead of the midpoint rule
+uniform int u_near_parallel; // 0: the paper's form at every angle (comparison only)
 
 // The density of the beam being shaded (set once per fragment).
 float g_layer;

@@ -2,6 +2,26 @@
 // All positions are camera-relative (the CPU subtracts the eye in double), so
 // far-away scenes keep float precision near the camera.
 
+#ifdef BEAMCAST_MULTIVIEW
+// Multi-view: one camera per view (layer), same layout as CameraBlock below;
+// stages copy their view's entry into `cam` first (select_view).
+struct CameraData {
+  mat4 view_proj;    // camera-relative world -> clip, reversed Z (near -> 1, far -> 0)
+  vec4 cam_right;    // xyz; w: tan(fov_y / 2) (perspective) or half height (orthographic)
+  vec4 cam_up;       // xyz; w: aspect = width / height
+  vec4 cam_forward;  // xyz; w: 1 for orthographic, 0 for perspective
+  vec4 viewport;     // x: width, y: height, z: near, w: far (view depth)
+  vec4 light_dir;    // xyz: unit vector towards the light; w: ambient
+  vec4 light_color;  // rgb: light color; w: intensity
+  vec4 mesh_offset;  // xyz: mesh anchor minus eye (triangles are stored anchor-relative)
+};
+layout(std430, binding = 4) readonly buffer Cameras { CameraData cams[]; };
+CameraData cam;
+void select_view(int view) { cam = cams[view]; }
+int view_index() { return gl_Layer; }  // fragment stages
+#define VIEW_SAMPLER sampler2DArray
+#define VIEW_TEXEL(s, p) texelFetch(s, ivec3(p, gl_Layer), 0)
+#else
 layout(std140, binding = 0) uniform CameraBlock {
   mat4 view_proj;    // camera-relative world -> clip, reversed Z (near -> 1, far -> 0)
   vec4 cam_right;    // xyz; w: tan(fov_y / 2) (perspective) or half height (orthographic)
@@ -12,6 +32,11 @@ layout(std140, binding = 0) uniform CameraBlock {
   vec4 light_color;  // rgb: light color; w: intensity
   vec4 mesh_offset;  // xyz: mesh anchor minus eye (triangles are stored anchor-relative)
 } cam;
+void select_view(int view) {}
+int view_index() { return 0; }
+#define VIEW_SAMPLER sampler2D
+#define VIEW_TEXEL(s, p) texelFetch(s, p, 0)
+#endif
 
 struct ViewRay {
   vec3 origin;

@@ -6,6 +6,7 @@ layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_view_depth;
 
 void main() {
+  select_view(view_index());
   vec3 view_dir = is_orthographic() ? cam.cam_forward.xyz : normalize(v_position);
   out_color = vec4(lambert(v_albedo, normalize(v_normal), view_dir), 0.0);
   out_view_depth = dot(v_position, cam.cam_forward.xyz);

@@ -8,6 +8,10 @@ out vec3 v_normal;
 out vec3 v_albedo;
 
 void main() {
+#ifdef BEAMCAST_MULTIVIEW
+  select_view(gl_InstanceID);  // one instance per view
+  gl_Layer = gl_InstanceID;
+#endif
   v_position = a_position + cam.mesh_offset.xyz;
   v_normal = a_normal;
   v_albedo = a_albedo;

@@ -28,4 +28,23 @@ struct RemoteRenderArgs {
 };
 int run_remote_render(const RemoteRenderArgs& args);
 
+// `beamcast render --rig SPEC` or `--path FILE`: numbered PNGs (frame_0000.png
+// ...) of a rig or a keyframed camera path, locally or with --server.
+struct SequenceArgs {
+  std::string scene;
+  std::string out = ".";
+  std::string assets;
+  std::string rig;   // orbit:K, cubemap[:SIZE], stereo[:SEPARATION]
+  std::string path;  // camera path JSON (protocol/camera_path.hpp)
+  int frames = 0;    // path frames (0: the file's, else one per keyframe)
+  int batch = 12;    // views per render call (local) or request (server)
+  bool json = false;
+  int device = -1;
+  std::string platform = "auto";
+  std::string server;
+  std::string encoding = "binary";
+  double timeout_s = 120;
+};
+int run_sequence(const SequenceArgs& args);
+
 }  // namespace beamcast::cli

@@ -135,6 +135,7 @@ int run_render(const RenderArgs& args) {
 void add_render_command(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   auto remote = std::make_shared<RemoteRenderArgs>();
+  auto seq = std::make_shared<SequenceArgs>();
   CLI::App* cmd = app.add_subcommand(
       "render", "Render a scene to one PNG per camera, offline or on a beamcast-server");
   CLI::Option* scene =
@@ -172,13 +173,48 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--timeout", remote->timeout_s, "With --server: seconds to wait for the frames")
       ->check(CLI::PositiveNumber)
       ->needs(server);
+  // Frame sequences: numbered PNGs of a rig or a camera path.
+  CLI::Option* rig = cmd->add_option(
+      "--rig", seq->rig,
+      "Render a rig framed by the scene's first camera instead of its cameras, to "
+      "frame_0000.png ...: orbit:COUNT (around the beams' centre, starting at the first "
+      "camera), cubemap[:SIZE], stereo[:SEPARATION]");
+  CLI::Option* path = cmd->add_option("--path", seq->path,
+                                      "Render a camera path (keyframes JSON, "
+                                      "protocol/camera_path.hpp) to frame_0000.png ...")
+                          ->check(CLI::ExistingFile)
+                          ->excludes(rig);
+  cmd->add_option("--frames", seq->frames, "With --path: frames to render (default: the file's)")
+      ->check(CLI::Range(1, 100000))
+      ->needs(path);
+  CLI::Option* batch =
+      cmd->add_option("--batch", seq->batch,
+                      "With --rig or --path: views per render call or request (default 12)")
+          ->check(CLI::Range(1, 256));
+  for (CLI::Option* o : {rig, path}) o->excludes(reference);
   // Options of the local renderer mean nothing to a server render.
   for (CLI::Option* local : {assets, reference, hdr, device, platform, threads})
     server->excludes(local);
 
-  cmd->callback([args, remote] {
+  cmd->callback([args, remote, seq, batch] {
     int rc = 0;
-    if (!remote->server.empty()) {
+    if (!seq->rig.empty() || !seq->path.empty()) {
+      if (args->scene.empty()) {
+        throw CLI::ValidationError("--rig and --path need a scene file (they frame its camera)");
+      }
+      seq->scene = args->scene;
+      seq->out = args->out;
+      seq->assets = args->assets;
+      seq->json = args->json;
+      seq->device = args->device;
+      seq->platform = args->platform;
+      seq->server = remote->server;
+      seq->encoding = remote->encoding;
+      seq->timeout_s = remote->timeout_s;
+      rc = run_sequence(*seq);
+    } else if (batch->count() > 0) {
+      throw CLI::ValidationError("--batch applies to --rig and --path only");
+    } else if (!remote->server.empty()) {
       if (args->scene.empty() && remote->scene_id.empty()) {
         throw CLI::ValidationError("render --server needs a scene file or --scene-id");
       }

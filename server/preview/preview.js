@@ -3,13 +3,15 @@
 // "WebSocket"). Plain JS, no build step; served and embedded by beamcast-server.
 //
 // URL parameters: scene (stored id, or an example file name), size (canvas
-// pixels, default 512), budget (frame-time budget in ms, default 33),
-// inflight (requests kept in flight, default 2).
+// pixels, default 512), budget (frame-time budget in ms, default 33), still
+// (ms of rest before the full-accuracy frame, default 300), inflight (requests
+// kept in flight, default 2).
 'use strict';
 
 const params = new URLSearchParams(location.search);
 const size = Math.max(16, Math.min(2048, parseInt(params.get('size') || '512', 10)));
 const budgetMs = parseFloat(params.get('budget') || '33');
+const stillMs = parseFloat(params.get('still') || '300');
 const maxInflight = Math.max(1, parseInt(params.get('inflight') || '2', 10));
 
 const canvas = document.getElementById('canvas');
@@ -38,6 +40,7 @@ let awaitingBinary = null;  // a response whose attachments come in the next bin
 let orbit = null;           // {target, yaw, pitch, dist, up, fov, near, far, projection, ortho}
 let lastSentKey = null;
 let lastSentAt = 0;
+let lastChangeAt = 0;       // when the pose last changed
 let stillKey = null;        // pose of the latest still frame
 let inflight = 0;
 let drawing = Promise.resolve();
@@ -144,7 +147,11 @@ canvas.addEventListener('pointerdown', (e) => {
   if (!orbit) return;
   drag = {x: e.clientX, y: e.clientY, pan: e.shiftKey || e.button === 2};
   canvas.classList.add('dragging');
-  canvas.setPointerCapture(e.pointerId);
+  try {
+    canvas.setPointerCapture(e.pointerId);
+  } catch {
+    // Synthetic pointers (scripts, tests) may have no capturable id.
+  }
 });
 canvas.addEventListener('pointermove', (e) => {
   if (!drag || !orbit) return;
@@ -162,6 +169,7 @@ canvas.addEventListener('pointermove', (e) => {
     orbit.yaw -= dx * 0.01;
     orbit.pitch = Math.max(-1.55, Math.min(1.55, orbit.pitch + dy * 0.01));
   }
+  maybeSend();
 });
 const endDrag = () => { drag = null; canvas.classList.remove('dragging'); };
 canvas.addEventListener('pointerup', endDrag);
@@ -170,12 +178,14 @@ canvas.addEventListener('wheel', (e) => {
   if (!orbit) return;
   e.preventDefault();
   orbit.dist *= Math.exp(e.deltaY * 0.001);
+  maybeSend();
 }, {passive: false});
 
 // --- frames -----------------------------------------------------------------
 
 function renderRequest(camera) {
-  return {scene_id: preview.sceneId, cameras: [camera], quality: 'auto', budget_ms: budgetMs};
+  return {scene_id: preview.sceneId, cameras: [camera], quality: 'auto', budget_ms: budgetMs,
+          still_ms: stillMs};
 }
 
 async function show(res, camera) {
@@ -197,6 +207,8 @@ async function show(res, camera) {
   if (q.still) {
     preview.lastStill = {camera, bytes: data.slice()};
     stillKey = JSON.stringify(camera);
+  } else {
+    stillKey = null;  // the canvas shows an interactive frame again
   }
   updateOverlay();
 }
@@ -220,15 +232,27 @@ function updateOverlay() {
 
 function tick() {
   requestAnimationFrame(tick);
+  maybeSend();
+}
+
+// Sends the next render request if the pose changed (or the still frame is
+// due) and fewer than `maxInflight` are in flight. Called every animation
+// frame, on every pointer move and when a response is in.
+function maybeSend() {
   if (!orbit || !preview.sceneId || ws.readyState !== WebSocket.OPEN) return;
   if (inflight >= maxInflight) return;
   const camera = cameraFromOrbit(orbit);
   const key = JSON.stringify(camera);
   const now = performance.now();
   if (key === lastSentKey) {
-    // Camera at rest: ask again (the server decides when the camera has been
-    // still long enough for the full-accuracy frame), until that frame is in.
-    if (key === stillKey || now - lastSentAt < 30) return;
+    // Camera at rest: once it has been still for still_ms, ask for the frame
+    // again; the server (which times the motion itself) answers with the
+    // full-accuracy frame, or with "settling" if it is early, and then we
+    // retry shortly. Nothing is sent while a button is held on a resting camera.
+    if (drag || key === stillKey || inflight > 0) return;
+    if (now - lastChangeAt < stillMs || now - lastSentAt < 40) return;
+  } else {
+    lastChangeAt = now;
   }
   lastSentKey = key;
   lastSentAt = now;
@@ -238,7 +262,7 @@ function tick() {
   // Draw in arrival order, one at a time.
   drawing = drawing.then(() => req).then((res) => show(res, camera))
       .catch((e) => setStatus(`render: ${e.code || ''} ${e.message || e}`, true))
-      .finally(() => { --inflight; });
+      .finally(() => { --inflight; maybeSend(); });
 }
 
 async function selectScene(value) {

@@ -4,12 +4,12 @@
 # is not there yet, then drives Debian's /usr/bin/chromium.
 # Missing node, npm or chromium is a failure, not a skip.
 set -euo pipefail
-cd "$(dirname "$0")"
+here="$(cd "$(dirname "$0")" && pwd)"
 for tool in node npm; do
   command -v "$tool" >/dev/null || { echo "FAIL: $tool is missing (scripts/install-deps.sh)" >&2; exit 1; }
 done
-if [ ! -f node_modules/playwright-core/package.json ]; then
+if [ ! -f "$here/node_modules/playwright-core/package.json" ]; then
   # PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD: playwright-core downloads nothing, but be explicit.
-  PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error
+  (cd "$here" && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error)
 fi
-exec node preview_test.mjs "$@"
+exec node "$here/preview_test.mjs" "$@"

@@ -439,3 +439,127 @@ TEST(Server, EightConcurrentClientsRenderWithoutErrors) {
 
 }  // namespace
 }  // namespace beamcast
+
+namespace beamcast {
+namespace {
+
+// Cross-connection batching: three viewers of one stored scene whose requests
+// arrive within the window share one multi-view render; each gets its own
+// frame (pixel-identical to rendering it alone) and is told it was batched.
+TEST(Server, BatchWindowMergesViewersOfOneStoredScene) {
+  ServerConfig cfg;
+  // Long enough that three requests sent back to back land in it even on a
+  // loaded 2-core machine (they arrive within a few ms normally).
+  cfg.batch_window_ms = 1500;
+  TestServer s(cfg);
+  Conn setup(s.port());
+  ASSERT_TRUE(setup.call({{"id", 1}, {"method", "scene.put"},
+                          {"params", {{"scene_id", "shared"}, {"scene", small_scene(48)}}}})
+                  .json["ok"]);
+  const json poses = {{{"position", {0, 1, 5}}, {"target", {0, 0, 0}}, {"width", 48}, {"height", 48}},
+                      {{"position", {4, 1, 3}}, {"target", {0, 0, 0}}, {"width", 48}, {"height", 48}},
+                      {{"position", {-3, 2, 4}}, {"target", {0, 0, 0}}, {"width", 48}, {"height", 48}}};
+  std::vector<std::unique_ptr<Conn>> viewers;
+  for (int i = 0; i < 3; ++i) viewers.push_back(std::make_unique<Conn>(s.port()));
+  for (int i = 0; i < 3; ++i) {
+    viewers[i]->send({{"id", i},
+                      {"method", "render"},
+                      {"params", {{"scene_id", "shared"}, {"cameras", {poses[i]}}}}});
+  }
+  Renderer offline;
+  Scene scene = parse_scene(small_scene(48), SceneLoadOptions{});
+  for (int i = 0; i < 3; ++i) {
+    const Reply r = viewers[i]->recv();
+    ASSERT_TRUE(r.json["ok"]) << r.json;
+    EXPECT_EQ(r.json["id"], i);
+    const json& res = r.json["result"];
+    EXPECT_EQ(res["batched"], true);
+    EXPECT_EQ(res["batch"]["requests"], 3);
+    EXPECT_EQ(res["batch"]["views"], 3);
+    ASSERT_EQ(res["frames"].size(), 1u);
+    EXPECT_EQ(res["frames"][0]["gpu_batch"]["views"], 3);  // one multi-view pass
+    scene.cameras = {parse_camera(poses[i], "", SceneLimits{})};
+    const auto alone = offline.render(scene);
+    EXPECT_EQ(compare_levels(frame_png(r, 0), alone[0].image).max_abs, 0) << "viewer " << i;
+  }
+  // An inline scene is never merged, and says so.
+  const Reply r = setup.call(render_req(9, small_scene(32)));
+  ASSERT_TRUE(r.json["ok"]) << r.json;
+  EXPECT_EQ(r.json["result"]["batched"], false);
+  EXPECT_EQ(r.json["result"]["batch"]["requests"], 1);
+}
+
+TEST(Server, WithoutBatchWindowRequestsRenderAlone) {
+  TestServer s;  // default: window 0
+  Conn a(s.port()), b(s.port());
+  ASSERT_TRUE(a.call({{"id", 1}, {"method", "scene.put"},
+                      {"params", {{"scene_id", "shared"}, {"scene", small_scene(32)}}}})
+                  .json["ok"]);
+  const json req = {{"method", "render"}, {"params", {{"scene_id", "shared"}}}};
+  json ra = req, rb = req;
+  ra["id"] = 1;
+  rb["id"] = 2;
+  a.send(ra);
+  b.send(rb);
+  for (Conn* c : {&a, &b}) {
+    const Reply r = c->recv();
+    ASSERT_TRUE(r.json["ok"]) << r.json;
+    EXPECT_EQ(r.json["result"]["batched"], false);
+  }
+}
+
+}  // namespace
+}  // namespace beamcast
+
+namespace beamcast {
+namespace {
+
+// "atlas": true returns one PNG whose tiles are the frames of a plain render,
+// at the documented grid positions.
+TEST(Server, AtlasTilesEveryFrameInTheDocumentedGrid) {
+  TestServer s;
+  Conn c(s.port());
+  json req = render_req(1, small_scene(24));
+  req["params"]["cameras"] = {{{"rig", "orbit"}, {"count", 5}, {"width", 24}, {"height", 16}}};
+  const Reply plain = c.call(req);
+  ASSERT_TRUE(plain.json["ok"]) << plain.json;
+  req["id"] = 2;
+  req["params"]["atlas"] = true;
+  const Reply r = c.call(req);
+  ASSERT_TRUE(r.json["ok"]) << r.json;
+  ASSERT_EQ(r.json["result"]["frames"].size(), 1u);
+  const json& f = r.json["result"]["frames"][0];
+  EXPECT_EQ(f["camera"], "atlas");
+  EXPECT_EQ(f["atlas"]["columns"], 3);  // ceil(sqrt(5))
+  EXPECT_EQ(f["atlas"]["rows"], 2);
+  const Image atlas = frame_png(r, 0);
+  ASSERT_EQ(atlas.width, 3 * 24);
+  ASSERT_EQ(atlas.height, 2 * 16);
+  const json& tiles = f["atlas"]["tiles"];
+  ASSERT_EQ(tiles.size(), 5u);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(tiles[i]["x"], (i % 3) * 24);
+    EXPECT_EQ(tiles[i]["y"], (i / 3) * 16);
+    EXPECT_EQ(tiles[i]["camera"], plain.json["result"]["frames"][i]["camera"]);
+    const Image one = frame_png(plain, i);
+    int differ = 0;
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 24 * 3; ++x)
+        differ += one.rgb[y * 24 * 3 + x] !=
+                  atlas.rgb[(tiles[i]["y"].get<int>() + y) * atlas.width * 3 +
+                            tiles[i]["x"].get<int>() * 3 + x];
+    EXPECT_EQ(differ, 0) << "tile " << i;
+  }
+  // The unused sixth cell is black.
+  for (int y = 16; y < 32; ++y)
+    for (int x = 48 * 3; x < 72 * 3; ++x) ASSERT_EQ(atlas.rgb[y * atlas.width * 3 + x], 0);
+  // A bad flag is refused with its path.
+  req["id"] = 3;
+  req["params"]["atlas"] = "yes";
+  const Reply bad = c.call(req);
+  EXPECT_EQ(error_code(bad), "wrong_type");
+  EXPECT_EQ(error_path(bad), "/params/atlas");
+}
+
+}  // namespace
+}  // namespace beamcast

@@ -181,6 +181,23 @@ TEST(AccuracyController, UnmeasuredLevelsArePredictedFromPixelCount) {
   EXPECT_DOUBLE_EQ(*c.estimate(last, 1.0), 9.0);
 }
 
+TEST(AccuracyController, PredictionLearnsTheFixedCostFromTwoScales) {
+  AccuracyController c(make_accuracy_ladder({}), {});
+  const int last = static_cast<int>(c.ladder().size()) - 1;  // scale 1/4
+  c.observe(0, 80.0, 0.0);
+  c.observe(last, 9.5, 1.0);
+  // per pixel (80 - 9.5) / (1 - 1/16) = 75.2, fixed 80 - 75.2 = 4.8: the
+  // 1/2 level is 4.8 + 75.2 / 4 = 23.6 ms, not the 20 ms of pure scaling.
+  int half = -1;
+  for (int l = 0; l <= last; ++l) {
+    if (c.ladder()[l].scale == 0.5) half = l;
+  }
+  ASSERT_GE(half, 0);
+  EXPECT_NEAR(*c.estimate(half, 1.0), 23.6, 1e-9);
+  // A measurement older than stale_ms is not used for the fit.
+  EXPECT_NEAR(*c.estimate(half, 1.0 + c.config().stale_ms + 1.0), 9.5 * 4.0, 1e-9);
+}
+
 TEST(AccuracyController, EwmaFollowsTheMeasurements) {
   ControllerConfig cfg;
   cfg.ewma_alpha = 0.5;

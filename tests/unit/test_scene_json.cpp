@@ -193,6 +193,14 @@ TEST(SceneJson, ScalarTableSizeSetsBothAxes) {
   EXPECT_EQ(s.render.table_s, 32);
 }
 
+TEST(SceneJson, NearParallelRule) {
+  EXPECT_EQ(parse_scene(minimal(), {}).render.near_parallel, NearParallel::kQuadrature);
+  const Scene s = parse_scene(with(minimal(), "/render", {{"near_parallel", "none"}}), {});
+  EXPECT_EQ(s.render.near_parallel, NearParallel::kNone);
+  EXPECT_REJECTED(with(minimal(), "/render", {{"near_parallel", "midpoint"}}), SceneLoadOptions{},
+                  "invalid_value", "/render/near_parallel");
+}
+
 TEST(SceneJson, IntegralFloatAcceptedAsInteger) {
   const Scene s = parse_scene(with(minimal(), "/cameras/0/width", 320.0), {});
   EXPECT_EQ(s.cameras[0].width, 320);

@@ -29,6 +29,14 @@ const std::vector<Stage> kStages = {
     {{"common.glsl", "beam.vert"}, "vert"},
     {{"common.glsl", "beam_math.glsl", "beam.frag"}, "frag"},
     {{"common.glsl", "tonemap.frag"}, "frag"},
+    // Multi-view variants (one draw, K layers).
+    {{"multiview_vertex.glsl", "common.glsl", "surface.vert"}, "vert"},
+    {{"multiview.glsl", "common.glsl", "surface.frag"}, "frag"},
+    {{"multiview_vertex.glsl", "common.glsl", "fullscreen.vert"}, "vert"},
+    {{"multiview.glsl", "common.glsl", "analytic_occluder.frag"}, "frag"},
+    {{"multiview_vertex.glsl", "common.glsl", "beam.vert"}, "vert"},
+    {{"multiview.glsl", "common.glsl", "beam_math.glsl", "beam.frag"}, "frag"},
+    {{"multiview.glsl", "common.glsl", "tonemap.frag"}, "frag"},
 };
 
 TEST(Shaders, EveryStageCompilesWithGlslangValidator) {
@@ -38,7 +46,8 @@ TEST(Shaders, EveryStageCompilesWithGlslangValidator) {
   const auto dir = std::filesystem::temp_directory_path() / "beamcast_shader_check";
   std::filesystem::create_directories(dir);
   for (const Stage& stage : kStages) {
-    const std::string name = std::string(stage.parts.back()) + "." + stage.extension;
+    const std::string name = std::string(stage.parts.front()) + "_" +
+                             std::string(stage.parts.back()) + "." + stage.extension;
     const auto file = dir / name;
     std::ofstream(file) << assemble_shader(stage.parts);
     const std::string cmd = validator + " " + file.string() + " > " + file.string() + ".log 2>&1";

@@ -14,7 +14,7 @@ namespace beamcast {
 namespace {
 
 TEST(Utf8, ValidInputIsUnchanged) {
-  for (const std::string& s : std::vector<std::string>{"", "abc", "\xC3\xA9t\xC3\xA9", "\xE2\x82\xAC", "\xF0\x9F\x98\x80",
+  for (const std::string& s : std::initializer_list<std::string>{"", "abc", "\xC3\xA9t\xC3\xA9", "\xE2\x82\xAC", "\xF0\x9F\x98\x80",
                               "\xF4\x8F\xBF\xBF", std::string("nul\0byte", 8)}) {
     EXPECT_TRUE(is_valid_utf8(s)) << s;
     EXPECT_EQ(to_valid_utf8(s), s);

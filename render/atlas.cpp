@@ -1,0 +1,41 @@
+#include "render/atlas.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace beamcast {
+
+Atlas make_atlas(const std::vector<const Image*>& frames) {
+  if (frames.empty()) throw std::invalid_argument("make_atlas: no frames");
+  Atlas a;
+  const int k = static_cast<int>(frames.size());
+  a.columns = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(k))));
+  a.rows = (k + a.columns - 1) / a.columns;
+  for (const Image* f : frames) {
+    if (f->bit_depth != frames[0]->bit_depth) {
+      throw std::invalid_argument("make_atlas: frames of different bit depths");
+    }
+    a.cell_width = std::max(a.cell_width, f->width);
+    a.cell_height = std::max(a.cell_height, f->height);
+  }
+  Image& img = a.image;
+  img.width = a.columns * a.cell_width;
+  img.height = a.rows * a.cell_height;
+  img.bit_depth = frames[0]->bit_depth;
+  img.rgb.assign(3 * static_cast<std::size_t>(img.width) * img.height, 0);
+  for (int i = 0; i < k; ++i) {
+    const Image& f = *frames[i];
+    AtlasTile t{(i % a.columns) * a.cell_width, (i / a.columns) * a.cell_height, f.width,
+                f.height};
+    for (int y = 0; y < f.height; ++y) {
+      const auto src = f.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(y) * f.width;
+      std::copy(src, src + 3 * f.width,
+                img.rgb.begin() + 3 * (static_cast<std::ptrdiff_t>(t.y + y) * img.width + t.x));
+    }
+    a.tiles.push_back(t);
+  }
+  return a;
+}
+
+}  // namespace beamcast

@@ -1,0 +1,67 @@
+#!/usr/bin/python3
+"""`beamcast bench views --quick` end to end: test_views_bench.py BEAMCAST.
+
+Runs the quick benchmark (it starts beamcast-server beside BEAMCAST) into a
+temporary directory and checks its outputs: the CSV header, one row per
+(K, mode) for K = 1, 2, 4, positive times, GPU time that grows with K (more
+views, more pixels), the Markdown table and the plot. No timing targets: those
+live in docs/performance.md. Plain python3; exit status 0 only if all passed.
+"""
+import csv
+import os
+import subprocess
+import sys
+import tempfile
+
+HEADER = "k,mode,round,e2e_ms,render_ms,gpu_ms,readback_ms,encode_ms"
+MODES = {"one_request", "k_requests", "renderer_batched", "renderer_single"}
+
+passed = 0
+failed = 0
+
+
+def check(name, ok, detail=""):
+    global passed, failed
+    if ok:
+        passed += 1
+        print(f"ok   {name}")
+    else:
+        failed += 1
+        print(f"FAIL {name}{': ' + detail if detail else ''}")
+
+
+def main():
+    beamcast = sys.argv[1]
+    with tempfile.TemporaryDirectory() as out:
+        proc = subprocess.run([beamcast, "bench", "views", "--quick", "--out", out],
+                              capture_output=True, text=True, timeout=600)
+        check("exit status 0", proc.returncode == 0, proc.stderr[-2000:])
+        csv_path = os.path.join(out, "views.csv")
+        check("views.csv written", os.path.exists(csv_path))
+        if not os.path.exists(csv_path):
+            return
+        with open(csv_path) as f:
+            header = f.readline().strip()
+        check("CSV header", header == HEADER, header)
+        with open(csv_path, newline="") as f:
+            rows = list(csv.DictReader(f))
+        keys = {(int(r["k"]), r["mode"]) for r in rows}
+        check("a row per (K, mode)", keys == {(k, m) for k in (1, 2, 4) for m in MODES},
+              str(sorted(keys)))
+        check("times positive", all(float(r["e2e_ms"]) > 0 and float(r["gpu_ms"]) > 0
+                                    for r in rows))
+        gpu = {(int(r["k"]), r["mode"]): float(r["gpu_ms"]) for r in rows}
+        # 4 views are 4x the fragments of 1: GPU time must grow (by far more
+        # than run-to-run noise, so "> 1.5x" cannot flake).
+        for mode in ("one_request", "k_requests"):
+            check(f"{mode}: GPU time grows with K", gpu[(4, mode)] > 1.5 * gpu[(1, mode)],
+                  f"{gpu[(1, mode)]} -> {gpu[(4, mode)]}")
+        md = os.path.join(out, "views.md")
+        check("views.md has a row per K",
+              os.path.exists(md) and sum(1 for line in open(md) if line.startswith("| ")) == 4)
+        check("views.png written", os.path.exists(os.path.join(out, "views.png")))
+
+
+main()
+print(f"{passed} passed, {failed} failed")
+sys.exit(1 if failed else 0)
