@@ -32,6 +32,27 @@ bool is_within(const fs::path& root, const fs::path& p) {
   return true;
 }
 
+// tinyobjloader parses "vw" (per-vertex joint weights, its own extension) and
+// converts the joint id with int(float), undefined behaviour for huge values
+// (found by fuzz_obj, docs/fuzzing.md). Occluders use positions and faces only,
+// so those lines are blanked (kept as empty lines: error line numbers stay right).
+std::string without_vertex_weights(const std::string& text) {
+  std::string out = text;
+  std::size_t pos = 0;
+  while (pos < out.size()) {
+    std::size_t eol = out.find('\n', pos);
+    if (eol == std::string::npos) eol = out.size();
+    std::size_t p = pos;
+    while (p < eol && (out[p] == ' ' || out[p] == '\t')) ++p;
+    if (eol - p >= 3 && out[p] == 'v' && out[p + 1] == 'w' && (out[p + 2] == ' ' || out[p + 2] == '\t')) {
+      out.erase(pos, eol - pos);
+      eol = pos;
+    }
+    pos = eol + 1;
+  }
+  return out;
+}
+
 std::string first_line(const std::string& s) {
   const auto nl = s.find('\n');
   return nl == std::string::npos ? s : s.substr(0, nl);
@@ -88,7 +109,7 @@ MeshOccluder mesh_from_obj_text(const std::string& obj_text, const std::string& 
   config.vertex_color = false;
   tinyobj::ObjReader reader;
   // Parsing from a string (not a file) keeps "mtllib" from opening other files.
-  if (!reader.ParseFromString(obj_text, std::string(), config)) {
+  if (!reader.ParseFromString(without_vertex_weights(obj_text), std::string(), config)) {
     fail("bad_mesh", json_path,
          "mesh file \"" + file + "\" is not a valid OBJ file: " + first_line(reader.Error()));
   }

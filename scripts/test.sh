@@ -1,7 +1,37 @@
 #!/usr/bin/env bash
-# The test command: installs dependencies, builds everything, runs every test.
-# Extra arguments go to ctest (e.g. -L image, -R Shaders).
+# The test command (= CI): installs dependencies, builds everything, runs every
+# test; then the fuzz targets (ctest -L fuzz, clang + libFuzzer, protocol/ only)
+# and the whole suite again under ASan + UBSan (build-asan/).
+# Extra arguments go to the main ctest run only (e.g. -L image, -R Shaders) and
+# skip the fuzz and sanitizer stages; BEAMCAST_SKIP_ASAN=1 skips the ASan stage.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+launcher=()
+if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+stage() { printf '\n== %s (%s)\n' "$1" "$(date -u +%H:%M:%S)"; }
+
+stage "build and test"
 scripts/build.sh
+# The soak test (label slow) runs for BEAMCAST_SOAK_SECONDS.
+export BEAMCAST_SOAK_SECONDS="${BEAMCAST_SOAK_SECONDS:-60}"
 ctest --test-dir build --output-on-failure -j"$(nproc)" "$@"
+if [ $# -gt 0 ]; then exit 0; fi
+
+stage "fuzz targets"
+if [ ! -f build-fuzz/build.ninja ]; then cmake --preset fuzz "${launcher[@]}" >/dev/null; fi
+cmake --build build-fuzz -j"$(nproc)"
+ctest --test-dir build-fuzz --output-on-failure -j"$(nproc)" -L fuzz
+
+if [ "${BEAMCAST_SKIP_ASAN:-0}" != 1 ]; then
+  stage "ASan + UBSan"
+  if [ ! -f build-asan/build.ninja ]; then cmake --preset asan "${launcher[@]}" >/dev/null; fi
+  cmake --build build-asan -j"$(nproc)"
+  # Sanitizer reports fail the test; leaks too (LeakSanitizer at exit).
+  export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
+  export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
+  export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+  # The soak runs shorter here: same faults, a quarter of the time (ASan's
+  # slowdown would otherwise make it the longest step of CI).
+  BEAMCAST_SOAK_SECONDS=15 ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -LE bench
+fi
+stage "done"

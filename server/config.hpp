@@ -12,6 +12,11 @@ namespace beamcast {
 
 struct ServerConfig {
   std::string bind = "127.0.0.1";
+  // Shared secret clients present in hello (params.token); empty: no auth.
+  // Required for a non-loopback bind unless insecure_no_token (server/auth.hpp).
+  std::string token;
+  bool insecure_no_token = false;
+  bool request_log = false;  // one JSON line per request on stderr (beamcast-server: on)
   unsigned short port = 7878;  // 0: any free port
   // HTTP listener (preview page, WebSocket, GET endpoints) on `bind`; -1: none,
   // 0: any free port. beamcast-server turns it on (7879) by default.

@@ -41,8 +41,14 @@ class Connection {
 
   InteractiveState& interactive() { return interactive_; }
 
+  // Whether this connection passed hello's token check (server/auth.hpp);
+  // TCP sessions and WebSockets go through the same gate.
+  bool authenticated() const { return authenticated_.load(); }
+  void set_authenticated() { authenticated_.store(true); }
+
  private:
   InteractiveState interactive_;
+  std::atomic<bool> authenticated_{false};
 };
 
 }  // namespace beamcast

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "protocol/request.hpp"
+#include "server/auth.hpp"
 #include "server/connection.hpp"
 #include "server/request_handler.hpp"
 #include "server/server_core.hpp"
@@ -267,6 +268,15 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     }
     if (req.method() != http::verb::get && req.method() != http::verb::head) {
       return reply_error(http::status::method_not_allowed, "only GET and HEAD\n");
+    }
+    {
+      const std::string_view target(req.target().data(), req.target().size());
+      const auto auth = req[http::field::authorization];
+      if (!http_request_authorized(owner_->core.config, target.substr(0, target.find('?')),
+                                   std::string_view(auth.data(), auth.size()))) {
+        return reply_error(http::status::unauthorized,
+                           "this server requires a token: Authorization: Bearer <token>\n");
+      }
     }
     const HttpReply r = owner_->route(std::string_view(req.target().data(), req.target().size()));
     auto res = std::make_shared<http::response<http::string_body>>(

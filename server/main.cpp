@@ -19,6 +19,13 @@ int main(int argc, char** argv) {
 
   CLI::App app{"beamcast-server: headless energy-beam render service (protocol/PROTOCOL.md)"};
   app.add_option("--bind", c.bind, "Address to listen on")->capture_default_str();
+  app.add_option("--token", c.token,
+                 "Shared token clients must send in hello (params.token); required to bind a "
+                 "non-loopback address")
+      ->envname("BEAMCAST_TOKEN");
+  app.add_flag("--insecure-no-token", c.insecure_no_token,
+               "Allow a non-loopback bind without a token (anyone who can reach the port may "
+               "render; docs/security.md)");
   app.add_option("--port", c.port, "TCP port; 0 picks a free one (printed on the first line)")
       ->capture_default_str();
   app.add_option("--http-port", c.http_port,
@@ -45,6 +52,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"none", "sub", "up", "paeth", "adaptive"}))->capture_default_str();
   app.add_option("--assets", assets, "Directory scenes' mesh files are read from")->capture_default_str();
   app.add_flag("--no-demo", no_demo, "Do not preload the scene 'demo'");
+  bool quiet_requests = false;
+  app.add_flag("--quiet-requests", quiet_requests,
+               "No per-request log lines on stderr (one JSON object per answered request)");
   app.add_option("--max-message-bytes", c.max_message_bytes)->capture_default_str();
   app.add_option("--max-width", l.max_width)->capture_default_str();
   app.add_option("--max-height", l.max_height)->capture_default_str();
@@ -65,6 +75,7 @@ int main(int argc, char** argv) {
   app.add_option("--drain-timeout-ms", c.drain_timeout_ms)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   c.assets_dir = assets;
+  c.request_log = !quiet_requests;
   // libpng's PNG_FILTER_* masks.
   c.png_filters = png_filter == "none"    ? 0x08
                   : png_filter == "sub"   ? 0x10

@@ -6,6 +6,8 @@
 #include "protocol/request.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/pass_plan.hpp"
+#include "server/auth.hpp"
+#include "server/session.hpp"
 #include "server/accuracy_controller.hpp"
 #include "server/connection.hpp"
 
@@ -97,6 +99,16 @@ json hello_result(const ServerCore& core, const json& params) {
             {"batch_window_ms", core.config.batch_window_ms},
             {"passes", passes}}},
           {"limits", limits_json(core.config)}};
+}
+
+// stats' params.format: "json" (default), "prometheus" or "health".
+std::string stats_format(const json& params) {
+  const auto it = params.find("format");
+  if (it == params.end()) return "json";
+  if (!it->is_string() || (*it != "json" && *it != "prometheus" && *it != "health")) {
+    fail("invalid_value", "/params/format", "format must be \"json\", \"prometheus\" or \"health\"");
+  }
+  return it->get<std::string>();
 }
 
 json store_scene(ServerCore& core, const std::string& id, json scene_json, Scene scene) {
@@ -203,6 +215,8 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     session->end_render();
     if (out.dropped) return;
     if (out.error) {
+      core.metrics.count_request("render", false);
+      log_request(core, id, "render", out.error->code);
       session->send_error(id, *out.error);
       return;
     }
@@ -315,6 +329,13 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
                      {"server_ms", ms_since(arrived)}}}};
     if (decision) result["quality"] = std::move(quality);
     core.stats.count_frames(out.frames.size());
+    core.metrics.count_request("render", true);
+    core.metrics.observe(Metrics::kQueue, out.queue_ms);
+    core.metrics.observe(Metrics::kRender, out.render_ms);
+    core.metrics.observe(Metrics::kEncode, out.encode_wall_ms);
+    core.metrics.observe(Metrics::kTotal, ms_since(arrived));
+    for (const FrameResult& fr : out.frames) core.metrics.add_gpu_ms(fr.gpu_ms);
+    log_request(core, id, "render", "ok", result["timings"]);
     session->send(ok_response(id, std::move(result)), std::move(binary));
   };
   if (!core.renders->submit(std::move(job))) {
@@ -351,6 +372,7 @@ std::string base64_encode(const std::vector<std::uint8_t>& in) {
 void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
                     std::string_view json_text, Clock::time_point arrived) {
   json id;
+  std::string method = "(invalid)";  // metrics key: a known method or a fixed placeholder
   try {
     const Request req = parse_request(json_text, &id);
     static const char* kMethods[] = {"hello", "ping", "stats", "render", "scene.put",
@@ -358,8 +380,13 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
     // Count unknown methods under one key: client-chosen strings must not grow the map.
     const bool known = std::any_of(std::begin(kMethods), std::end(kMethods),
                                    [&](const char* m) { return req.method == m; });
-    core.stats.count_request(known ? req.method : "(unknown)");
+    method = known ? req.method : "(unknown)";
+    core.stats.count_request(method);
     const json& params = req.params;
+    if (token_required(core.config) && !session->authenticated()) {
+      check_unauthenticated_request(core.config, req.method, params);
+      session->set_authenticated();
+    }
     const bool mutating = req.method == "render" || req.method.starts_with("scene.");
     if (mutating && core.shutting_down.load()) {
       fail("shutting_down", "", "the server is shutting down and takes no new work");
@@ -368,6 +395,13 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
       session->send(ok_response(id, hello_result(core, params)));
     } else if (req.method == "ping") {
       session->send(ok_response(id, {{"echo", params}}));
+    } else if (req.method == "stats" && stats_format(params) == "prometheus") {
+      // The Prometheus exposition (server/metrics.hpp) inside a JSON response.
+      session->send(ok_response(id, {{"format", "prometheus"},
+                                     {"text", core.metrics.prometheus(sample_gauges(core))}}));
+    } else if (req.method == "stats" && stats_format(params) == "health") {
+      session->send(ok_response(
+          id, health_json(core.shutting_down.load(), sample_gauges(core), core.renderer_description)));
     } else if (req.method == "stats") {
       json s = core.stats.to_json();
       s["inflight"] = core.renders->inflight();
@@ -400,10 +434,17 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
            "unknown method \"" + req.method +
                "\" (hello, ping, render, scene.put, scene.update, scene.delete, stats)");
     }
+    if (method != "render") {  // render is counted when its answer is ready
+      core.metrics.count_request(method, true);
+      log_request(core, id, method, "ok");
+    }
   } catch (const ProtocolError& e) {
+    core.metrics.count_request(method, false);
+    log_request(core, id, method, e.info().code);
     session->send_error(id, e.info());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "beamcast-server: internal error: %s\n", e.what());
+    core.metrics.count_request(method, false);
     session->send_error(id, ErrorInfo{"internal", e.what(), ""});
   }
 }

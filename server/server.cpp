@@ -9,6 +9,7 @@
 
 #include "protocol/framing.hpp"
 #include "protocol/request.hpp"
+#include "server/auth.hpp"
 #include "server/session.hpp"
 
 namespace beamcast {
@@ -24,6 +25,7 @@ Server::Server(const ServerConfig& config, RendererFactory renderers)
       drain_timer_(io_),
       http_(std::make_unique<HttpServer>(io_, core_)) {
   register_preview_routes(*http_, core_);
+  register_metrics_routes(*http_, core_);
 }
 
 Server::~Server() {
@@ -34,6 +36,7 @@ Server::~Server() {
 
 unsigned short Server::start() {
   const ServerConfig& c = core_.config;
+  check_bind_policy(c);
   core_.renders = std::make_unique<RenderService>(factory_, c.render_workers, c.encode_threads,
                                                   c.png_level, c.png_filters,
                                                   c.max_inflight_total);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "server/config.hpp"
+#include "server/metrics.hpp"
 #include "server/render_service.hpp"
 #include "server/scene_store.hpp"
 #include "server/stats.hpp"
@@ -16,6 +17,7 @@ namespace beamcast {
 struct ServerCore {
   ServerConfig config;
   ServerStats stats;
+  Metrics metrics;
   SceneStore scenes;
   std::unique_ptr<RenderService> renders;
   std::string renderer_description;

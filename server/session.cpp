@@ -183,6 +183,7 @@ void Session::do_write() {
     if (ec == asio::error::operation_aborted || self->closed_) return;
     if (self->write_timer_.expiry() > Clock::now()) return;
     std::fprintf(stderr, "beamcast-server: client did not read for write_timeout_ms; closing\n");
+    self->core_.stats.count_error("write_timeout");
     self->close_now();
   });
   asio::async_write(socket_, asio::buffer(writes_.front()),

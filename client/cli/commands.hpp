@@ -13,6 +13,8 @@ void add_info_command(CLI::App& app);
 void add_server_commands(CLI::App& app);
 // `bench accuracy`: integration settings against the CPU reference (bench/).
 void add_bench_command(CLI::App& app);
+// `load`: a load generator against beamcast-server (load_command.cpp).
+void add_load_command(CLI::App& app);
 
 // `beamcast render --server HOST:PORT`: the render happens on the server.
 struct RemoteRenderArgs {

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   beamcast::cli::add_info_command(app);
   beamcast::cli::add_server_commands(app);
   beamcast::cli::add_bench_command(app);
+  beamcast::cli::add_load_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

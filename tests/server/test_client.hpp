@@ -65,6 +65,7 @@ class Conn {
     return ec == boost::asio::error::eof || ec == boost::asio::error::connection_reset;
   }
   void close() { socket_.close(); }
+  int native_handle() { return socket_.native_handle(); }
 
  private:
   boost::asio::io_context io_;

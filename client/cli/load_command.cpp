@@ -1,0 +1,760 @@
+// `beamcast load`: a load generator for beamcast-server. N connections on one
+// Asio event loop, closed loop (each connection waits for its answer) or open
+// loop (a fixed request rate, latency measured from each request's scheduled
+// time so a slow server cannot hide queueing: no coordinated omission). Every
+// frame received is decoded and checked; a fraction is compared with a local
+// render of the same pose (the offline GL renderer, same code as the server).
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <deque>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include <boost/asio.hpp>
+#include <nlohmann/json.hpp>
+
+#include "client/cli/commands.hpp"
+#include "client/client.hpp"
+#include "client/latency_histogram.hpp"
+#include "protocol/framing.hpp"
+#include "protocol/scene_json.hpp"
+#include "render/image.hpp"
+#include "render/renderer.hpp"
+
+namespace beamcast::cli {
+namespace {
+
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+using Clock = std::chrono::steady_clock;
+using json = nlohmann::json;
+using client::LatencyHistogram;
+
+struct LoadArgs {
+  std::string server;
+  int connections = 16;
+  double duration_s = 10;
+  long long requests = 0;  // total; 0: until duration
+  double rate = 0;         // requests/s over all connections; 0: closed loop
+  int size = 256;
+  std::string scene_file = BEAMCAST_DEMO_SCENE;
+  std::string poses = "mix";  // fixed, orbit, random, mix
+  int cameras = 0;            // cameras per request; 0: mix of 1 and 4
+  double verify_fraction = 0.02;
+  int tolerance = 1;  // max |difference| per 8-bit channel against the local render
+  int inflight_per_connection = 8;
+  double busy_backoff_ms = 20;  // closed loop: pause after a "busy" answer, as a polite client does  // open loop: more than this is a client-side skip
+  double timeout_s = 60;
+  std::string token;
+  bool json_out = false;
+  bool quiet = false;
+};
+
+// ---- camera poses ---------------------------------------------------------
+
+struct PoseSource {
+  std::array<double, 3> target{0, 0, 0};
+  double radius = 5, azimuth = 0, elevation = 0.3, fov = 45;
+  int size = 256;
+
+  explicit PoseSource(const json& cam, int sz) : size(sz) {
+    const auto p = cam.at("position").get<std::array<double, 3>>();
+    if (cam.contains("target")) target = cam.at("target").get<std::array<double, 3>>();
+    fov = cam.value("fov_y", 45.0);
+    const double dx = p[0] - target[0], dy = p[1] - target[1], dz = p[2] - target[2];
+    radius = std::sqrt(dx * dx + dy * dy + dz * dz);
+    azimuth = std::atan2(dx, dz);
+    elevation = std::asin(std::clamp(dy / radius, -1.0, 1.0));
+  }
+  json camera(const std::string& name, double az, double el, double r) const {
+    return {{"name", name},
+            {"position",
+             {target[0] + r * std::cos(el) * std::sin(az), target[1] + r * std::sin(el),
+              target[2] + r * std::cos(el) * std::cos(az)}},
+            {"target", target},
+            {"fov_y", fov},
+            {"width", size},
+            {"height", size}};
+  }
+  // The cameras of request number `seq` (deterministic, so a reference render
+  // of the same request can be made later from seq alone).
+  json cameras_for(std::uint64_t seq, const std::string& mode, int count) const {
+    const std::string m = mode == "mix" ? (seq % 3 == 0 ? "fixed" : seq % 3 == 1 ? "orbit" : "random")
+                                        : mode;
+    const int n = count > 0 ? count : (seq % 4 == 3 ? 4 : 1);
+    std::mt19937_64 rng(seq * 0x9E3779B97F4A7C15ull + 1);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    json cams = json::array();
+    for (int k = 0; k < n; ++k) {
+      double az = azimuth + 2 * std::numbers::pi * k / n, el = elevation, r = radius;
+      if (m == "orbit") az += 2 * std::numbers::pi * static_cast<double>(seq % 120) / 120.0;
+      if (m == "random") {
+        az = 2 * std::numbers::pi * u(rng);
+        el = (-30.0 + 90.0 * u(rng)) * std::numbers::pi / 180.0;  // keep clear of the up axis
+        r = radius * (0.7 + 0.6 * u(rng));
+      }
+      cams.push_back(camera("c" + std::to_string(k), az, el, r));
+    }
+    return cams;
+  }
+};
+
+// ---- results ----------------------------------------------------------------
+
+struct Results {
+  std::mutex mu;
+  LatencyHistogram latency, queue_ms, render_ms, encode_ms, server_ms;
+  LatencyHistogram busy_latency;  // how fast refusals come back
+  std::map<std::string, std::uint64_t> errors;
+  std::uint64_t sent = 0, ok = 0, frames = 0, bytes = 0, skipped = 0;
+  // Verification (filled by the verifier threads).
+  std::uint64_t decoded = 0, decode_failed = 0, size_mismatch = 0;
+  std::uint64_t ref_checked = 0, ref_failed = 0;
+  int ref_max_diff = 0;
+  std::vector<std::string> failures;  // first few, for the report
+};
+
+void note_failure(Results& r, std::string what) {
+  if (r.failures.size() < 5) r.failures.push_back(std::move(what));
+}
+
+// ---- frame verification -----------------------------------------------------
+
+struct VerifyJob {
+  std::vector<std::uint8_t> png;
+  int width = 0, height = 0;
+  json camera;     // set for a reference comparison
+  std::uint64_t seq = 0;
+};
+
+class Verifier {
+ public:
+  Verifier(Results& r, const json& scene_json, int tolerance)
+      : results_(r), tolerance_(tolerance) {
+    SceneLoadOptions opts;
+    opts.assets_dir = std::filesystem::path(BEAMCAST_DEMO_SCENE).parent_path();
+    scene_ = parse_scene(scene_json, opts);
+    // Decoding every frame: two threads; reference renders: one (its own GL context).
+    for (int i = 0; i < 2; ++i) threads_.emplace_back([this] { decode_loop(); });
+    ref_thread_ = std::thread([this] { reference_loop(); });
+  }
+  ~Verifier() { finish(); }
+
+  void push(VerifyJob job) {
+    std::lock_guard lock(mu_);
+    (job.camera.is_null() ? jobs_ : ref_jobs_).push_back(std::move(job));
+    cv_.notify_all();
+  }
+  std::size_t backlog() {
+    std::lock_guard lock(mu_);
+    return jobs_.size() + ref_jobs_.size();
+  }
+  void finish() {
+    {
+      std::lock_guard lock(mu_);
+      if (done_) return;
+      done_ = true;
+      cv_.notify_all();
+    }
+    for (auto& t : threads_) t.join();
+    ref_thread_.join();
+  }
+
+ private:
+  std::optional<Image> decode(const VerifyJob& job) {
+    try {
+      Image img = decode_png(job.png);
+      std::lock_guard lock(results_.mu);
+      ++results_.decoded;
+      if (img.width != job.width || img.height != job.height) {
+        ++results_.size_mismatch;
+        note_failure(results_, "request " + std::to_string(job.seq) + ": frame is " +
+                                   std::to_string(img.width) + "x" + std::to_string(img.height));
+        return std::nullopt;
+      }
+      return img;
+    } catch (const std::exception& e) {
+      std::lock_guard lock(results_.mu);
+      ++results_.decode_failed;
+      note_failure(results_, "request " + std::to_string(job.seq) + ": " + e.what());
+      return std::nullopt;
+    }
+  }
+  bool next(std::deque<VerifyJob>& q, VerifyJob* out) {
+    std::unique_lock lock(mu_);
+    cv_.wait(lock, [&] { return done_ || !q.empty(); });
+    if (q.empty()) return false;
+    *out = std::move(q.front());
+    q.pop_front();
+    return true;
+  }
+  void decode_loop() {
+    VerifyJob job;
+    while (next(jobs_, &job)) decode(job);
+  }
+  void reference_loop() {
+    std::unique_ptr<Renderer> renderer;
+    VerifyJob job;
+    while (next(ref_jobs_, &job)) {
+      const std::optional<Image> got = decode(job);
+      if (!got) continue;
+      try {
+        if (!renderer) renderer = std::make_unique<Renderer>();
+        const Camera cam = parse_camera(job.camera, "/camera", SceneLimits{});
+        const Image want = renderer->render(scene_, {cam}).at(0).image;
+        int max_diff = 0;
+        for (std::size_t i = 0; i < want.rgb.size(); ++i) {
+          max_diff = std::max(max_diff, std::abs(int(want.rgb[i]) - int(got->rgb[i])));
+        }
+        std::lock_guard lock(results_.mu);
+        ++results_.ref_checked;
+        results_.ref_max_diff = std::max(results_.ref_max_diff, max_diff);
+        if (max_diff > tolerance_) {
+          ++results_.ref_failed;
+          note_failure(results_, "request " + std::to_string(job.seq) + " camera " +
+                                     job.camera.value("name", "") + ": differs from the local " +
+                                     "render by " + std::to_string(max_diff) + " levels");
+        }
+      } catch (const std::exception& e) {
+        std::lock_guard lock(results_.mu);
+        ++results_.ref_failed;
+        note_failure(results_, std::string("reference render failed: ") + e.what());
+      }
+    }
+  }
+
+  Results& results_;
+  int tolerance_;
+  Scene scene_;
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::deque<VerifyJob> jobs_, ref_jobs_;
+  bool done_ = false;
+  std::vector<std::thread> threads_;
+  std::thread ref_thread_;
+};
+
+// ---- connections --------------------------------------------------------------
+
+class Load;
+
+class Conn : public std::enable_shared_from_this<Conn> {
+ public:
+  Conn(Load& load, asio::io_context& io, int index) : load_(load), socket_(io), index_(index) {}
+  void start(const tcp::resolver::results_type& endpoints);
+  // Sends request `seq`, timed from `intended` (its scheduled time).
+  void send_render(std::uint64_t seq, Clock::time_point intended);
+  std::size_t inflight() const { return pending_.size(); }
+  bool ready() const { return ready_ && !dead_; }
+  void close() {
+    boost::system::error_code ignored;
+    socket_.close(ignored);
+  }
+
+ private:
+  struct Pending {
+    std::uint64_t seq;
+    Clock::time_point intended;
+    json cameras;
+  };
+  void write(std::vector<std::uint8_t> frame);
+  void do_write();
+  void read_header();
+  void on_message(json msg, std::vector<std::uint8_t> binary);
+  void fail(const std::string& why);
+
+  Load& load_;
+  tcp::socket socket_;
+  int index_;
+  bool ready_ = false, dead_ = false, writing_ = false;
+  std::deque<std::vector<std::uint8_t>> writes_;
+  std::array<std::uint8_t, kFrameHeaderSize> header_{};
+  std::vector<std::uint8_t> body_;
+  std::map<std::int64_t, Pending> pending_;
+  std::int64_t next_id_ = 1;
+};
+
+class Load {
+ public:
+  Load(const LoadArgs& a, json scene_json, std::string scene_id)
+      : args(a),
+        scene_id(std::move(scene_id)),
+        poses(scene_json.at("cameras").at(0), a.size),
+        verifier(results, scene_json, a.tolerance) {}
+
+  int run(const client::Endpoint& ep) {
+    tcp::resolver resolver(io);
+    const auto endpoints = resolver.resolve(ep.host, std::to_string(ep.port));
+    start = Clock::now();
+    for (int i = 0; i < args.connections; ++i) {
+      conns.push_back(std::make_shared<Conn>(*this, io, i));
+      conns.back()->start(endpoints);
+    }
+    asio::steady_timer ticker(io);
+    tick(ticker);
+    io.run();
+    verifier.finish();
+    return 0;
+  }
+
+  // Called by a connection when it is ready (closed loop: starts its loop) or
+  // when an answer arrived (closed loop: sends the next).
+  void on_ready(Conn& c) {
+    if (args.rate <= 0) maybe_send(c, Clock::now());
+  }
+  void on_answer(Conn& c, bool busy) {
+    if (args.rate <= 0 && busy && args.busy_backoff_ms > 0) {
+      auto t = std::make_shared<asio::steady_timer>(io);
+      t->expires_after(std::chrono::microseconds(static_cast<long long>(args.busy_backoff_ms * 1000)));
+      t->async_wait([this, t, conn = c.shared_from_this()](const boost::system::error_code&) {
+        maybe_send(*conn, Clock::now());
+        maybe_stop();
+      });
+      return;
+    }
+    if (args.rate <= 0) maybe_send(c, Clock::now());
+    maybe_stop();
+  }
+  bool sending_over() const {
+    return stopping || (args.requests > 0 && next_seq >= static_cast<std::uint64_t>(args.requests));
+  }
+  void on_dead() { maybe_stop(); }
+
+  const LoadArgs& args;
+  std::string scene_id;
+  PoseSource poses;
+  Results results;
+  Verifier verifier;
+  asio::io_context io;
+  std::vector<std::shared_ptr<Conn>> conns;
+  Clock::time_point start;
+  std::uint64_t next_seq = 0;
+  bool stopping = false;
+  Clock::time_point stop_at_deadline;
+
+ private:
+  void maybe_send(Conn& c, Clock::time_point intended) {
+    if (sending_over() || !c.ready()) return;
+    c.send_render(next_seq++, intended);
+  }
+  void maybe_stop() {
+    if (!sending_over()) return;
+    for (auto& c : conns) {
+      if (c->ready() && c->inflight() > 0) return;
+    }
+    for (auto& c : conns) c->close();
+    io.stop();
+  }
+  void tick(asio::steady_timer& t) {
+    const auto now = Clock::now();
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    if (!stopping && elapsed >= args.duration_s && args.requests == 0) {
+      stopping = true;
+      stop_at_deadline = now + std::chrono::milliseconds(static_cast<long long>(args.timeout_s * 1000));
+    }
+    if (stopping && now > stop_at_deadline) {
+      // Answers that never came count as errors.
+      std::lock_guard lock(results.mu);
+      for (auto& c : conns) results.errors["no_answer"] += c->ready() ? c->inflight() : 0;
+      for (auto& c : conns) c->close();
+      io.stop();
+      return;
+    }
+    if (args.rate > 0 && !sending_over()) {
+      // Open loop: every request due by now is sent, round robin over the
+      // connections, timed from its own scheduled instant.
+      const auto due = static_cast<std::uint64_t>(elapsed * args.rate);
+      while (next_seq < due && !sending_over()) {
+        const auto intended = start + std::chrono::duration_cast<Clock::duration>(
+                                          std::chrono::duration<double>(next_seq / args.rate));
+        Conn* c = nullptr;
+        for (std::size_t k = 0; k < conns.size() && !c; ++k) {
+          Conn& cand = *conns[(rr++) % conns.size()];
+          if (cand.ready() && cand.inflight() < static_cast<std::size_t>(args.inflight_per_connection)) c = &cand;
+        }
+        if (!c) {
+          // Every connection is at its in-flight cap: the request is not
+          // sent (counted, not hidden).
+          ++next_seq;
+          std::lock_guard lock(results.mu);
+          ++results.skipped;
+          continue;
+        }
+        c->send_render(next_seq++, intended);
+      }
+    }
+    progress(now, false);
+    maybe_stop();
+    t.expires_after(std::chrono::milliseconds(args.rate > 0 ? 2 : 50));
+    t.async_wait([this, &t](const boost::system::error_code& ec) {
+      if (!ec) tick(t);
+    });
+  }
+
+ public:
+  void progress(Clock::time_point now, bool final) {
+    if (args.quiet) return;
+    if (!final && now - last_progress < std::chrono::seconds(1)) return;
+    last_progress = now;
+    const double t = std::chrono::duration<double>(now - start).count();
+    std::lock_guard lock(results.mu);
+    std::uint64_t errs = 0;
+    for (auto& [k, v] : results.errors) errs += v;
+    std::fprintf(stderr,
+                 "%sload %6.1fs  sent %llu  ok %llu  errors %llu  frames/s %.1f  p50 %.1f ms  "
+                 "p99 %.1f ms  verify backlog %zu%s",
+                 isatty(2) ? "\r" : "", t, (unsigned long long)results.sent,
+                 (unsigned long long)results.ok, (unsigned long long)errs,
+                 t > 0 ? results.frames / t : 0.0, results.latency.percentile_ms(0.5),
+                 results.latency.percentile_ms(0.99), verifier.backlog(),
+                 isatty(2) && !final ? "   " : "\n");
+  }
+  Clock::time_point last_progress{};
+  std::size_t rr = 0;
+};
+
+void Conn::start(const tcp::resolver::results_type& endpoints) {
+  asio::async_connect(socket_, endpoints,
+                      [self = shared_from_this()](const boost::system::error_code& ec, const tcp::endpoint&) {
+                        if (ec) return self->fail("connect_failed");
+                        self->socket_.set_option(tcp::no_delay(true));
+                        self->read_header();
+                        if (!self->load_.args.token.empty()) {
+                          json hello = {{"id", 0},
+                                        {"method", "hello"},
+                                        {"params", {{"protocol", 1}, {"token", self->load_.args.token}}}};
+                          self->write(encode_frame(hello.dump()));
+                          return;  // ready once hello is answered
+                        }
+                        self->ready_ = true;
+                        self->load_.on_ready(*self);
+                      });
+}
+
+void Conn::send_render(std::uint64_t seq, Clock::time_point intended) {
+  const std::int64_t id = next_id_++;
+  json cams = load_.poses.cameras_for(seq, load_.args.poses, load_.args.cameras);
+  json req = {{"id", id},
+              {"method", "render"},
+              {"params", {{"scene_id", load_.scene_id}, {"cameras", cams}}}};
+  pending_[id] = Pending{seq, intended, std::move(cams)};
+  {
+    std::lock_guard lock(load_.results.mu);
+    ++load_.results.sent;
+  }
+  write(encode_frame(req.dump()));
+}
+
+void Conn::write(std::vector<std::uint8_t> frame) {
+  writes_.push_back(std::move(frame));
+  if (!writing_) do_write();
+}
+
+void Conn::do_write() {
+  writing_ = true;
+  asio::async_write(socket_, asio::buffer(writes_.front()),
+                    [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
+                      if (ec) return self->fail("write_failed");
+                      self->writes_.pop_front();
+                      if (self->writes_.empty()) {
+                        self->writing_ = false;
+                      } else {
+                        self->do_write();
+                      }
+                    });
+}
+
+void Conn::read_header() {
+  asio::async_read(socket_, asio::buffer(header_),
+                   [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
+                     if (ec) return self->fail("connection_lost");
+                     FrameHeader h;
+                     if (parse_frame_header(self->header_, 1ull << 31, &h) != HeaderStatus::kOk) {
+                       return self->fail("bad_frame");
+                     }
+                     self->body_.resize(h.body_length());
+                     asio::async_read(
+                         self->socket_, asio::buffer(self->body_),
+                         [self, h](const boost::system::error_code& ec2, std::size_t) {
+                           if (ec2) return self->fail("connection_lost");
+                           json msg = json::parse(self->body_.begin(),
+                                                  self->body_.begin() + h.json_length, nullptr, false);
+                           if (msg.is_discarded() || !msg.is_object()) return self->fail("bad_json_response");
+                           std::vector<std::uint8_t> bin(self->body_.begin() + h.json_length,
+                                                         self->body_.end());
+                           self->on_message(std::move(msg), std::move(bin));
+                           if (!self->dead_) self->read_header();
+                         });
+                   });
+}
+
+void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
+  const auto now = Clock::now();
+  const json id = msg.value("id", json());
+  const bool ok = msg.value("ok", false);
+  Results& r = load_.results;
+  if (!ready_) {  // the answer to hello
+    if (!ok) {
+      std::lock_guard lock(r.mu);
+      ++r.errors[msg["error"].value("code", "hello_failed")];
+      dead_ = true;
+      close();
+      load_.on_dead();
+      return;
+    }
+    ready_ = true;
+    load_.on_ready(*this);
+    return;
+  }
+  if (!id.is_number_integer() || !pending_.count(id.get<std::int64_t>())) {
+    // An error the server could not tie to a request (e.g. max_connections).
+    std::lock_guard lock(r.mu);
+    ++r.errors[ok ? "unexpected_response" : msg["error"].value("code", "unknown")];
+    return;
+  }
+  const Pending p = std::move(pending_[id.get<std::int64_t>()]);
+  pending_.erase(id.get<std::int64_t>());
+  const double ms = std::chrono::duration<double, std::milli>(now - p.intended).count();
+  bool busy = false;
+  if (!ok) {
+    const std::string code = msg["error"].value("code", "unknown");
+    busy = code == "busy";
+    std::lock_guard lock(r.mu);
+    ++r.errors[code];
+    if (busy) r.busy_latency.record_ms(ms);
+  } else {
+    const json& res = msg["result"];
+    const json& frames = res["frames"];
+    std::vector<VerifyJob> jobs;
+    bool shape_ok = frames.is_array() && frames.size() == p.cameras.size();
+    for (std::size_t i = 0; shape_ok && i < frames.size(); ++i) {
+      const json& att = frames[i]["attachment"];
+      const std::size_t off = att.value("offset", std::size_t{0}), len = att.value("length", std::size_t{0});
+      if (off + len > binary.size() || len == 0) {
+        shape_ok = false;
+        break;
+      }
+      VerifyJob job;
+      job.png.assign(binary.begin() + off, binary.begin() + off + len);
+      job.width = p.cameras[i]["width"];
+      job.height = p.cameras[i]["height"];
+      job.seq = p.seq;
+      // Deterministic sample of requests for the reference comparison.
+      const double u = static_cast<double>((p.seq * 0x9E3779B97F4A7C15ull) >> 11) * 0x1.0p-53;
+      if (u < load_.args.verify_fraction) job.camera = p.cameras[i];
+      jobs.push_back(std::move(job));
+    }
+    {
+      std::lock_guard lock(r.mu);
+      if (!shape_ok) {
+        ++r.errors["bad_frames"];
+        note_failure(r, "request " + std::to_string(p.seq) + ": frames do not match the cameras");
+      } else {
+        ++r.ok;
+        r.frames += frames.size();
+        r.bytes += kFrameHeaderSize + body_.size();
+        r.latency.record_ms(ms);
+        const json& t = res["timings"];
+        r.queue_ms.record_ms(t.value("queue_ms", 0.0));
+        r.render_ms.record_ms(t.value("render_ms", 0.0));
+        r.encode_ms.record_ms(t.value("encode_ms", 0.0));
+        r.server_ms.record_ms(t.value("server_ms", 0.0));
+      }
+    }
+    for (auto& j : jobs) load_.verifier.push(std::move(j));
+  }
+  load_.on_answer(*this, busy);
+}
+
+void Conn::fail(const std::string& why) {
+  if (dead_) return;
+  dead_ = true;
+  {
+    std::lock_guard lock(load_.results.mu);
+    if (!load_.stopping || !pending_.empty()) ++load_.results.errors[why];
+    load_.results.errors["no_answer"] += pending_.size();
+  }
+  pending_.clear();
+  close();
+  load_.on_dead();
+}
+
+json histogram_json(const LatencyHistogram& h) {
+  return {{"count", h.count()},
+          {"mean", h.mean_ms()},
+          {"p50", h.percentile_ms(0.5)},
+          {"p90", h.percentile_ms(0.9)},
+          {"p99", h.percentile_ms(0.99)},
+          {"p999", h.percentile_ms(0.999)},
+          {"max", h.max_ms()}};
+}
+
+int run_load(const LoadArgs& args) {
+  client::Endpoint ep;
+  try {
+    ep = client::parse_endpoint(args.server);
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--server", e.what());
+  }
+  std::ifstream in(args.scene_file);
+  if (!in) throw std::runtime_error("cannot read scene file " + args.scene_file);
+  json scene_json = json::parse(in);
+  if (!scene_json.contains("cameras") || scene_json["cameras"].empty()) {
+    throw std::runtime_error(args.scene_file + " has no camera to derive poses from");
+  }
+  // Store the scene once under a per-run id; every request renders it by id.
+  const std::string scene_id = "load-" + std::to_string(::getpid());
+  {
+    client::Client c;
+    c.set_receive_timeout(std::chrono::milliseconds(static_cast<long long>(args.timeout_s * 1000)));
+    c.connect(ep.host, ep.port);
+    if (!args.token.empty()) {
+      const auto h = c.call("hello", {{"protocol", 1}, {"token", args.token}});
+      if (!h.ok) throw std::runtime_error("hello refused: [" + h.error.code + "] " + h.error.message);
+    }
+    const auto put = c.scene_put(scene_id, scene_json);
+    if (!put.ok) throw std::runtime_error("scene.put refused: [" + put.error.code + "] " + put.error.message);
+  }
+
+  Load load(args, scene_json, scene_id);
+  load.run(ep);
+  const double wall = std::chrono::duration<double>(Clock::now() - load.start).count();
+  load.progress(Clock::now(), true);
+
+  {
+    client::Client c;
+    c.connect(ep.host, ep.port);
+    if (!args.token.empty()) c.call("hello", {{"protocol", 1}, {"token", args.token}});
+    c.scene_delete(scene_id);
+  }
+
+  Results& r = load.results;
+  std::uint64_t errors = 0;
+  for (auto& [k, v] : r.errors) errors += v;
+  const bool verified = r.decode_failed == 0 && r.size_mismatch == 0 && r.ref_failed == 0 &&
+                        r.decoded == r.frames;
+  json out = {
+      {"server", args.server},
+      {"mode", args.rate > 0 ? "open" : "closed"},
+      {"connections", args.connections},
+      {"rate", args.rate},
+      {"size", args.size},
+      {"poses", args.poses},
+      {"cameras_per_request", args.cameras > 0 ? json(args.cameras) : json("mix 1/4")},
+      {"duration_s", wall},
+      {"requests", {{"sent", r.sent}, {"ok", r.ok}, {"errors", errors}, {"not_sent", r.skipped}}},
+      {"errors_by_code", r.errors},
+      {"frames", r.frames},
+      {"frames_per_s", r.frames / wall},
+      {"requests_per_s", r.ok / wall},
+      {"mb_per_s", r.bytes / wall / 1e6},
+      {"latency_ms", histogram_json(r.latency)},
+      {"busy_latency_ms", histogram_json(r.busy_latency)},
+      {"server_timings_ms",
+       {{"queue", histogram_json(r.queue_ms)},
+        {"render", histogram_json(r.render_ms)},
+        {"encode", histogram_json(r.encode_ms)},
+        {"server", histogram_json(r.server_ms)}}},
+      {"verify",
+       {{"decoded", r.decoded},
+        {"decode_failed", r.decode_failed},
+        {"size_mismatch", r.size_mismatch},
+        {"reference_checked", r.ref_checked},
+        {"reference_failed", r.ref_failed},
+        {"reference_max_diff", r.ref_max_diff},
+        {"tolerance", args.tolerance},
+        {"all_frames_correct", verified},
+        {"failures", r.failures}}}};
+  if (args.json_out) {
+    std::printf("%s\n", out.dump(2).c_str());
+  } else {
+    const json& l = out["latency_ms"];
+    std::printf("beamcast load: %s loop, %d connections, %.1f s, %dx%d\n",
+                args.rate > 0 ? "open" : "closed", args.connections, wall, args.size, args.size);
+    std::printf("  requests  sent %llu  ok %llu  errors %llu  not sent %llu\n",
+                (unsigned long long)r.sent, (unsigned long long)r.ok,
+                (unsigned long long)errors, (unsigned long long)r.skipped);
+    for (auto& [k, v] : r.errors) std::printf("    error %-20s %llu\n", k.c_str(), (unsigned long long)v);
+    std::printf("  throughput  %.1f frames/s  %.1f requests/s  %.2f MB/s\n", r.frames / wall,
+                r.ok / wall, r.bytes / wall / 1e6);
+    std::printf("  latency ms  p50 %.1f  p90 %.1f  p99 %.1f  p99.9 %.1f  max %.1f\n",
+                l["p50"].get<double>(), l["p90"].get<double>(), l["p99"].get<double>(),
+                l["p999"].get<double>(), l["max"].get<double>());
+    std::printf("  server ms (mean)  queue %.1f  render %.1f  encode %.1f  total %.1f\n",
+                r.queue_ms.mean_ms(), r.render_ms.mean_ms(), r.encode_ms.mean_ms(),
+                r.server_ms.mean_ms());
+    std::printf("  verify  %llu/%llu frames decoded, %llu compared with a local render (max "
+                "diff %d, tolerance %d): %s\n",
+                (unsigned long long)r.decoded, (unsigned long long)r.frames,
+                (unsigned long long)r.ref_checked, r.ref_max_diff, args.tolerance,
+                verified ? "all correct" : "FAILURES");
+    for (auto& f : r.failures) std::printf("    %s\n", f.c_str());
+  }
+  return verified ? 0 : 3;
+}
+
+}  // namespace
+
+void add_load_command(CLI::App& app) {
+  auto args = std::make_shared<LoadArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "load", "Load-test a beamcast-server: N connections, closed or open loop; latency "
+              "percentiles, throughput, errors; every frame verified");
+  cmd->add_option("--server", args->server, "HOST:PORT of beamcast-server")->required();
+  cmd->add_option("--connections,-c", args->connections, "Connections")
+      ->check(CLI::Range(1, 1000))->capture_default_str();
+  cmd->add_option("--duration", args->duration_s, "Seconds of load (ignored with --requests)")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--requests", args->requests, "Total requests instead of a duration")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--rate", args->rate,
+                  "Open loop: requests/s over all connections (0: closed loop)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  cmd->add_option("--size", args->size, "Frame width and height")
+      ->check(CLI::Range(1, 4096))->capture_default_str();
+  cmd->add_option("--scene", args->scene_file, "Scene file (stored once on the server)")
+      ->capture_default_str();
+  cmd->add_option("--poses", args->poses, "Camera poses: fixed, orbit, random or mix")
+      ->check(CLI::IsMember({"fixed", "orbit", "random", "mix"}))->capture_default_str();
+  cmd->add_option("--cameras", args->cameras, "Cameras per request (0: 1, and 4 every 4th request)")
+      ->check(CLI::Range(0, 64))->capture_default_str();
+  cmd->add_option("--verify-fraction", args->verify_fraction,
+                  "Fraction of requests whose frames are compared with a local render")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  cmd->add_option("--tolerance", args->tolerance,
+                  "Largest per-channel difference (8-bit levels) from the local render")
+      ->capture_default_str();
+  cmd->add_option("--inflight", args->inflight_per_connection,
+                  "Open loop: requests in flight per connection before one is skipped")
+      ->check(CLI::Range(1, 1024))->capture_default_str();
+  cmd->add_option("--busy-backoff", args->busy_backoff_ms,
+                  "Closed loop: milliseconds a connection waits after a busy answer")
+      ->capture_default_str();
+  cmd->add_option("--timeout", args->timeout_s, "Seconds to wait for outstanding answers at the end")
+      ->capture_default_str();
+  cmd->add_option("--token", args->token, "Token for hello (servers on non-loopback addresses)")
+      ->envname("BEAMCAST_TOKEN");
+  cmd->add_flag("--json", args->json_out, "Print the results as JSON");
+  cmd->add_flag("--quiet,-q", args->quiet, "No live progress line");
+  cmd->callback([args] {
+    const int rc = run_load(*args);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+}
+
+}  // namespace beamcast::cli

@@ -1,0 +1,134 @@
+#include "server/metrics.hpp"
+
+#include <cstdio>
+
+namespace beamcast {
+namespace {
+
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// Label values are server-chosen, but escape per the format anyway.
+std::string label(const std::string& v) {
+  std::string out;
+  for (char c : v) {
+    if (c == '\\' || c == '"') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out;
+}
+
+void header(std::string& o, const char* name, const char* type, const char* help) {
+  o += "# HELP ";
+  o += name;
+  o += ' ';
+  o += help;
+  o += "\n# TYPE ";
+  o += name;
+  o += ' ';
+  o += type;
+  o += '\n';
+}
+
+}  // namespace
+
+const char* Metrics::stage_name(Stage s) {
+  switch (s) {
+    case kQueue: return "queue";
+    case kRender: return "render";
+    case kEncode: return "encode";
+    case kTotal: return "total";
+    default: return "?";
+  }
+}
+
+void Metrics::count_request(const std::string& method, bool ok) {
+  std::lock_guard lock(mu_);
+  ++requests_[{method, ok}];
+}
+
+void Metrics::observe(Stage stage, double ms) {
+  const double s = ms / 1000.0;
+  std::lock_guard lock(mu_);
+  Histogram& h = stages_[stage];
+  std::size_t i = 0;
+  while (i < kBuckets.size() && s > kBuckets[i]) ++i;
+  ++h.counts[i];
+  ++h.count;
+  h.sum_s += s;
+}
+
+void Metrics::add_gpu_ms(double ms) {
+  std::lock_guard lock(mu_);
+  gpu_s_ += ms / 1000.0;
+}
+
+std::string Metrics::prometheus(const Gauges& g) const {
+  std::string o;
+  std::lock_guard lock(mu_);
+  header(o, "beamcast_requests_total", "counter", "Requests answered, by method and outcome.");
+  for (const auto& [key, n] : requests_) {
+    o += "beamcast_requests_total{method=\"" + label(key.first) + "\",outcome=\"" +
+         (key.second ? "ok" : "error") + "\"} " + std::to_string(n) + "\n";
+  }
+  header(o, "beamcast_errors_total", "counter", "Error responses and connection faults, by code.");
+  for (const auto& [code, n] : g.errors) {
+    o += "beamcast_errors_total{code=\"" + label(code) + "\"} " + std::to_string(n) + "\n";
+  }
+  header(o, "beamcast_stage_seconds", "histogram",
+         "Render request latency by stage: queue wait, render (GPU + readback), PNG encode, "
+         "and total time in the server.");
+  for (int s = 0; s < kStageCount; ++s) {
+    const Histogram& h = stages_[s];
+    const std::string st = stage_name(static_cast<Stage>(s));
+    std::uint64_t cum = 0;
+    for (std::size_t i = 0; i < kBuckets.size(); ++i) {
+      cum += h.counts[i];
+      char le[32];
+      std::snprintf(le, sizeof le, "%g", kBuckets[i]);  // bucket bounds as written: "0.05"
+      o += "beamcast_stage_seconds_bucket{stage=\"" + st + "\",le=\"" + le + "\"} " +
+           std::to_string(cum) + "\n";
+    }
+    cum += h.counts.back();
+    o += "beamcast_stage_seconds_bucket{stage=\"" + st + "\",le=\"+Inf\"} " + std::to_string(cum) + "\n";
+    o += "beamcast_stage_seconds_sum{stage=\"" + st + "\"} " + num(h.sum_s) + "\n";
+    o += "beamcast_stage_seconds_count{stage=\"" + st + "\"} " + std::to_string(h.count) + "\n";
+  }
+  header(o, "beamcast_gpu_seconds_total", "counter", "GPU time of rendered frames (timer queries).");
+  o += "beamcast_gpu_seconds_total " + num(gpu_s_) + "\n";
+  header(o, "beamcast_frames_total", "counter", "Frames sent.");
+  o += "beamcast_frames_total " + std::to_string(g.frames) + "\n";
+  header(o, "beamcast_bytes_out_total", "counter", "Bytes of response frames queued for sending.");
+  o += "beamcast_bytes_out_total " + std::to_string(g.bytes_out) + "\n";
+  header(o, "beamcast_renders_dropped_total", "counter", "Queued renders dropped because their client left.");
+  o += "beamcast_renders_dropped_total " + std::to_string(g.renders_dropped) + "\n";
+  header(o, "beamcast_queue_depth", "gauge", "Render jobs waiting for a GL worker.");
+  o += "beamcast_queue_depth " + std::to_string(g.queue_depth) + "\n";
+  header(o, "beamcast_inflight", "gauge", "Render jobs admitted and not yet answered.");
+  o += "beamcast_inflight " + std::to_string(g.inflight) + "\n";
+  header(o, "beamcast_connections_open", "gauge", "Open client connections.");
+  o += "beamcast_connections_open " + std::to_string(g.connections_open) + "\n";
+  header(o, "beamcast_connections_total", "counter", "Connections accepted.");
+  o += "beamcast_connections_total " + std::to_string(g.connections_total) + "\n";
+  header(o, "beamcast_uptime_seconds", "gauge", "Seconds since the server started.");
+  o += "beamcast_uptime_seconds " + num(g.uptime_s) + "\n";
+  return o;
+}
+
+nlohmann::json health_json(bool shutting_down, const Metrics::Gauges& g, const std::string& renderer) {
+  return {{"status", shutting_down ? "draining" : "ok"},
+          {"renderer", renderer},
+          {"uptime_s", g.uptime_s},
+          {"queue_depth", g.queue_depth},
+          {"inflight", g.inflight},
+          {"connections_open", g.connections_open}};
+}
+
+}  // namespace beamcast
