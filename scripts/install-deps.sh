@@ -11,6 +11,7 @@ PACKAGES=(
   glslang-tools                                       # shader compile check in the tests
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev libboost-system-dev
+  libssl-dev                                          # TLS of the HTTP listener (--tls-cert)
   clang-14 libclang-rt-14-dev                         # libFuzzer targets (fuzz/, --preset fuzz)
   python3 python3-numpy python3-matplotlib            # plots and analysis scripts
   nodejs chromium                                     # the preview page's browser test (ctest -L preview)

@@ -21,6 +21,10 @@ struct ServerConfig {
   // HTTP listener (preview page, WebSocket, GET endpoints) on `bind`; -1: none,
   // 0: any free port. beamcast-server turns it on (7879) by default.
   int http_port = -1;
+  // TLS for the HTTP listener (HTTPS/WSS): PEM certificate chain and private
+  // key files, both or neither (docs/security.md). The BCP1 port stays plain.
+  std::string tls_cert_file;
+  std::string tls_key_file;
   int device_index = -1;       // EGL device; -1: automatic
   std::string egl_platform = "auto";
   int render_workers = 1;  // threads that each own a GL context

@@ -6,13 +6,22 @@
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket.hpp>
+#include <boost/beast/websocket/ssl.hpp>
 
 #include <cstdio>
 #include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <type_traits>
 #include <vector>
+
+#include <openssl/err.h>
+#include <openssl/ssl.h>
+#include <openssl/x509.h>
 
 #include "protocol/request.hpp"
 #include "server/auth.hpp"
@@ -32,6 +41,15 @@ using tcp = asio::ip::tcp;
 constexpr std::size_t kMaxHttpHeaderBytes = 16 * 1024;
 constexpr std::size_t kMaxHttpBodyBytes = 16 * 1024;
 constexpr auto kHttpIdle = std::chrono::seconds(30);
+// A TLS close_notify exchange on a connection we are closing anyway: short.
+constexpr auto kTlsShutdown = std::chrono::seconds(5);
+
+// The two byte streams a session runs over: plain TCP, or TLS over TCP
+// (--tls-cert/--tls-key). Sessions are templates over these.
+using PlainStream = beast::tcp_stream;
+using TlsStream = beast::ssl_stream<beast::tcp_stream>;
+template <class Stream>
+constexpr bool kIsTls = std::is_same_v<Stream, TlsStream>;
 
 struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
   asio::io_context& io;
@@ -41,6 +59,7 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
   std::map<std::string, Handler, std::less<>> routes;
   std::vector<std::pair<std::string, PrefixHandler>> prefix_routes;
   std::vector<std::weak_ptr<Connection>> sockets;
+  std::optional<asio::ssl::context> tls;  // set before start(); then read-only
 
   Impl(asio::io_context& i, ServerCore& c) : io(i), core(c), acceptor(i) {}
 
@@ -82,10 +101,14 @@ namespace {
 // One WebSocket client: a Connection like a TCP session. Each text message is
 // one request; a response is one text message, followed by one binary message
 // holding its attachments when it has any.
-class WsSession : public Connection, public std::enable_shared_from_this<WsSession> {
+template <class Stream>
+class WsSession : public Connection, public std::enable_shared_from_this<WsSession<Stream>> {
+  using std::enable_shared_from_this<WsSession<Stream>>::shared_from_this;
+
  public:
-  WsSession(tcp::socket socket, ServerCore& core)
-      : ws_(std::move(socket)), core_(core), alive_(std::make_shared<std::atomic<bool>>(true)) {
+  // Takes over the HTTP session's stream (and its TLS state) after the upgrade.
+  WsSession(Stream stream, ServerCore& core)
+      : ws_(std::move(stream)), core_(core), alive_(std::make_shared<std::atomic<bool>>(true)) {
     core_.stats.connection_opened();
   }
   ~WsSession() override { core_.stats.connection_closed(); }
@@ -201,7 +224,7 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
     beast::get_lowest_layer(ws_).socket().close(ignored);
   }
 
-  websocket::stream<beast::tcp_stream> ws_;
+  websocket::stream<Stream> ws_;
   ServerCore& core_;
   std::shared_ptr<std::atomic<bool>> alive_;
   std::atomic<int> inflight_{0};
@@ -217,21 +240,42 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
 
 // One HTTP connection: GET requests answered from the routes, keep-alive, and
 // the upgrade of /ws to a WebSocket.
-class HttpSession : public std::enable_shared_from_this<HttpSession> {
+template <class Stream>
+class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
+  using std::enable_shared_from_this<HttpSession<Stream>>::shared_from_this;
+
  public:
-  HttpSession(tcp::socket socket, std::shared_ptr<HttpServer::Impl> owner)
-      : stream_(std::move(socket)), owner_(std::move(owner)) {}
+  HttpSession(Stream stream, std::shared_ptr<HttpServer::Impl> owner)
+      : stream_(std::move(stream)), owner_(std::move(owner)) {}
 
   void run() {
-    asio::dispatch(stream_.get_executor(), [self = shared_from_this()] { self->do_read(); });
+    asio::dispatch(stream_.get_executor(), [self = shared_from_this()] {
+      if constexpr (kIsTls<Stream>) {
+        self->do_handshake();
+      } else {
+        self->do_read();
+      }
+    });
   }
 
  private:
+  void do_handshake() {
+    // The handshake gets the idle deadline too: a client that connects and
+    // says nothing (or speaks plain HTTP) is dropped like an idle one.
+    beast::get_lowest_layer(stream_).expires_after(kHttpIdle);
+    stream_.async_handshake(asio::ssl::stream_base::server,
+                            [self = shared_from_this()](beast::error_code ec) {
+                              // Plain HTTP on the TLS port ends here: no page, socket closed.
+                              if (ec) return;
+                              self->do_read();
+                            });
+  }
+
   void do_read() {
     parser_.emplace();
     parser_->header_limit(kMaxHttpHeaderBytes);
     parser_->body_limit(kMaxHttpBodyBytes);
-    stream_.expires_after(kHttpIdle);
+    beast::get_lowest_layer(stream_).expires_after(kHttpIdle);
     http::async_read(stream_, buffer_, *parser_,
                      [self = shared_from_this()](beast::error_code ec, std::size_t) {
                        self->on_read(ec);
@@ -256,8 +300,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
         return reply_error(http::status::service_unavailable,
                            "max_connections reached or shutting down; retry later\n");
       }
-      stream_.expires_never();  // the WebSocket has its own timeouts
-      auto ws = std::make_shared<WsSession>(stream_.release_socket(), owner_->core);
+      beast::get_lowest_layer(stream_).expires_never();  // the WebSocket has its own timeouts
+      auto ws = std::make_shared<WsSession<Stream>>(std::move(stream_), owner_->core);
       {
         std::lock_guard lock(owner_->mu);
         std::erase_if(owner_->sockets, [](const auto& w) { return w.expired(); });
@@ -310,11 +354,17 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   }
 
   void shutdown() {
-    beast::error_code ignored;
-    stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+    if constexpr (kIsTls<Stream>) {
+      // TLS close_notify, then the socket closes with the session.
+      beast::get_lowest_layer(stream_).expires_after(kTlsShutdown);
+      stream_.async_shutdown([self = shared_from_this()](beast::error_code) {});
+    } else {
+      beast::error_code ignored;
+      stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+    }
   }
 
-  beast::tcp_stream stream_;
+  Stream stream_;
   std::shared_ptr<HttpServer::Impl> owner_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
@@ -328,8 +378,11 @@ void HttpServer::Impl::do_accept() {
     if (ec) {
       if (!self->acceptor.is_open()) return;
       std::fprintf(stderr, "beamcast-server: http accept: %s\n", ec.message().c_str());
+    } else if (self->tls) {
+      std::make_shared<HttpSession<TlsStream>>(TlsStream(std::move(socket), *self->tls), self)
+          ->run();
     } else {
-      std::make_shared<HttpSession>(std::move(socket), self)->run();
+      std::make_shared<HttpSession<PlainStream>>(PlainStream(std::move(socket)), self)->run();
     }
     self->do_accept();
   });
@@ -349,6 +402,50 @@ void HttpServer::add_get_prefix(std::string prefix, PrefixHandler handler) {
   std::lock_guard lock(impl_->mu);
   impl_->prefix_routes.emplace_back(std::move(prefix), std::move(handler));
 }
+
+namespace {
+
+// The first OpenSSL error queued by a failed call, as text ("" when none).
+std::string openssl_error() {
+  const unsigned long e = ERR_get_error();
+  ERR_clear_error();
+  if (e == 0) return "";
+  char text[256];
+  ERR_error_string_n(e, text, sizeof text);
+  return text;
+}
+
+}  // namespace
+
+void HttpServer::enable_tls(const std::string& cert_file, const std::string& key_file) {
+  asio::ssl::context ctx(asio::ssl::context::tls_server);
+  // TLS 1.2 and newer only; OpenSSL's defaults pick the ciphers.
+  ctx.set_options(asio::ssl::context::default_workarounds | asio::ssl::context::no_sslv2 |
+                  asio::ssl::context::no_sslv3 | asio::ssl::context::no_tlsv1 |
+                  asio::ssl::context::no_tlsv1_1 | asio::ssl::context::single_dh_use);
+  SSL_CTX* native = ctx.native_handle();
+  ERR_clear_error();
+  if (SSL_CTX_use_certificate_chain_file(native, cert_file.c_str()) != 1) {
+    throw std::runtime_error("cannot load TLS certificate (PEM) from '" + cert_file +
+                             "': " + openssl_error());
+  }
+  if (SSL_CTX_use_PrivateKey_file(native, key_file.c_str(), SSL_FILETYPE_PEM) != 1) {
+    // OpenSSL checks the key against the loaded certificate here already.
+    if (ERR_GET_REASON(ERR_peek_error()) == X509_R_KEY_VALUES_MISMATCH) {
+      throw std::runtime_error("TLS private key '" + key_file + "' does not match certificate '" +
+                               cert_file + "': " + openssl_error());
+    }
+    throw std::runtime_error("cannot load TLS private key (PEM) from '" + key_file +
+                             "': " + openssl_error());
+  }
+  if (SSL_CTX_check_private_key(native) != 1) {
+    throw std::runtime_error("TLS private key '" + key_file + "' does not match certificate '" +
+                             cert_file + "': " + openssl_error());
+  }
+  impl_->tls.emplace(std::move(ctx));
+}
+
+bool HttpServer::tls_enabled() const { return impl_->tls.has_value(); }
 
 unsigned short HttpServer::start(const std::string& bind, unsigned short port) {
   const tcp::endpoint ep(asio::ip::make_address(bind), port);

@@ -2,6 +2,7 @@
 // preview page, its scene lists, and whatever else a component adds, e.g.
 // /metrics), and WebSocket connections on /ws that speak the same JSON
 // requests as the BCP1 TCP protocol (protocol/PROTOCOL.md, "WebSocket").
+// Optionally TLS (HTTPS/WSS) with enable_tls(); the BCP1 port stays plain.
 //
 // Routes are registered before start(); handlers run on a network thread and
 // must be thread-safe. Binds loopback by default, like the TCP port.
@@ -40,6 +41,13 @@ class HttpServer {
   void add_get(std::string path, Handler handler);
   // Every path that starts with `prefix` (e.g. "/api/examples/") and has more after it.
   void add_get_prefix(std::string prefix, PrefixHandler handler);
+
+  // Serves HTTPS and WSS instead of HTTP and WS (call before start()). Loads
+  // a PEM certificate chain and its PEM private key; throws std::runtime_error
+  // naming the file and OpenSSL's reason when either cannot be loaded or the
+  // key does not match the certificate.
+  void enable_tls(const std::string& cert_file, const std::string& key_file);
+  bool tls_enabled() const;
 
   // Binds and starts accepting; returns the bound port (useful with port 0).
   unsigned short start(const std::string& bind, unsigned short port);

@@ -32,6 +32,13 @@ int main(int argc, char** argv) {
                  "HTTP port of the preview page and WebSocket (same address as --bind); "
                  "0 picks a free one, -1 turns HTTP off")
       ->check(CLI::Range(-1, 65535))->capture_default_str();
+  auto* tls_cert = app.add_option("--tls-cert", c.tls_cert_file,
+                                  "PEM certificate (chain) file: serve the HTTP listener as HTTPS "
+                                  "and WSS (the BCP1 TCP port stays plain); needs --tls-key");
+  auto* tls_key = app.add_option("--tls-key", c.tls_key_file,
+                                 "PEM private key file of --tls-cert");
+  tls_cert->needs(tls_key);
+  tls_key->needs(tls_cert);
   app.add_option("--device", c.device_index, "EGL device index (-1: automatic)")->capture_default_str();
   app.add_option("--platform", c.egl_platform, "EGL platform: auto, device or surfaceless")
       ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
@@ -93,7 +100,8 @@ int main(int argc, char** argv) {
     std::printf("beamcast-server listening on %s:%u\n", c.bind.c_str(), port);
     if (c.http_port >= 0) {
       const bool v6 = c.bind.find(':') != std::string::npos;
-      std::printf("beamcast-server preview: http://%s%s%s:%u/\n", v6 ? "[" : "", c.bind.c_str(),
+      std::printf("beamcast-server preview: %s://%s%s%s:%u/\n",
+                  c.tls_cert_file.empty() ? "http" : "https", v6 ? "[" : "", c.bind.c_str(),
                   v6 ? "]" : "", server.http_port());
     }
     std::fflush(stdout);

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <csignal>
+#include <stdexcept>
 
 #include "protocol/framing.hpp"
 #include "protocol/request.hpp"
@@ -37,6 +38,18 @@ Server::~Server() {
 unsigned short Server::start() {
   const ServerConfig& c = core_.config;
   check_bind_policy(c);
+  if (c.tls_cert_file.empty() != c.tls_key_file.empty()) {
+    throw std::invalid_argument("TLS needs both a certificate and a private key "
+                                "(--tls-cert FILE --tls-key FILE), or neither");
+  }
+  if (!c.tls_cert_file.empty()) {
+    if (c.http_port < 0) {
+      throw std::invalid_argument(
+          "--tls-cert/--tls-key apply to the HTTP listener, which is off (--http-port -1); "
+          "the BCP1 TCP port has no TLS (use an SSH tunnel, docs/security.md)");
+    }
+    http_->enable_tls(c.tls_cert_file, c.tls_key_file);  // before any port is bound
+  }
   core_.renders = std::make_unique<RenderService>(factory_, c.render_workers, c.encode_threads,
                                                   c.png_level, c.png_filters,
                                                   c.max_inflight_total);
