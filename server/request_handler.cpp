@@ -286,7 +286,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
         f["x"] = t.x;
         f["y"] = t.y;
       } else {
-        f["format"] = "png";
+        f["format"] = out.is_jpeg[i] ? "jpeg" : "png";
         f["bit_depth"] = bit_depth;
         f["encode_ms"] = out.encode_ms[i];
         attach(f, out.pngs[i]);
