@@ -270,8 +270,6 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
                 {"index", i},
                 {"width", cameras[i].width},
                 {"height", cameras[i].height},
-                {"format", !out.atlas && out.is_jpeg[i] ? "jpeg" : "png"},
-                {"bit_depth", bit_depth},
                 {"gpu_ms", fr.gpu_ms},
                 {"pass_ms", pass_ms},
                 {"readback_ms", fr.readback_ms},
@@ -286,7 +284,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
         f["x"] = t.x;
         f["y"] = t.y;
       } else {
-        f["format"] = "png";
+        f["format"] = out.is_jpeg[i] ? "jpeg" : "png";
         f["bit_depth"] = bit_depth;
         f["encode_ms"] = out.encode_ms[i];
         attach(f, out.pngs[i]);
