@@ -1,6 +1,11 @@
 #include "protocol/request.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
+
+#include "protocol/json_reader.hpp"
 
 #include "protocol/utf8.hpp"
 
@@ -16,31 +21,66 @@ bool valid_id_char(char c) {
 }
 }  // namespace
 
-Request parse_request(std::string_view text, nlohmann::json* id_out) {
-  *id_out = nullptr;
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    fail("bad_json", "", std::string("request is not valid JSON: ") + e.what());
-  } catch (const nlohmann::json::out_of_range& e) {
-    // A number too large for a double (1e999): the parser stops before a path is known.
-    fail("not_finite", "", std::string("request contains a number that is not finite: ") + e.what());
-  } catch (const nlohmann::json::exception& e) {
-    fail("bad_json", "", std::string("request JSON is not acceptable: ") + e.what());
+namespace {
+
+// Number of Unicode code points in valid UTF-8 (continuation bytes not counted).
+std::size_t code_points(std::string_view s) {
+  std::size_t n = 0;
+  for (unsigned char c : s) n += (c & 0xC0) != 0x80;
+  return n;
+}
+
+// An id or protocol number may be written as an integral float (7.0), as the
+// scene format accepts integers (docs/scene-format.md); it is read as 7.
+bool integral_number(const nlohmann::json& v, std::int64_t* out) {
+  if (v.is_number_integer()) {
+    if (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX)) {
+      return false;
+    }
+    *out = v.get<std::int64_t>();
+    return true;
   }
-  if (!j.is_object()) fail("bad_json", "", "request must be a JSON object");
+  if (!v.is_number_float()) return false;
+  const double d = v.get<double>();
+  if (!(d >= -9.2e18 && d <= 9.2e18) || d != std::floor(d)) return false;
+  *out = static_cast<std::int64_t>(d);
+  return true;
+}
+
+// The request's id if it is acceptable, else null.
+nlohmann::json read_id(const nlohmann::json& v, std::string* problem) {
+  if (v.is_string()) {
+    if (code_points(v.get_ref<const std::string&>()) > 128) {
+      *problem = "id must be at most 128 characters";
+      return nullptr;
+    }
+    return v;
+  }
+  std::int64_t i = 0;
+  if (integral_number(v, &i)) return i;
+  *problem = "id must be a string or an integer";
+  return nullptr;
+}
+
+}  // namespace
+
+Request parse_request(std::string_view text, nlohmann::json* id_out, const JsonLimits& limits) {
+  *id_out = nullptr;
+  BoundedParse parsed = parse_json_bounded(text, limits, /*recover_top_level_scalars=*/true);
+  nlohmann::json& j = parsed.value;
+  if (parsed.error) {
+    // Echo the id when it could be read, so a pipelining client can match the error.
+    std::string ignored;
+    if (auto id = j.find("id"); id != j.end()) *id_out = read_id(*id, &ignored);
+    throw ProtocolError(std::move(*parsed.error));
+  }
+  if (!j.is_object()) fail("bad_json", "", "a request must be a JSON object");
   Request r;
   auto id = j.find("id");
   if (id == j.end()) fail("bad_request", "/id", "request has no \"id\"");
-  if (id->is_string()) {
-    if (id->get_ref<const std::string&>().size() > 128) {
-      fail("bad_request", "/id", "id must be at most 128 characters");
-    }
-  } else if (!id->is_number_integer()) {
-    fail("bad_request", "/id", "id must be a string or an integer");
-  }
-  r.id = *id;
+  std::string problem;
+  r.id = read_id(*id, &problem);
+  if (r.id.is_null()) fail("bad_request", "/id", problem);
   *id_out = r.id;
   auto method = j.find("method");
   if (method == j.end()) fail("bad_request", "/method", "request has no \"method\"");
@@ -48,15 +88,36 @@ Request parse_request(std::string_view text, nlohmann::json* id_out) {
   r.method = method->get<std::string>();
   if (auto p = j.find("params"); p != j.end()) {
     if (!p->is_object()) fail("invalid_params", "/params", "params must be an object");
-    r.params = *p;
+    r.params = std::move(*p);
   }
   for (const auto& [key, value] : j.items()) {
     (void)value;
     if (key != "id" && key != "method" && key != "params") {
-      fail("bad_request", "/" + key, "unknown request field \"" + key + "\"");
+      fail("bad_request", json_read::child_path("", key),
+           "unknown request field \"" + to_valid_utf8(key.substr(0, 64)) +
+               "\" (a request has id, method and params)");
     }
   }
   return r;
+}
+
+int read_protocol_number(const nlohmann::json& v) {
+  std::int64_t i = 0;
+  if (!integral_number(v, &i)) fail("wrong_type", "/params/protocol", "protocol must be an integer");
+  return i < INT32_MIN || i > INT32_MAX ? -1 : static_cast<int>(i);
+}
+
+void allow_params(const nlohmann::json& params, std::initializer_list<std::string_view> allowed,
+                  std::string_view method) {
+  for (const auto& [key, value] : params.items()) {
+    (void)value;
+    if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+    std::string list;
+    for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+    fail("unknown_field", json_read::child_path("/params", key),
+         "unknown " + std::string(method) + " parameter \"" + to_valid_utf8(key.substr(0, 64)) +
+             "\" (allowed: " + list + ")");
+  }
 }
 
 nlohmann::json ok_response(const nlohmann::json& id, nlohmann::json result) {

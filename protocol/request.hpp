@@ -2,6 +2,7 @@
 // the server's sessions call these, tests and fuzzers call them directly.
 #pragma once
 
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -9,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "protocol/bounded_json.hpp"
 #include "protocol/errors.hpp"
 #include "protocol/scene.hpp"
 #include "protocol/scene_json.hpp"
@@ -23,10 +25,25 @@ struct Request {
   nlohmann::json params = nlohmann::json::object();
 };
 
-// Parses one frame's JSON text. On failure throws ProtocolError (bad_json,
-// bad_request); `*id_out` is set to the request's id as soon as it is known, so
-// the error response can carry it (null otherwise).
-Request parse_request(std::string_view json_text, nlohmann::json* id_out);
+// Parses one frame's JSON text within `limits` (max_json_depth,
+// max_json_values: enforced while parsing, protocol/bounded_json.hpp). On
+// failure throws ProtocolError (bad_json, not_finite, limit_exceeded,
+// bad_request, invalid_params); `*id_out` is set to the request's id whenever it
+// could be read, also when the rest of the text is refused, so the error
+// response can carry it (null otherwise). An id written as an integral float
+// (7.0) is read as the integer 7; a string id has at most 128 characters
+// (code points).
+Request parse_request(std::string_view json_text, nlohmann::json* id_out,
+                      const JsonLimits& limits = {});
+
+// hello's params.protocol: an integer, integral floats accepted (1.0);
+// wrong_type otherwise. Out-of-int range values come back as -1.
+int read_protocol_number(const nlohmann::json& v);
+
+// Refuses (unknown_field, at /params/<key>) a key of a method's params that
+// is not in `allowed`; every method but ping (which echoes anything) checks.
+void allow_params(const nlohmann::json& params, std::initializer_list<std::string_view> allowed,
+                  std::string_view method);
 
 nlohmann::json ok_response(const nlohmann::json& id, nlohmann::json result);
 nlohmann::json error_response(const nlohmann::json& id, const ErrorInfo& error);

@@ -2,7 +2,9 @@
 // docs/scene-format.md; keep the two in step.
 #include "protocol/scene_json.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -422,7 +424,11 @@ OutputSettings parse_output_settings(const json& j, const std::string& path) {
   return parse_output(Node{&j, path});
 }
 
-Camera parse_camera(const json& j, const std::string& path, const SceneLimits& limits) {
+namespace {
+
+// Every camera field except the size check: rigs check the size of the frames
+// they make themselves (a cube map's size is its own field).
+Camera parse_camera_fields(const json& j, const std::string& path, const SceneLimits& limits) {
   const Node n{&j, path};
   ObjectReader o(n, "a camera");
   o.allow_only({"name", "position", "target", "rotation", "up", "projection", "fov_y",
@@ -463,19 +469,68 @@ Camera parse_camera(const json& j, const std::string& path, const SceneLimits& l
              " and far " + format_number(c.far_plane));
   }
 
-  if (auto v = o.optional("width"))
-    c.width = read_int_limited(*v, 1, limits.max_width, "max_width");
+  if (auto v = o.optional("width")) c.width = read_int_limited(*v, 1, limits.max_width, "max_width");
   if (auto v = o.optional("height")) {
     c.height = read_int_limited(*v, 1, limits.max_height, "max_height");
   }
-  const std::int64_t pixels = static_cast<std::int64_t>(c.width) * c.height;
-  if (pixels > limits.max_pixels) {
-    fail("limit_exceeded", o.path_of("width"),
-         "width * height = " + std::to_string(pixels) +
-             " pixels, over the limit max_pixels = " + std::to_string(limits.max_pixels));
-  }
   return c;
 }
+
+// Where a camera's (or a rig's) width and height came from: the field, or the
+// object itself when the default applied.
+std::string size_path(const json& j, const std::string& path, const char* key) {
+  return j.is_object() && j.contains(key) ? child_path(path, key) : path;
+}
+
+}  // namespace
+
+void check_frame_size(std::int64_t width, std::int64_t height, const SceneLimits& limits,
+                      const std::string& width_path, const std::string& height_path,
+                      std::string_view what) {
+  const std::string w = std::to_string(width), h = std::to_string(height);
+  // A path that ends in the object rather than a size field: the default applied.
+  const auto dflt = [](const std::string& p) {
+    return p.ends_with("/width") || p.ends_with("/height") || p.ends_with("/size") ? ""
+                                                                                   : " (the default)";
+  };
+  if (width > limits.max_width) {
+    fail("limit_exceeded", width_path,
+         std::string(what) + " width " + w + dflt(width_path) +
+             " is over the limit max_width = " + std::to_string(limits.max_width));
+  }
+  if (height > limits.max_height) {
+    fail("limit_exceeded", height_path,
+         std::string(what) + " height " + h +
+             dflt(height_path) +
+             " is over the limit max_height = " + std::to_string(limits.max_height));
+  }
+  if (width * height > limits.max_pixels) {
+    fail("limit_exceeded", width_path,
+         std::string(what) + " of " + w + " x " + h + " = " + std::to_string(width * height) +
+             " pixels is over the limit max_pixels = " + std::to_string(limits.max_pixels));
+  }
+}
+
+AtlasGrid atlas_grid(const std::vector<std::pair<int, int>>& sizes) {
+  AtlasGrid g;
+  const int k = static_cast<int>(sizes.size());
+  if (k == 0) return g;
+  g.columns = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(k))));
+  g.rows = (k + g.columns - 1) / g.columns;
+  for (const auto& [w, h] : sizes) {
+    g.cell_width = std::max(g.cell_width, w);
+    g.cell_height = std::max(g.cell_height, h);
+  }
+  return g;
+}
+
+Camera parse_camera(const json& j, const std::string& path, const SceneLimits& limits) {
+  Camera c = parse_camera_fields(j, path, limits);
+  check_frame_size(c.width, c.height, limits, size_path(j, path, "width"),
+                   size_path(j, path, "height"), "camera");
+  return c;
+}
+
 
 namespace {
 
@@ -492,7 +547,7 @@ Camera read_rig_base(const json& j, const std::string& path, const SceneLimits& 
   for (std::string_view key : kIntrinsics) {
     if (auto it = j.find(key); it != j.end()) subset[std::string(key)] = *it;
   }
-  return parse_camera(subset, path, limits);
+  return parse_camera_fields(subset, path, limits);
 }
 
 int read_rig_count(const ObjectReader& o, const SceneLimits& limits) {
@@ -521,7 +576,10 @@ std::vector<Camera> parse_orbit(const ObjectReader& o, const json& j, const std:
     rig.elevation_deg = check_open(*v, read_number(*v), -90.0, 90.0);
   }
   if (auto v = o.optional("start")) rig.start_deg = read_number(*v);
-  std::vector<Camera> cams = expand_orbit(rig, read_rig_base(j, o.path(), limits), prefix);
+  const Camera base = read_rig_base(j, o.path(), limits);
+  check_frame_size(base.width, base.height, limits, size_path(j, o.path(), "width"),
+                   size_path(j, o.path(), "height"), "orbit camera");
+  std::vector<Camera> cams = expand_orbit(rig, base, prefix);
   for (const Camera& c : cams) {
     // Rounding can still bring a camera within 1e-6 of its up axis (elevation
     // a hair under 90); the same rule as a plain look-at camera.
@@ -539,14 +597,9 @@ std::vector<Camera> parse_cubemap(const ObjectReader& o, const json& j, const st
   CubemapRig rig;
   if (auto v = o.optional("position")) rig.position = read_point(*v, limits);
   Camera base = read_rig_base(j, o.path(), limits);
-  if (auto v = o.optional("size")) {
-    base.width = read_int_limited(*v, 1, std::min(limits.max_width, limits.max_height),
-                                  "max_width, max_height");
-    if (static_cast<std::int64_t>(base.width) * base.width > limits.max_pixels) {
-      fail("limit_exceeded", v->path,
-           "size * size is over the limit max_pixels = " + std::to_string(limits.max_pixels));
-    }
-  }
+  if (auto v = o.optional("size")) base.width = read_int_limited(*v, 1, std::numeric_limits<int>::max(), "size");
+  const std::string where = size_path(j, o.path(), "size");
+  check_frame_size(base.width, base.width, limits, where, where, "cube map face");
   return expand_cubemap(rig, base, prefix);
 }
 
@@ -571,7 +624,10 @@ std::vector<Camera> parse_stereo(const ObjectReader& o, const json& j, const std
     }
   }
   if (auto v = o.optional("convergence")) rig.convergence = read_size(*v, limits);
-  return expand_stereo(rig, read_rig_base(j, o.path(), limits), prefix);
+  const Camera base = read_rig_base(j, o.path(), limits);
+  check_frame_size(base.width, base.height, limits, size_path(j, o.path(), "width"),
+                   size_path(j, o.path(), "height"), "stereo camera");
+  return expand_stereo(rig, base, prefix);
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -50,6 +52,26 @@ std::vector<Camera> parse_camera_entry(const nlohmann::json& j, const std::strin
 // max_cameras after expansion, names unique.
 std::vector<Camera> parse_camera_list(const nlohmann::json& j, const std::string& path,
                                       const SceneLimits& limits);
+// The one check of a frame's size against max_width, max_height and
+// max_pixels, for every frame the server renders or composes: cameras (also
+// with default sizes), rig cameras, cube map faces, atlases. `width_path` and
+// `height_path` name the fields that set the size, or the object whose default
+// applied; `what` names the frame in the message ("camera", "atlas"). Throws
+// limit_exceeded.
+void check_frame_size(std::int64_t width, std::int64_t height, const SceneLimits& limits,
+                      const std::string& width_path, const std::string& height_path,
+                      std::string_view what);
+
+// The grid of an atlas of frames of these sizes (PROTOCOL.md, "Atlas";
+// render/atlas.hpp composes it): columns = ceil(sqrt(K)), rows = ceil(K /
+// columns), cells as large as the largest frame.
+struct AtlasGrid {
+  int columns = 0, rows = 0, cell_width = 0, cell_height = 0;
+  std::int64_t width() const { return static_cast<std::int64_t>(columns) * cell_width; }
+  std::int64_t height() const { return static_cast<std::int64_t>(rows) * cell_height; }
+};
+AtlasGrid atlas_grid(const std::vector<std::pair<int, int>>& sizes);
+
 // A camera as scene JSON (parse_camera of the result gives the camera back;
 // numbers are written with full double precision).
 nlohmann::json camera_to_json(const Camera& c);

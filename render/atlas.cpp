@@ -1,5 +1,7 @@
 #include "render/atlas.hpp"
 
+#include "protocol/scene_json.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -10,15 +12,18 @@ Atlas make_atlas(const std::vector<const Image*>& frames) {
   if (frames.empty()) throw std::invalid_argument("make_atlas: no frames");
   Atlas a;
   const int k = static_cast<int>(frames.size());
-  a.columns = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(k))));
-  a.rows = (k + a.columns - 1) / a.columns;
+  std::vector<std::pair<int, int>> sizes;
   for (const Image* f : frames) {
     if (f->bit_depth != frames[0]->bit_depth) {
       throw std::invalid_argument("make_atlas: frames of different bit depths");
     }
-    a.cell_width = std::max(a.cell_width, f->width);
-    a.cell_height = std::max(a.cell_height, f->height);
+    sizes.emplace_back(f->width, f->height);
   }
+  const AtlasGrid g = atlas_grid(sizes);  // the grid the server checked against its limits
+  a.columns = g.columns;
+  a.rows = g.rows;
+  a.cell_width = g.cell_width;
+  a.cell_height = g.cell_height;
   Image& img = a.image;
   img.width = a.columns * a.cell_width;
   img.height = a.rows * a.cell_height;

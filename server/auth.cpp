@@ -48,17 +48,21 @@ bool http_request_authorized(const ServerConfig& config, std::string_view path,
   return token_matches(authorization_header.substr(kBearer.size()), config.token);
 }
 
-void check_unauthenticated_request(const ServerConfig& config, const std::string& method,
-                                   const nlohmann::json& params) {
+void check_request_token(const ServerConfig& config, const std::string& method,
+                         const nlohmann::json& params, bool authenticated) {
+  if (!token_required(config)) return;
   if (method != "hello") {
+    if (authenticated) return;
     throw ProtocolError({"unauthorized",
                          "this server requires a token: send hello with params.token first", ""});
   }
   const auto it = params.find("token");
-  if (it == params.end() || !it->is_string()) {
+  if (it == params.end()) {
     throw ProtocolError(
-        {"unauthorized", "this server requires a token: params.token (a string) is missing",
-         "/params/token"});
+        {"unauthorized", "this server requires a token: params.token is missing", "/params/token"});
+  }
+  if (!it->is_string()) {
+    throw ProtocolError({"unauthorized", "params.token must be a string", "/params/token"});
   }
   if (!token_matches(it->get_ref<const std::string&>(), config.token)) {
     throw ProtocolError({"unauthorized", "the token does not match", "/params/token"});

@@ -34,11 +34,14 @@ bool token_matches(std::string_view presented, std::string_view expected);
 bool http_request_authorized(const ServerConfig& config, std::string_view path,
                              std::string_view authorization_header);
 
-// The gate in front of every request on a connection that has not
-// authenticated yet (only called when token_required): a `hello` whose
-// params.token matches passes (returns normally, the caller marks the session);
-// anything else throws ProtocolError "unauthorized".
-void check_unauthenticated_request(const ServerConfig& config, const std::string& method,
-                                   const nlohmann::json& params);
+// The gate in front of every request (PROTOCOL.md, "Token"); does nothing
+// without a configured token. Every `hello` must carry the token in
+// params.token (a string), also on an already authenticated connection: a
+// missing, non-string or wrong token throws ProtocolError "unauthorized" at
+// /params/token. Any other method on a connection that is not authenticated
+// throws "unauthorized". Passing this check does not authenticate: the caller
+// marks the connection only once its hello has succeeded.
+void check_request_token(const ServerConfig& config, const std::string& method,
+                         const nlohmann::json& params, bool authenticated);
 
 }  // namespace beamcast

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string>
 
+#include "protocol/bounded_json.hpp"
 #include "protocol/scene_json.hpp"
 
 namespace beamcast {
@@ -47,6 +48,9 @@ struct ServerConfig {
                            .max_pixels = 4096LL * 4096LL,
                            .max_mesh_triangles = 1000000};
   std::uint64_t max_message_bytes = 16u << 20;
+  // Enforced while a request's JSON is parsed (protocol/bounded_json.hpp):
+  // max_json_depth (nesting) and max_json_values (values in one request).
+  JsonLimits json_limits;
   int max_inflight_per_connection = 16;
   int max_inflight_total = 64;
   int max_connections = 256;

@@ -3,6 +3,7 @@
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
@@ -26,6 +27,7 @@
 #include "protocol/request.hpp"
 #include "server/auth.hpp"
 #include "server/connection.hpp"
+#include "server/memory.hpp"
 #include "server/request_handler.hpp"
 #include "server/server_core.hpp"
 
@@ -108,7 +110,10 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
  public:
   // Takes over the HTTP session's stream (and its TLS state) after the upgrade.
   WsSession(Stream stream, ServerCore& core)
-      : ws_(std::move(stream)), core_(core), alive_(std::make_shared<std::atomic<bool>>(true)) {
+      : ws_(std::move(stream)),
+        core_(core),
+        message_timer_(ws_.get_executor()),
+        alive_(std::make_shared<std::atomic<bool>>(true)) {
     core_.stats.connection_opened();
   }
   ~WsSession() override { core_.stats.connection_closed(); }
@@ -153,12 +158,28 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
   }
 
  private:
+  // A message is read in pieces (read_some) so that its deadline can start
+  // with its first bytes: as on TCP, a started message must be complete
+  // within read_timeout_ms (PROTOCOL.md, "Limits"). Between messages only
+  // Beast's idle timeout (idle_timeout_ms, with pings) applies.
   void do_read() {
-    if (closed_ || paused_) return;
+    if (closed_ || (paused_ && !in_message_)) return;
     read_pending_ = true;
-    ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      self->on_read(ec);
-    });
+    ws_.async_read_some(buffer_, 64 * 1024,
+                        [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                          self->on_read(ec);
+                        });
+  }
+
+  void on_message_deadline(beast::error_code ec) {
+    if (ec == asio::error::operation_aborted || closed_ || !in_message_) return;
+    if (message_timer_.expiry() > std::chrono::steady_clock::now()) return;
+    const ErrorInfo e{"timeout",
+                      "message incomplete after read_timeout_ms (" +
+                          std::to_string(core_.config.read_timeout_ms) + " ms)",
+                      ""};
+    send_error(nullptr, e);
+    close_after_write_ = true;
   }
 
   void on_read(beast::error_code ec) {
@@ -168,7 +189,18 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
       core_.stats.count_error("message_too_large");
       return close_now();
     }
-    if (ec || closed_) return close_now();
+    if (ec || closed_ || close_after_write_) return close_now();
+    if (!in_message_) {
+      in_message_ = true;
+      message_timer_.expires_after(std::chrono::milliseconds(core_.config.read_timeout_ms));
+      message_timer_.async_wait([self = shared_from_this()](beast::error_code e) {
+        self->on_message_deadline(e);
+      });
+    }
+    if (!ws_.is_message_done()) return do_read();
+    in_message_ = false;
+    message_timer_.cancel();
+    std::size_t bytes = buffer_.size();
     if (!ws_.got_text()) {
       send_error(nullptr, ErrorInfo{"bad_request",
                                     "binary WebSocket messages are not requests; send each "
@@ -176,9 +208,12 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
                                     ""});
     } else {
       const std::string text = beast::buffers_to_string(buffer_.data());
+      buffer_.consume(buffer_.size());
+      buffer_.shrink_to_fit();
       handle_message(core_, shared_from_this(), text, std::chrono::steady_clock::now());
     }
     buffer_.consume(buffer_.size());
+    release_large_message_memory(bytes);
     do_read();
   }
 
@@ -207,6 +242,7 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
     writes_.pop_front();
     if (!writes_.empty()) return do_write();
     writing_ = false;
+    if (close_after_write_) return close_now();
     if (paused_ && queued_bytes_ <= core_.config.max_write_queue_bytes / 2) {
       paused_ = false;
       if (!read_pending_) do_read();
@@ -219,6 +255,7 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
     alive_->store(false);
     writes_.clear();
     queued_bytes_ = 0;
+    message_timer_.cancel();
     beast::error_code ignored;
     beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ignored);
     beast::get_lowest_layer(ws_).socket().close(ignored);
@@ -226,6 +263,7 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
 
   websocket::stream<Stream> ws_;
   ServerCore& core_;
+  asio::steady_timer message_timer_;  // read_timeout_ms of the message being read
   std::shared_ptr<std::atomic<bool>> alive_;
   std::atomic<int> inflight_{0};
   // Strand-only state.
@@ -235,6 +273,8 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
   bool writing_ = false;
   bool paused_ = false;
   bool read_pending_ = false;
+  bool in_message_ = false;         // part of a message has arrived
+  bool close_after_write_ = false;  // a timeout was sent: close once written
   bool closed_ = false;
 };
 

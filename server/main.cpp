@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "protocol/scene_json.hpp"
+#include "protocol/bounded_json.hpp"
 #include "server/demo_scene.hpp"
 #include "server/server.hpp"
 
@@ -63,6 +64,8 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet-requests", quiet_requests,
                "No per-request log lines on stderr (one JSON object per answered request)");
   app.add_option("--max-message-bytes", c.max_message_bytes)->capture_default_str();
+  app.add_option("--max-json-depth", c.json_limits.max_depth)->check(CLI::Range(1, 100000))->capture_default_str();
+  app.add_option("--max-json-values", c.json_limits.max_values)->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40))->capture_default_str();
   app.add_option("--max-width", l.max_width)->capture_default_str();
   app.add_option("--max-height", l.max_height)->capture_default_str();
   app.add_option("--max-pixels", l.max_pixels)->capture_default_str();
@@ -94,6 +97,33 @@ int main(int argc, char** argv) {
     RendererOptions ropts;
     ropts.egl.device_index = c.device_index;
     ropts.egl.platform = c.egl_platform;
+    // The demo scene is checked against this server's limits before it
+    // listens: a limit it exceeds is a start-up error that names it.
+    std::shared_ptr<StoredScene> demo;
+    if (!no_demo) {
+      try {
+        const auto j = parse_json_or_throw(kDemoSceneJson, c.json_limits);
+        SceneLoadOptions opts{c.assets_dir, c.scene_limits};
+        demo = std::make_shared<StoredScene>();
+        demo->scene = parse_scene(j, opts);
+        demo->bytes = j.dump().size();
+        demo->json = j;
+        if (demo->bytes > c.max_scene_store_bytes) {
+          throw ProtocolError({"limit_exceeded",
+                               "it takes " + std::to_string(demo->bytes) +
+                                   " bytes, over max_scene_store_bytes = " +
+                                   std::to_string(c.max_scene_store_bytes),
+                               ""});
+        }
+      } catch (const ProtocolError& e) {
+        std::fprintf(stderr,
+                     "beamcast-server: the demo scene (examples/paper_10sets.json, preloaded as "
+                     "'demo') does not fit this server's limits: %s; raise the limit or pass "
+                     "--no-demo\n",
+                     e.what());
+        return 1;
+      }
+    }
     Server server(c, gl_renderer_factory(ropts));
     const unsigned short port = server.start();
     // First line of output: tools and tests read the port from it.
@@ -107,14 +137,8 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     std::fprintf(stderr, "beamcast-server: renderer: %s\n",
                  server.core().renderer_description.c_str());
-    if (!no_demo) {
-      const auto j = nlohmann::json::parse(kDemoSceneJson);
-      SceneLoadOptions opts{c.assets_dir, c.scene_limits};
-      auto stored = std::make_shared<StoredScene>();
-      stored->scene = parse_scene(j, opts);
-      stored->bytes = j.dump().size();
-      stored->json = j;
-      server.core().scenes.put("demo", std::move(stored));
+    if (demo) {
+      server.core().scenes.put("demo", std::move(demo));
       std::fprintf(stderr, "beamcast-server: scene 'demo' preloaded (the paper's 10 beam sets)\n");
     }
     server.run(/*handle_signals=*/true);

@@ -17,6 +17,8 @@
 
 #include <boost/asio/thread_pool.hpp>
 
+#include "server/threads.hpp"
+
 #include "protocol/errors.hpp"
 #include "protocol/scene.hpp"
 #include "render/atlas.hpp"
@@ -131,7 +133,7 @@ class RenderService {
   std::string description_;
   std::string failure_;
   std::condition_variable ready_cv_;
-  std::vector<std::thread> workers_;
+  std::vector<SizedThread> workers_;  // each owns a GL context
   boost::asio::thread_pool encoders_;
 };
 

@@ -56,6 +56,8 @@ const json& required_object(const json& params, const char* key) {
 json limits_json(const ServerConfig& c) {
   const SceneLimits& l = c.scene_limits;
   return {{"max_message_bytes", c.max_message_bytes},
+          {"max_json_depth", c.json_limits.max_depth},
+          {"max_json_values", c.json_limits.max_values},
           {"max_width", l.max_width},
           {"max_height", l.max_height},
           {"max_pixels", l.max_pixels},
@@ -75,9 +77,12 @@ json limits_json(const ServerConfig& c) {
 }
 
 json hello_result(const ServerCore& core, const json& params) {
+  allow_params(params, {"protocol", "client", "token"}, "hello");
+  if (auto c = params.find("client"); c != params.end() && !c->is_string()) {
+    fail("wrong_type", "/params/client", "client must be a string (\"name/version\")");
+  }
   if (auto p = params.find("protocol"); p != params.end()) {
-    if (!p->is_number_integer()) fail("wrong_type", "/params/protocol", "protocol must be an integer");
-    if (p->get<long long>() != kProtocolVersion) {
+    if (read_protocol_number(*p) != kProtocolVersion) {
       fail("unsupported_protocol", "/params/protocol",
            "this server speaks protocol " + std::to_string(kProtocolVersion));
     }
@@ -103,6 +108,7 @@ json hello_result(const ServerCore& core, const json& params) {
 
 // stats' params.format: "json" (default), "prometheus" or "health".
 std::string stats_format(const json& params) {
+  allow_params(params, {"format"}, "stats");
   const auto it = params.find("format");
   if (it == params.end()) return "json";
   if (!it->is_string() || (*it != "json" && *it != "prometheus" && *it != "health")) {
@@ -111,9 +117,19 @@ std::string stats_format(const json& params) {
   return it->get<std::string>();
 }
 
-json store_scene(ServerCore& core, const std::string& id, json scene_json, Scene scene) {
+// `path`: where the scene came from in the request (for limit_exceeded).
+json store_scene(ServerCore& core, const std::string& id, json scene_json, Scene scene,
+                 const char* path) {
   auto stored = std::make_shared<StoredScene>();
   stored->bytes = scene_json.dump().size();
+  // The store never holds more than max_scene_store_bytes: a scene larger than
+  // the whole store is refused (evicting everything would not make it fit).
+  if (stored->bytes > core.config.max_scene_store_bytes) {
+    fail("limit_exceeded", path,
+         "the scene takes " + std::to_string(stored->bytes) +
+             " bytes as stored JSON, over the limit max_scene_store_bytes = " +
+             std::to_string(core.config.max_scene_store_bytes));
+  }
   stored->json = std::move(scene_json);
   stored->scene = std::move(scene);
   const std::uint64_t bytes = stored->bytes;
@@ -148,6 +164,14 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     scene = std::move(copy);
   }
   std::vector<Camera> cameras = rp.cameras ? *rp.cameras : scene->cameras;
+  if (rp.atlas) {
+    // The composed image is a frame too: same limits as every camera.
+    std::vector<std::pair<int, int>> sizes;
+    for (const Camera& c : cameras) sizes.emplace_back(c.width, c.height);
+    const AtlasGrid g = atlas_grid(sizes);
+    check_frame_size(g.width(), g.height(), core.config.scene_limits, "/params/atlas",
+                     "/params/atlas", "the atlas");
+  }
 
   // quality "auto": the connection's accuracy controller picks this frame's level.
   std::optional<ControllerDecision> decision;
@@ -285,7 +309,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
         f["y"] = t.y;
       } else {
         f["format"] = out.is_jpeg[i] ? "jpeg" : "png";
-        f["bit_depth"] = bit_depth;
+        f["bit_depth"] = out.is_jpeg[i] ? 8 : bit_depth;  // JPEG has 8 bits per channel
         f["encode_ms"] = out.encode_ms[i];
         attach(f, out.pngs[i]);
       }
@@ -304,7 +328,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
                 {"width", a.columns * a.cell_width},
                 {"height", a.rows * a.cell_height},
                 {"format", out.is_jpeg[0] ? "jpeg" : "png"},
-                {"bit_depth", bit_depth},
+                {"bit_depth", out.is_jpeg[0] ? 8 : bit_depth},
                 {"encode_ms", out.encode_ms[0]},
                 {"atlas",
                  {{"columns", a.columns},
@@ -372,7 +396,7 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
   json id;
   std::string method = "(invalid)";  // metrics key: a known method or a fixed placeholder
   try {
-    const Request req = parse_request(json_text, &id);
+    const Request req = parse_request(json_text, &id, core.config.json_limits);
     static const char* kMethods[] = {"hello", "ping", "stats", "render", "scene.put",
                                      "scene.update", "scene.delete"};
     // Count unknown methods under one key: client-chosen strings must not grow the map.
@@ -381,16 +405,16 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
     method = known ? req.method : "(unknown)";
     core.stats.count_request(method);
     const json& params = req.params;
-    if (token_required(core.config) && !session->authenticated()) {
-      check_unauthenticated_request(core.config, req.method, params);
-      session->set_authenticated();
-    }
+    check_request_token(core.config, req.method, params, session->authenticated());
     const bool mutating = req.method == "render" || req.method.starts_with("scene.");
     if (mutating && core.shutting_down.load()) {
       fail("shutting_down", "", "the server is shutting down and takes no new work");
     }
     if (req.method == "hello") {
-      session->send(ok_response(id, hello_result(core, params)));
+      json result = hello_result(core, params);
+      // Only a hello that succeeded (token and protocol) authenticates.
+      if (token_required(core.config)) session->set_authenticated();
+      session->send(ok_response(id, std::move(result)));
     } else if (req.method == "ping") {
       session->send(ok_response(id, {{"echo", params}}));
     } else if (req.method == "stats" && stats_format(params) == "prometheus") {
@@ -410,11 +434,13 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
     } else if (req.method == "render") {
       handle_render(core, session, id, params, arrived);
     } else if (req.method == "scene.put") {
+      allow_params(params, {"scene_id", "scene"}, "scene.put");
       const std::string sid = parse_scene_id(params, "/params/scene_id");
       const json& sj = required_object(params, "scene");
       Scene scene = parse_scene_at(core, sj, "/params/scene");
-      session->send(ok_response(id, store_scene(core, sid, sj, std::move(scene))));
+      session->send(ok_response(id, store_scene(core, sid, sj, std::move(scene), "/params/scene")));
     } else if (req.method == "scene.update") {
+      allow_params(params, {"scene_id", "patch"}, "scene.update");
       const std::string sid = parse_scene_id(params, "/params/scene_id");
       const json& patch = required_object(params, "patch");
       auto stored = core.scenes.get(sid);
@@ -422,8 +448,10 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
       json merged = stored->json;
       merged.merge_patch(patch);
       Scene scene = parse_scene_at(core, merged, "/params/patch");
-      session->send(ok_response(id, store_scene(core, sid, std::move(merged), std::move(scene))));
+      session->send(ok_response(
+          id, store_scene(core, sid, std::move(merged), std::move(scene), "/params/patch")));
     } else if (req.method == "scene.delete") {
+      allow_params(params, {"scene_id"}, "scene.delete");
       const std::string sid = parse_scene_id(params, "/params/scene_id");
       if (!core.scenes.erase(sid)) fail("unknown_scene", "/params/scene_id", "no stored scene \"" + sid + "\"");
       session->send(ok_response(id, {{"deleted", true}}));

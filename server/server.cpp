@@ -2,14 +2,17 @@
 
 #include <boost/asio/post.hpp>
 #include <boost/asio/strand.hpp>
+
 #include <boost/asio/write.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <csignal>
 #include <stdexcept>
 
 #include "protocol/framing.hpp"
 #include "protocol/request.hpp"
+#include "server/threads.hpp"
 #include "server/auth.hpp"
 #include "server/session.hpp"
 
@@ -117,10 +120,13 @@ void Server::run(bool handle_signals) {
       shutdown();
     });
   }
-  std::vector<std::thread> extra;
-  for (int i = 1; i < core_.config.network_threads; ++i) extra.emplace_back([this] { io_.run(); });
-  io_.run();
-  for (auto& t : extra) t.join();
+  // Every network thread, the first too, gets a stack of known size
+  // (server/threads.hpp): request handling walks client JSON recursively.
+  std::vector<SizedThread> threads;
+  for (int i = 0; i < std::max(1, core_.config.network_threads); ++i) {
+    threads.emplace_back([this] { io_.run(); });
+  }
+  for (auto& t : threads) t.join();
 }
 
 void Server::shutdown() {

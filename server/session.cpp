@@ -9,6 +9,7 @@
 
 #include "protocol/request.hpp"
 #include "server/request_handler.hpp"
+#include "server/memory.hpp"
 
 namespace beamcast {
 
@@ -32,11 +33,29 @@ void Session::start() {
 
 void Session::do_read_header() {
   if (closed_) return;
-  state_ = ReadState::kHeader;
+  state_ = ReadState::kIdle;
   if (paused_) return;  // resumed by on_write once the client has read enough
   arm_read_deadline();
   read_pending_ = true;
-  asio::async_read(socket_, asio::buffer(header_),
+  // The first byte alone: it starts the message's read_timeout_ms, so a client
+  // that sends part of a header and stops is timed out like a slow body.
+  asio::async_read(socket_, asio::buffer(header_.data(), 1),
+                   [self = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
+                     self->on_first_byte(ec, n);
+                   });
+}
+
+void Session::on_first_byte(const boost::system::error_code& ec, std::size_t) {
+  read_pending_ = false;
+  if (ec || closed_) {
+    close_now();  // peer closed or reset: nothing to answer
+    return;
+  }
+  state_ = ReadState::kHeader;
+  message_deadline_ = Clock::now() + std::chrono::milliseconds(core_.config.read_timeout_ms);
+  arm_read_deadline();
+  read_pending_ = true;
+  asio::async_read(socket_, asio::buffer(header_.data() + 1, header_.size() - 1),
                    [self = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
                      self->on_header(ec, n);
                    });
@@ -57,9 +76,15 @@ void Session::on_header(const boost::system::error_code& ec, std::size_t) {
       // The stream cannot be resynchronized: answer once, then close.
       state_ = ReadState::kStopped;
       read_timer_.cancel();
+      // Earlier requests still in flight are answered by nobody: say how many.
+      const int dropped = inflight_.load();
       const ErrorInfo e{"bad_framing",
                         "expected a frame starting with \"BCP1\" and a non-zero JSON length "
-                        "(see PROTOCOL.md, Framing)",
+                        "(see PROTOCOL.md, Framing); the connection is closed" +
+                            (dropped > 0 ? "; " + std::to_string(dropped) +
+                                               " earlier request(s) still in flight are cancelled "
+                                               "without a response"
+                                         : std::string()),
                         ""};
       core_.stats.count_error(e.code);
       enqueue(encode_frame(error_response(nullptr, e).dump()), true);
@@ -74,14 +99,12 @@ void Session::on_header(const boost::system::error_code& ec, std::size_t) {
       send_error(nullptr, e);
       discard_left_ = h.body_length();
       state_ = ReadState::kDiscard;
-      arm_read_deadline();
       do_discard();
       return;
     }
   }
   body_.resize(h.body_length());
   state_ = ReadState::kBody;
-  arm_read_deadline();
   read_pending_ = true;
   asio::async_read(socket_, asio::buffer(body_),
                    [self = shared_from_this(), json_len = h.json_length](
@@ -97,10 +120,12 @@ void Session::on_body(const boost::system::error_code& ec, std::size_t) {
     close_now();
     return;
   }
+  read_timer_.cancel();
   const std::string text(body_.begin(), body_.end());
   body_.clear();
   body_.shrink_to_fit();
   handle_message(core_, shared_from_this(), text, Clock::now());
+  release_large_message_memory(text.size());
   do_read_header();
 }
 
@@ -124,9 +149,11 @@ void Session::do_discard() {
 }
 
 void Session::arm_read_deadline() {
-  const int ms =
-      state_ == ReadState::kHeader ? core_.config.idle_timeout_ms : core_.config.read_timeout_ms;
-  read_timer_.expires_after(std::chrono::milliseconds(ms));
+  if (state_ == ReadState::kIdle) {
+    read_timer_.expires_after(std::chrono::milliseconds(core_.config.idle_timeout_ms));
+  } else {
+    read_timer_.expires_at(message_deadline_);
+  }
   read_timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
     self->on_read_deadline(ec);
   });
@@ -135,13 +162,14 @@ void Session::arm_read_deadline() {
 void Session::on_read_deadline(const boost::system::error_code& ec) {
   if (ec == asio::error::operation_aborted || closed_) return;
   if (read_timer_.expiry() > Clock::now()) return;  // re-armed since this wait began
-  if (state_ == ReadState::kHeader) {
+  if (state_ == ReadState::kIdle) {
     if (!read_pending_) return;  // paused, not idle
     std::fprintf(stderr, "beamcast-server: closing idle connection\n");
     close_now();
     return;
   }
-  if (state_ == ReadState::kBody || state_ == ReadState::kDiscard) {
+  if (state_ == ReadState::kHeader || state_ == ReadState::kBody ||
+      state_ == ReadState::kDiscard) {
     const ErrorInfo e{"timeout",
                       "message incomplete after read_timeout_ms (" +
                           std::to_string(core_.config.read_timeout_ms) + " ms)",
@@ -214,7 +242,7 @@ void Session::on_write(const boost::system::error_code& ec, std::size_t) {
 void Session::resume_reading_if_paused() {
   if (paused_ && queued_bytes_ <= core_.config.max_write_queue_bytes / 2) {
     paused_ = false;
-    if (state_ == ReadState::kHeader && !read_pending_) do_read_header();
+    if (state_ == ReadState::kIdle && !read_pending_) do_read_header();
   }
 }
 

@@ -39,13 +39,19 @@ class Session : public Connection, public std::enable_shared_from_this<Session> 
   std::shared_ptr<const std::atomic<bool>> alive_flag() const override { return alive_; }
 
  private:
-  enum class ReadState { kHeader, kBody, kDiscard, kStopped };
+  // kIdle: between messages (idle_timeout_ms); kHeader, kBody, kDiscard: a
+  // message has started (its first byte arrived) and must be complete within
+  // read_timeout_ms of that byte.
+  enum class ReadState { kIdle, kHeader, kBody, kDiscard, kStopped };
 
   void do_read_header();
+  void on_first_byte(const boost::system::error_code& ec, std::size_t n);
   void on_header(const boost::system::error_code& ec, std::size_t n);
   void do_read_body();
   void on_body(const boost::system::error_code& ec, std::size_t n);
   void do_discard();
+  // Idle: idle_timeout_ms from now. A started message: read_timeout_ms from
+  // its first byte (message_deadline_), not re-armed per read.
   void arm_read_deadline();
   void on_read_deadline(const boost::system::error_code& ec);
   void enqueue(std::vector<std::uint8_t> frame, bool close_after);
@@ -62,7 +68,8 @@ class Session : public Connection, public std::enable_shared_from_this<Session> 
   std::atomic<int> inflight_{0};
 
   // Strand-only state.
-  ReadState state_ = ReadState::kHeader;
+  ReadState state_ = ReadState::kIdle;
+  std::chrono::steady_clock::time_point message_deadline_{};
   bool read_pending_ = false;  // an async read is outstanding
   bool paused_ = false;        // reading stopped: write queue over its limit
   std::array<std::uint8_t, kFrameHeaderSize> header_{};

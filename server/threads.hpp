@@ -1,0 +1,38 @@
+// Threads with a stack size the server chooses rather than inherits
+// (std::thread takes RLIMIT_STACK's, which a user's ulimit can shrink). The
+// network threads run the recursive walks over client JSON (copy, merge patch,
+// validation, echo); their depth is bounded by max_json_depth (PROTOCOL.md,
+// "Limits"), and kServerThreadStackBytes leaves a wide margin above what that
+// depth needs (tests/server/test_hostile.cpp renders, echoes and merges at the
+// limit).
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+
+#include <pthread.h>
+
+namespace beamcast {
+
+inline constexpr std::size_t kServerThreadStackBytes = 8u << 20;
+
+class SizedThread {
+ public:
+  // Starts `fn` on a new thread with a stack of `stack_bytes`; throws
+  // std::system_error if the thread cannot be created.
+  explicit SizedThread(std::function<void()> fn, std::size_t stack_bytes = kServerThreadStackBytes);
+  SizedThread(SizedThread&& other) noexcept;
+  SizedThread& operator=(SizedThread&&) = delete;
+  SizedThread(const SizedThread&) = delete;
+  ~SizedThread();  // joins if still joinable
+
+  bool joinable() const { return joinable_; }
+  void join();
+
+ private:
+  pthread_t thread_{};
+  bool joinable_ = false;
+};
+
+}  // namespace beamcast
