@@ -1,5 +1,7 @@
 #include "client/client.hpp"
 
+#include "protocol/bounded_json.hpp"
+
 #include <functional>
 #include <optional>
 #include <stdexcept>
@@ -131,12 +133,14 @@ Response Client::read_response() {
   }
 
   Response r;
-  try {
-    r.json = nlohmann::json::parse(msg.json);
-  } catch (const nlohmann::json::parse_error& e) {
+  // The same bounded parser as the server's: a hostile server cannot make this
+  // client recurse either (responses are shallow; their depth is a few levels).
+  BoundedParse parsed = parse_json_bounded(msg.json, JsonLimits{});
+  if (parsed.error) {
     close();
-    throw std::runtime_error(what + ": response JSON does not parse: " + e.what());
+    throw std::runtime_error(what + ": response JSON is not acceptable: " + parsed.error->message);
   }
+  r.json = std::move(parsed.value);
   if (!r.json.is_object()) {
     close();
     throw std::runtime_error(what + ": response JSON is not an object");

@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "fuzz/fuzz_support.hpp"
+#include "protocol/bounded_json.hpp"
 #include "protocol/request.hpp"
 #include "protocol/scene_json.hpp"
 
@@ -63,9 +64,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   json response;
   try {
     const beamcast::Request req = beamcast::parse_request(text, &id);
+    // Nothing deeper than max_json_depth gets past the parser (issue 19).
+    FUZZ_CHECK(beamcast::json_depth(req.params) < beamcast::JsonLimits{}.max_depth);
     response = beamcast::ok_response(id, handle(req, opts));
   } catch (const ProtocolError& e) {
     beamcast::fuzz::check_error(e.info());
+    // An echoed id is always one the protocol allows.
+    FUZZ_CHECK(id.is_null() || id.is_string() || id.is_number_integer());
     response = beamcast::error_response(id, e.info());
   }
   // Session::send serializes with the strict UTF-8 handler: it must not throw.

@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "fuzz/fuzz_support.hpp"
+#include "protocol/bounded_json.hpp"
 #include "protocol/request.hpp"
 #include "protocol/scene_json.hpp"
 
@@ -34,8 +35,15 @@ void check_scene(const beamcast::Scene& s, const beamcast::SceneLimits& l) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   const beamcast::SceneLoadOptions opts = beamcast::fuzz::load_options();
-  const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded()) return 0;
+  // Scenes arrive inside requests: the same bounded parser and limits.
+  beamcast::BoundedParse parsed = beamcast::parse_json_bounded(text, beamcast::JsonLimits{});
+  if (parsed.error) {
+    beamcast::fuzz::check_error(*parsed.error);
+    beamcast::fuzz::serialize(beamcast::error_response(1, *parsed.error));
+    return 0;
+  }
+  const json& j = parsed.value;
+  FUZZ_CHECK(beamcast::json_depth(j) <= beamcast::JsonLimits{}.max_depth);
   json response;
   try {
     const beamcast::Scene scene = beamcast::parse_scene(j, opts);

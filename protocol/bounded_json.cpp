@@ -62,9 +62,14 @@ class BoundedBuilder {
     overflow_end_ = position;
     overflow_token_ = last_token;
     if (error_) return false;  // a limit error came first (recovery mode)
-    // nlohmann reports the position after the offending token: point at its start.
-    const std::string where =
-        location(position >= last_token.size() ? position - last_token.size() : position);
+    // nlohmann reports the position after the last character it read: for a
+    // number overflow that is the end of the number (point at its start); for
+    // a syntax error, the offending character is the last one read.
+    const std::size_t offset =
+        ex.id == kNumberOverflow
+            ? (position >= last_token.size() ? position - last_token.size() : 0)
+            : (position > 0 ? position - 1 : 0);
+    const std::string where = location(offset);
     if (ex.id == kNumberOverflow) {
       set_error("not_finite", "the number " + clip(last_token) + " " + where +
                                   " is too large for a double");

@@ -31,6 +31,7 @@
 #include "client/cli/commands.hpp"
 #include "client/client.hpp"
 #include "client/latency_histogram.hpp"
+#include "protocol/bounded_json.hpp"
 #include "protocol/framing.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
@@ -492,9 +493,14 @@ void Conn::read_header() {
                          self->socket_, asio::buffer(self->body_),
                          [self, h](const boost::system::error_code& ec2, std::size_t) {
                            if (ec2) return self->fail("connection_lost");
-                           json msg = json::parse(self->body_.begin(),
-                                                  self->body_.begin() + h.json_length, nullptr, false);
-                           if (msg.is_discarded() || !msg.is_object()) return self->fail("bad_json_response");
+                           BoundedParse parsed = parse_json_bounded(
+                               std::string_view(reinterpret_cast<const char*>(self->body_.data()),
+                                                h.json_length),
+                               JsonLimits{});
+                           if (parsed.error || !parsed.value.is_object()) {
+                             return self->fail("bad_json_response");
+                           }
+                           json msg = std::move(parsed.value);
                            std::vector<std::uint8_t> bin(self->body_.begin() + h.json_length,
                                                          self->body_.end());
                            self->on_message(std::move(msg), std::move(bin));
