@@ -301,6 +301,40 @@ def test_depth_limit_is_exact():
         assert "max_json_values" in hello["limits"], hello["limits"]
 
 
+def test_every_method_at_the_default_depth_limit():
+    """Echo, merge patch and scene validation walk documents of exactly depth 64."""
+    with Server("--no-demo") as srv:
+        c = Bcp(srv.port)
+        # ping: root (1), params (2), 62 more objects = 64.
+        c.send_text('{"id":1,"method":"ping","params":' + '{"a":' * 63 + "1" + "}" * 63 + "}")
+        r = c.recv()[0]
+        assert r["ok"], r
+        echo, depth = r["result"]["echo"], 1
+        while isinstance(echo, dict):
+            echo, depth = echo["a"], depth + 1
+        assert depth == 64, depth  # params and its 62 nested objects came back whole
+        c.send_text('{"id":2,"method":"ping","params":' + '{"a":' * 64 + "1" + "}" * 64 + "}")
+        expect_error(c.recv()[0], "limit_exceeded", rid=2)
+        assert c.call({"id": 3, "method": "scene.put",
+                       "params": {"scene_id": "s", "scene": SMALL_SCENE}})["ok"]
+        # scene.update: root, params, patch, beams, beams[0] = 5, then k objects in
+        # the beam's unknown field "a": k = 59 is depth 64, k = 60 is 65.
+        def patch(k):
+            beam = '{"type":"sphere","center":[0,0,0],"radius":1,"density":"linear","a":'
+            return ('{"id":4,"method":"scene.update","params":{"scene_id":"s","patch":'
+                    '{"beams":[' + beam + '{"a":' * k + "1" + "}" * k + "}]}}}")
+        c.send_text(patch(59))
+        # merged, validated, then refused for the unknown field
+        expect_error(c.recv()[0], "unknown_field", path="/params/patch/beams/0/a", rid=4)
+        c.send_text(patch(60))
+        expect_error(c.recv()[0], "limit_exceeded", rid=4)
+        # render: root, params, scene (3), then 61 objects in an unknown field = 64.
+        c.send_text('{"id":6,"method":"render","params":{"scene":' +
+                    json.dumps(SMALL_SCENE)[:-1] + ',"extra":' + '{"a":' * 60 + "1" + "}" * 60 + "}}}")
+        expect_error(c.recv()[0], "unknown_field", path="/params/scene/extra", rid=6)
+        assert c.call({"id": 7, "method": "ping"})["ok"]
+
+
 def test_value_count_limit():
     with Server("--max-json-values", "1000") as srv:
         c = Bcp(srv.port)
