@@ -23,13 +23,7 @@ namespace beamcast::fuzz {
 // occluders are refused by path, the OBJ parser has its own target.
 inline SceneLoadOptions load_options() {
   SceneLoadOptions o;
-  o.limits = SceneLimits{.max_beams = 10000,
-                         .max_occluders = 1000,
-                         .max_cameras = 64,
-                         .max_width = 4096,
-                         .max_height = 4096,
-                         .max_pixels = 4096LL * 4096LL,
-                         .max_mesh_triangles = 1000000};
+  o.limits = kServerSceneLimits;
   return o;
 }
 

@@ -32,6 +32,16 @@ struct SceneLimits {
   double max_abs_coordinate = 1e12;  // any position or size, world units
 };
 
+// The server's scene limits (PROTOCOL.md, "Limits"), stricter than the
+// offline defaults above: beamcast-server's defaults and the fuzz targets'.
+inline constexpr SceneLimits kServerSceneLimits{.max_beams = 10000,
+                                                .max_occluders = 1000,
+                                                .max_cameras = 64,
+                                                .max_width = 4096,
+                                                .max_height = 4096,
+                                                .max_pixels = 4096LL * 4096LL,
+                                                .max_mesh_triangles = 1000000};
+
 struct SceneLoadOptions {
   // Mesh files are read only from below this directory; absolute paths and
   // ".." components are refused. Empty: meshes are refused.

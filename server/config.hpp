@@ -40,13 +40,7 @@ struct ServerConfig {
   int png_filters = 0x10;
   std::filesystem::path assets_dir;
 
-  SceneLimits scene_limits{.max_beams = 10000,
-                           .max_occluders = 1000,
-                           .max_cameras = 64,
-                           .max_width = 4096,
-                           .max_height = 4096,
-                           .max_pixels = 4096LL * 4096LL,
-                           .max_mesh_triangles = 1000000};
+  SceneLimits scene_limits = kServerSceneLimits;
   std::uint64_t max_message_bytes = 16u << 20;
   // Enforced while a request's JSON is parsed (protocol/bounded_json.hpp):
   // max_json_depth (nesting) and max_json_values (values in one request).

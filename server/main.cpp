@@ -1,5 +1,7 @@
 // beamcast-server: the Beamcast render service (protocol/PROTOCOL.md).
+#include <cstdint>
 #include <cstdio>
+#include <vector>
 #include <exception>
 
 #include <CLI/CLI.hpp>
@@ -7,6 +9,7 @@
 #include "protocol/scene_json.hpp"
 #include "protocol/bounded_json.hpp"
 #include "server/demo_scene.hpp"
+#include "server/limits.hpp"
 #include "server/server.hpp"
 
 int main(int argc, char** argv) {
@@ -16,7 +19,6 @@ int main(int argc, char** argv) {
   c.http_port = 7879;
   std::string assets = c.assets_dir.string();
   bool no_demo = false;
-  SceneLimits& l = c.scene_limits;
 
   CLI::App app{"beamcast-server: headless energy-beam render service (protocol/PROTOCOL.md)"};
   app.add_option("--bind", c.bind, "Address to listen on")->capture_default_str();
@@ -63,27 +65,18 @@ int main(int argc, char** argv) {
   bool quiet_requests = false;
   app.add_flag("--quiet-requests", quiet_requests,
                "No per-request log lines on stderr (one JSON object per answered request)");
-  app.add_option("--max-message-bytes", c.max_message_bytes)->capture_default_str();
-  app.add_option("--max-json-depth", c.json_limits.max_depth)->check(CLI::Range(1, 100000))->capture_default_str();
-  app.add_option("--max-json-values", c.json_limits.max_values)->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40))->capture_default_str();
-  app.add_option("--max-width", l.max_width)->capture_default_str();
-  app.add_option("--max-height", l.max_height)->capture_default_str();
-  app.add_option("--max-pixels", l.max_pixels)->capture_default_str();
-  app.add_option("--max-cameras", l.max_cameras)->capture_default_str();
-  app.add_option("--max-beams", l.max_beams)->capture_default_str();
-  app.add_option("--max-occluders", l.max_occluders)->capture_default_str();
-  app.add_option("--max-mesh-triangles", l.max_mesh_triangles)->capture_default_str();
-  app.add_option("--max-inflight-per-connection", c.max_inflight_per_connection)->capture_default_str();
-  app.add_option("--max-inflight-total", c.max_inflight_total)->capture_default_str();
-  app.add_option("--max-connections", c.max_connections)->capture_default_str();
-  app.add_option("--max-write-queue-bytes", c.max_write_queue_bytes)->capture_default_str();
-  app.add_option("--max-scenes", c.max_scenes)->capture_default_str();
-  app.add_option("--max-scene-store-bytes", c.max_scene_store_bytes)->capture_default_str();
-  app.add_option("--idle-timeout-ms", c.idle_timeout_ms)->capture_default_str();
-  app.add_option("--read-timeout-ms", c.read_timeout_ms)->capture_default_str();
-  app.add_option("--write-timeout-ms", c.write_timeout_ms)->capture_default_str();
+  // Every limit of PROTOCOL.md's table is an option, from the one table (server/limits.hpp).
+  std::vector<std::int64_t> limit_values;
+  for (const LimitEntry& e : limit_table()) limit_values.push_back(e.get(c));
+  for (std::size_t i = 0; i < limit_table().size(); ++i) {
+    const LimitEntry& e = limit_table()[i];
+    app.add_option(e.option(), limit_values[i], std::string(e.help))
+        ->check(CLI::Range(e.min, e.max))
+        ->capture_default_str();
+  }
   app.add_option("--drain-timeout-ms", c.drain_timeout_ms)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  for (std::size_t i = 0; i < limit_table().size(); ++i) limit_table()[i].set(c, limit_values[i]);
   c.assets_dir = assets;
   c.request_log = !quiet_requests;
   // libpng's PNG_FILTER_* masks.

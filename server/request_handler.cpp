@@ -7,6 +7,7 @@
 #include "protocol/scene_json.hpp"
 #include "render/pass_plan.hpp"
 #include "server/auth.hpp"
+#include "server/limits.hpp"
 #include "server/session.hpp"
 #include "server/accuracy_controller.hpp"
 #include "server/connection.hpp"
@@ -51,29 +52,6 @@ const json& required_object(const json& params, const char* key) {
   if (it == params.end()) fail("missing_field", std::string("/params/") + key, std::string(key) + " is required");
   if (!it->is_object()) fail("wrong_type", std::string("/params/") + key, std::string(key) + " must be an object");
   return *it;
-}
-
-json limits_json(const ServerConfig& c) {
-  const SceneLimits& l = c.scene_limits;
-  return {{"max_message_bytes", c.max_message_bytes},
-          {"max_json_depth", c.json_limits.max_depth},
-          {"max_json_values", c.json_limits.max_values},
-          {"max_width", l.max_width},
-          {"max_height", l.max_height},
-          {"max_pixels", l.max_pixels},
-          {"max_cameras", l.max_cameras},
-          {"max_beams", l.max_beams},
-          {"max_occluders", l.max_occluders},
-          {"max_mesh_triangles", l.max_mesh_triangles},
-          {"max_inflight_per_connection", c.max_inflight_per_connection},
-          {"max_inflight_total", c.max_inflight_total},
-          {"max_connections", c.max_connections},
-          {"max_write_queue_bytes", c.max_write_queue_bytes},
-          {"max_scenes", c.max_scenes},
-          {"max_scene_store_bytes", c.max_scene_store_bytes},
-          {"idle_timeout_ms", c.idle_timeout_ms},
-          {"read_timeout_ms", c.read_timeout_ms},
-          {"write_timeout_ms", c.write_timeout_ms}};
 }
 
 json hello_result(const ServerCore& core, const json& params) {

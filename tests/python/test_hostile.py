@@ -79,8 +79,13 @@ class Server:
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, exc_type, *exc):
         self.stop()
+        # A clean SIGTERM shutdown exits 0; under ASan, LeakSanitizer makes a
+        # leak a non-zero exit here.
+        if exc_type is None:
+            assert self.proc.returncode == 0, (
+                f"server exited {self.proc.returncode}: {''.join(self.stderr[-20:])}")
 
 
 class Bcp:
@@ -283,7 +288,13 @@ def test_deep_nesting_tcp_and_ws_on_token_server_before_hello():
         # would already exceed 4 MiB, and glibc keeps up to a few MiB of
         # trimmed-but-fragmented arena. Anything above 8 MiB is a leak or an
         # untrimmed heap.
-        assert after - base < 8.0, f"RSS grew from {base:.1f} to {after:.1f} MiB"
+        # Under AddressSanitizer (CI's last stage sets ASAN_OPTIONS) freed blocks
+        # sit in ASan's 256 MiB quarantine: RSS says nothing about leaks there,
+        # and LeakSanitizer checks them when the server exits instead.
+        if os.environ.get("ASAN_OPTIONS") is None:
+            assert after - base < 8.0, f"RSS grew from {base:.1f} to {after:.1f} MiB"
+        else:
+            print("    (ASan build: RSS not compared; LeakSanitizer checks at exit)")
 
 
 def test_depth_limit_is_exact():
