@@ -88,6 +88,17 @@ class Server:
                 f"server exited {self.proc.returncode}: {''.join(self.stderr[-20:])}")
 
 
+def recv_exact(sock, n):
+    """Exactly n bytes from `sock`; EOFError if the server closes first."""
+    out = b""
+    while len(out) < n:
+        chunk = sock.recv(n - len(out))
+        if not chunk:
+            raise EOFError("connection closed by the server")
+        out += chunk
+    return out
+
+
 class Bcp:
     """A blocking BCP1 connection."""
 
@@ -99,13 +110,7 @@ class Bcp:
         self.s.sendall(b"BCP1" + struct.pack(">II", len(b), 0) + b)
 
     def _exact(self, n):
-        out = b""
-        while len(out) < n:
-            chunk = self.s.recv(n - len(out))
-            if not chunk:
-                raise EOFError("connection closed by the server")
-            out += chunk
-        return out
+        return recv_exact(self.s, n)
 
     def recv(self):
         h = self._exact(12)
@@ -168,13 +173,7 @@ class Ws:
         self.s.sendall(hdr + mask + body)
 
     def _exact(self, n):
-        out = b""
-        while len(out) < n:
-            chunk = self.s.recv(n - len(out))
-            if not chunk:
-                raise EOFError("connection closed by the server")
-            out += chunk
-        return out
+        return recv_exact(self.s, n)
 
     def recv(self):
         """(opcode, payload) of the next whole message; pings are skipped."""
