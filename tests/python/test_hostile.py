@@ -444,6 +444,20 @@ def test_partial_header_times_out_with_read_timeout():
         assert c.closed_within(3.0)
 
 
+def test_partial_websocket_message_times_out():
+    with Server("--read-timeout-ms", "1000", "--no-demo") as srv:
+        w = Ws(srv.http_port)
+        assert w.call_text('{"id":1,"method":"ping"}')["ok"]
+        # A text frame announcing 100 bytes, of which 10 arrive.
+        mask = b"\0\0\0\0"
+        w.s.sendall(struct.pack(">BB", 0x81, 0x80 | 100) + mask + b'{"id":2,"m')
+        t0 = time.time()
+        op, data = w.recv()
+        took = time.time() - t0
+        expect_error(json.loads(data), "timeout")
+        assert 0.9 <= took < 3.0, f"timeout after {took:.2f} s (read_timeout_ms 1000)"
+
+
 def test_slow_but_steady_sender_is_not_idle():
     with Server("--idle-timeout-ms", "500", "--read-timeout-ms", "15000", "--no-demo") as srv:
         c = Bcp(srv.port)
@@ -525,10 +539,11 @@ def test_spec_mismatches():
         r = c.call({"id": 10, "method": "render",
                     "params": {"scene": scene, "quality": "auto", "motion": "moving"}})
         f = r["result"]["frames"][0]
-        if f["format"] == "jpeg":
-            assert f["bit_depth"] == 8, f
-        else:
-            assert f["bit_depth"] == 16, f
+        assert f["format"] == "jpeg", f  # a moving frame, interactive_format's default
+        assert f["bit_depth"] == 8, f
+        r = c.call({"id": 11, "method": "render", "params": {"scene": scene}})
+        f = r["result"]["frames"][0]
+        assert f["format"] == "png" and f["bit_depth"] == 16, f
 
 
 def test_demo_scene_over_a_limit_is_named_before_listening():
