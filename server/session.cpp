@@ -121,11 +121,15 @@ void Session::on_body(const boost::system::error_code& ec, std::size_t) {
     return;
   }
   read_timer_.cancel();
-  const std::string text(body_.begin(), body_.end());
-  body_.clear();
-  body_.shrink_to_fit();
-  handle_message(core_, shared_from_this(), text, Clock::now());
-  release_large_message_memory(text.size());
+  std::size_t bytes = 0;
+  {
+    const std::string text(body_.begin(), body_.end());
+    body_.clear();
+    body_.shrink_to_fit();
+    bytes = text.size();
+    handle_message(core_, shared_from_this(), text, Clock::now());
+  }  // the text is freed before the trim
+  release_large_message_memory(bytes);
   do_read_header();
 }
 
