@@ -179,7 +179,6 @@ class BoundedBuilder {
     if (skipping_) {
       // Recovery keeps the root object's own scalars (a request's id).
       if (recover_ && levels_.size() == 1 && !levels_[0].is_array) place(std::move(v));
-      else if (!levels_.empty() && levels_.back().is_array) ++levels_.back().count;
       return true;
     }
     if (!count_value()) return false;
@@ -213,11 +212,7 @@ class BoundedBuilder {
         return false;
       }
     }
-    if (skipping_) {
-      if (levels_.back().is_array) ++levels_.back().count;
-    } else {
-      l.container = place(is_array ? json::array() : json::object());
-    }
+    if (!skipping_) l.container = place(is_array ? json::array() : json::object());
     levels_.push_back(std::move(l));
     return true;
   }

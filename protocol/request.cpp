@@ -1,6 +1,5 @@
 #include "protocol/request.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -30,8 +29,9 @@ std::size_t code_points(std::string_view s) {
   return n;
 }
 
-// An id or protocol number may be written as an integral float (7.0), as the
-// scene format accepts integers (docs/scene-format.md); it is read as 7.
+// An id may be written as an integral float (7.0), as the scene format accepts
+// integers (docs/scene-format.md); it is read as 7. Unlike scene integers, any
+// int64 is a valid id.
 bool integral_number(const nlohmann::json& v, std::int64_t* out) {
   if (v.is_number_integer()) {
     if (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX)) {
@@ -102,22 +102,14 @@ Request parse_request(std::string_view text, nlohmann::json* id_out, const JsonL
 }
 
 int read_protocol_number(const nlohmann::json& v) {
-  std::int64_t i = 0;
-  if (!integral_number(v, &i)) fail("wrong_type", "/params/protocol", "protocol must be an integer");
+  const std::int64_t i = json_read::read_integer(json_read::Node{&v, "/params/protocol"});
   return i < INT32_MIN || i > INT32_MAX ? -1 : static_cast<int>(i);
 }
 
 void allow_params(const nlohmann::json& params, std::initializer_list<std::string_view> allowed,
                   std::string_view method) {
-  for (const auto& [key, value] : params.items()) {
-    (void)value;
-    if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
-    std::string list;
-    for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-    fail("unknown_field", json_read::child_path("/params", key),
-         "unknown " + std::string(method) + " parameter \"" + to_valid_utf8(key.substr(0, 64)) +
-             "\" (allowed: " + list + ")");
-  }
+  json_read::ObjectReader(json_read::Node{&params, "/params"}, std::string(method) + " params")
+      .allow_only(allowed);
 }
 
 nlohmann::json ok_response(const nlohmann::json& id, nlohmann::json result) {
@@ -153,17 +145,10 @@ std::string parse_scene_id(const nlohmann::json& params, const std::string& path
 
 RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits& limits) {
   RenderParams rp;
-  for (const auto& [key, value] : params.items()) {
-    (void)value;
-    if (key != "scene" && key != "scene_id" && key != "cameras" && key != "output" &&
-        key != "encoding" && key != "atlas" && key != "quality" && key != "budget_ms" &&
-        key != "still_ms" && key != "motion" && key != "interactive_format") {
-      fail("unknown_field", "/params/" + key,
-           "unknown render parameter \"" + key +
-               "\" (allowed: scene, scene_id, cameras, output, encoding, atlas, quality, "
-               "budget_ms, still_ms, motion, interactive_format)");
-    }
-  }
+  allow_params(params,
+               {"scene", "scene_id", "cameras", "output", "encoding", "atlas", "quality", "budget_ms",
+                "still_ms", "motion", "interactive_format"},
+               "render");
   bool automatic = false;
   if (auto q = params.find("quality"); q != params.end()) {
     if (!q->is_string() || (*q != "auto" && *q != "full")) {

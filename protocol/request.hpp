@@ -36,8 +36,9 @@ struct Request {
 Request parse_request(std::string_view json_text, nlohmann::json* id_out,
                       const JsonLimits& limits = {});
 
-// hello's params.protocol: an integer, integral floats accepted (1.0);
-// wrong_type otherwise. Out-of-int range values come back as -1.
+// hello's params.protocol: an integer, integral floats accepted (1.0), read
+// as the scene format reads integers (wrong_type / out_of_range otherwise).
+// Values outside int come back as -1.
 int read_protocol_number(const nlohmann::json& v);
 
 // Refuses (unknown_field, at /params/<key>) a key of a method's params that
