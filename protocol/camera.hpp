@@ -37,17 +37,4 @@ Ray camera_ray(const Camera& cam, const CameraBasis& basis, int px, int py);
 // Same, for a point in normalized device coordinates [-1, 1]^2.
 Ray camera_ray_ndc(const Camera& cam, const CameraBasis& basis, double ndc_x, double ndc_y);
 
-// Small vector helpers used across the project.
-inline Vec3 operator+(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-inline Vec3 operator-(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-inline Vec3 operator*(double s, const Vec3& a) { return {s * a[0], s * a[1], s * a[2]}; }
-inline double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-inline Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double length(const Vec3& a);
-Vec3 normalize(const Vec3& a);
-// Rotates v by the unit quaternion q = (w, x, y, z).
-Vec3 rotate(const std::array<double, 4>& q, const Vec3& v);
-
 }  // namespace beamcast

@@ -103,15 +103,24 @@ bool has_closed_form(const Density& density) {
          density.kind == DensityKind::kQuadratic || density.kind == DensityKind::kGaussian;
 }
 
+namespace {
+const struct {
+  const char* name;
+  DensityKind kind;
+} kBuiltins[] = {{"abe", DensityKind::kAbe},
+                 {"shell", DensityKind::kShell},
+                 {"linear", DensityKind::kLinear},
+                 {"quadratic", DensityKind::kQuadratic},
+                 {"gaussian", DensityKind::kGaussian}};
+}  // namespace
+
+std::vector<std::string_view> density_names() {
+  std::vector<std::string_view> names;
+  for (const auto& b : kBuiltins) names.emplace_back(b.name);
+  return names;
+}
+
 bool density_from_name(const std::string& name, Density* out) {
-  static const struct {
-    const char* name;
-    DensityKind kind;
-  } kBuiltins[] = {{"abe", DensityKind::kAbe},
-                   {"shell", DensityKind::kShell},
-                   {"linear", DensityKind::kLinear},
-                   {"quadratic", DensityKind::kQuadratic},
-                   {"gaussian", DensityKind::kGaussian}};
   for (const auto& b : kBuiltins) {
     if (name == b.name) {
       *out = Density{};

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace beamcast {
@@ -41,5 +42,7 @@ bool has_closed_form(const Density& density);
 // The built-in density for a name ("abe", "shell", "linear", "quadratic",
 // "gaussian"); false if the name is unknown.
 bool density_from_name(const std::string& name, Density* out);
+// Those names, in order.
+std::vector<std::string_view> density_names();
 
 }  // namespace beamcast

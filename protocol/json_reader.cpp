@@ -92,6 +92,10 @@ ObjectReader::ObjectReader(const Node& node, std::string_view what)
 }
 
 void ObjectReader::allow_only(std::initializer_list<std::string_view> allowed) const {
+  allow_only(std::span<const std::string_view>(allowed.begin(), allowed.size()));
+}
+
+void ObjectReader::allow_only(std::span<const std::string_view> allowed) const {
   for (const auto& item : obj_->items()) {
     const std::string& key = item.key();
     if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;

@@ -10,6 +10,7 @@
 #include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -50,6 +51,7 @@ class ObjectReader {
 
   // Throws unknown_field for the first key not in `allowed`, listing the allowed keys.
   void allow_only(std::initializer_list<std::string_view> allowed) const;
+  void allow_only(std::span<const std::string_view> allowed) const;
 
   std::optional<Node> optional(std::string_view key) const;
   Node required(std::string_view key) const;  // throws missing_field
@@ -89,7 +91,7 @@ Vec3 check_coordinates(const Node& n, const Vec3& v, double max_abs);
 
 // String enumerations: "invalid_value" listing the allowed strings.
 template <class E>
-E read_enum(const Node& n, std::initializer_list<std::pair<std::string_view, E>> options) {
+E read_enum(const Node& n, std::span<const std::pair<std::string_view, E>> options) {
   const std::string s = read_string(n);
   std::string allowed;
   for (const auto& [name, value] : options) {
@@ -101,6 +103,18 @@ E read_enum(const Node& n, std::initializer_list<std::pair<std::string_view, E>>
   }
   fail("invalid_value", n.path,
        n.name() + " must be one of " + allowed + ", got " + describe(n.json()));
+}
+template <class E>
+E read_enum(const Node& n, std::initializer_list<std::pair<std::string_view, E>> options) {
+  return read_enum<E>(n, std::span<const std::pair<std::string_view, E>>(options.begin(),
+                                                                         options.size()));
+}
+// The names of a table of options, for capability lists.
+template <class E, std::size_t N>
+std::vector<std::string_view> enum_names(const std::array<std::pair<std::string_view, E>, N>& t) {
+  std::vector<std::string_view> names;
+  for (const auto& [name, value] : t) names.push_back(name);
+  return names;
 }
 
 }  // namespace beamcast::json_read

@@ -1,6 +1,8 @@
 // Scene model: what a client describes. Pure data, no GL, no sockets.
 // Every later scene element (lights, media, SLIM surfaces, volumes) is a new
-// member here and a new pass in render/, never a change to the existing ones.
+// member here and a new pass in render/, never a change to the existing ones;
+// a new occluder kind is a module in protocol/occluders/ (docs/architecture.md,
+// "Adding a scene element").
 #pragma once
 
 #include <array>
@@ -11,11 +13,10 @@
 #include <vector>
 
 #include "protocol/density.hpp"
+#include "protocol/occluders/occluders.hpp"
+#include "protocol/vec.hpp"
 
 namespace beamcast {
-
-using Vec3 = std::array<double, 3>;
-using Color = std::array<double, 3>;  // linear RGB
 
 // A glowing body whose density depends on the normalized distance x = dist/radius
 // to its center (sphere) or to its axis segment (capsule).
@@ -37,29 +38,10 @@ struct Beam {
   Density density;
 };
 
-struct PlaneOccluder {
-  Vec3 point{};
-  Vec3 normal{0.0, 1.0, 0.0};
-};
-struct BoxOccluder {
-  Vec3 center{};
-  Vec3 size{1.0, 1.0, 1.0};             // full edge lengths
-  std::array<double, 4> rotation{1, 0, 0, 0};  // unit quaternion w, x, y, z
-};
-struct SphereOccluder {
-  Vec3 center{};
-  double radius = 1.0;
-};
-// Triangles already transformed to world space (the OBJ is read and
-// transformed when the scene is loaded, so renderers never touch files).
-struct MeshOccluder {
-  std::string file;  // as named in the scene, for messages
-  std::vector<Vec3> vertices;
-  std::vector<std::array<std::uint32_t, 3>> triangles;
-};
-
+// One module per kind in protocol/occluders/ (parsing, bounds, GPU form, CPU
+// reference intersection); the kinds are listed once, in OccluderShape.
 struct Occluder {
-  std::variant<PlaneOccluder, BoxOccluder, SphereOccluder, MeshOccluder> shape;
+  OccluderShape shape;
   Color albedo{0.8, 0.8, 0.8};
 };
 

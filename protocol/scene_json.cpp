@@ -11,7 +11,7 @@
 
 #include "protocol/camera.hpp"
 #include "protocol/json_reader.hpp"
-#include "protocol/mesh_obj.hpp"
+#include "protocol/occluders/occluder_parse.hpp"
 #include "protocol/rigs.hpp"
 
 namespace beamcast {
@@ -22,65 +22,6 @@ using namespace json_read;
 namespace {
 
 // ---- Small typed readers shared by the scene parts ----------------------------------
-
-Vec3 read_point(const Node& n, const SceneLimits& limits) {
-  return check_coordinates(n, read_vec3(n), limits.max_abs_coordinate);
-}
-
-// A length: > 0, finite, at most max_abs_coordinate.
-double read_size(const Node& n, const SceneLimits& limits) {
-  const double v = check_positive(n, read_number(n));
-  if (v > limits.max_abs_coordinate) {
-    fail("out_of_range", n.path,
-         n.name() + " must be <= " + format_number(limits.max_abs_coordinate) +
-             " (limit max_abs_coordinate), got " + format_number(v));
-  }
-  return v;
-}
-
-// True if normalize(v) is finite: nonzero, and not so tiny (denormal) that 1/|v| overflows.
-bool normalizable(const Vec3& v) {
-  const double len = length(v);
-  return len > 0.0 && std::isfinite(len) && std::isfinite(1.0 / len);
-}
-
-// A direction: finite, not the zero vector (need not be unit).
-Vec3 read_direction(const Node& n) {
-  const Vec3 v = read_vec3(n);
-  if (!normalizable(v)) {
-    fail("invalid_value", n.path,
-         n.name() + " must be a nonzero direction vector (length > 1e-300), got [" +
-             format_number(v[0]) + ", " + format_number(v[1]) + ", " + format_number(v[2]) + "]");
-  }
-  return v;
-}
-
-Color read_color(const Node& n) {
-  Color c = read_vec3(n);
-  for (std::size_t i = 0; i < 3; ++i)
-    check_non_negative(Node{&n.json()[i], child_path(n.path, i)}, c[i]);
-  return c;
-}
-
-Color read_albedo(const Node& n) {
-  Color c = read_vec3(n);
-  for (std::size_t i = 0; i < 3; ++i)
-    check_closed(Node{&n.json()[i], child_path(n.path, i)}, c[i], 0.0, 1.0);
-  return c;
-}
-
-// [w, x, y, z] with finite nonzero norm, returned normalized.
-std::array<double, 4> read_quaternion(const Node& n) {
-  auto q = read_numbers<4>(n);
-  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (!(norm > 0.0) || !std::isfinite(norm)) {
-    fail("invalid_value", n.path,
-         n.name() + " must be a quaternion [w, x, y, z] with finite nonzero norm, got norm " +
-             format_number(norm));
-  }
-  for (double& c : q) c /= norm;
-  return q;
-}
 
 int read_int_in(const Node& n, std::int64_t lo, std::int64_t hi) {
   const std::int64_t v = read_integer(n);
@@ -109,13 +50,31 @@ int read_int_limited(const Node& n, std::int64_t lo, std::int64_t hi, const char
 
 // ---- Beams --------------------------------------------------------------------------
 
+// The beam and rig types: read by the parser, listed in hello's capabilities.
+enum class BeamKind { kSphere, kCapsule };
+constexpr std::array<std::pair<std::string_view, BeamKind>, 2> kBeamKinds{
+    {{"sphere", BeamKind::kSphere}, {"capsule", BeamKind::kCapsule}}};
+enum class RigKind { kOrbit, kCubemap, kStereo };
+constexpr std::array<std::pair<std::string_view, RigKind>, 3> kRigKinds{
+    {{"orbit", RigKind::kOrbit}, {"cubemap", RigKind::kCubemap}, {"stereo", RigKind::kStereo}}};
+
+// "abe", "shell", ... (the built-in density names, quoted).
+std::string quoted_density_names() {
+  std::string names;
+  for (std::string_view name : density_names()) {
+    names += names.empty() ? "\"" : ", \"";
+    names += name;
+    names += '"';
+  }
+  return names;
+}
+
 Density parse_density(const Node& n, const SceneLimits& limits) {
-  static constexpr std::string_view kNames = R"("abe", "shell", "linear", "quadratic", "gaussian")";
   Density d;
   if (n.json().is_string()) {
     if (!density_from_name(n.json().get<std::string>(), &d)) {
       fail("invalid_value", n.path,
-           "density must be one of " + std::string(kNames) + " or an object, got " +
+           "density must be one of " + quoted_density_names() + " or an object, got " +
                describe(n.json()));
     }
     return d;
@@ -149,7 +108,7 @@ Density parse_density(const Node& n, const SceneLimits& limits) {
   }
   if (!density_from_name(t, &d)) {
     fail("invalid_value", type.path,
-         "density type must be one of " + std::string(kNames) + ", \"table\", got " +
+         "density type must be one of " + quoted_density_names() + ", \"table\", got " +
              describe(type.json()));
   }
   if (d.kind == DensityKind::kGaussian) {
@@ -169,8 +128,8 @@ Density parse_density(const Node& n, const SceneLimits& limits) {
 Beam parse_beam(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "a beam");
   const Node type = o.required("type");
-  enum class Kind { kSphere, kCapsule };
-  const Kind kind = read_enum<Kind>(type, {{"sphere", Kind::kSphere}, {"capsule", Kind::kCapsule}});
+  using Kind = BeamKind;
+  const Kind kind = read_enum<Kind>(type, std::span(kBeamKinds));
   Beam b;
   if (kind == Kind::kSphere) {
     o.allow_only({"type", "center", "radius", "color", "intensity", "density"});
@@ -211,83 +170,14 @@ Beam parse_beam(const Node& n, const SceneLimits& limits) {
 
 // ---- Occluders ----------------------------------------------------------------------
 
-MeshTransform parse_mesh_transform(const ObjectReader& o, const SceneLimits& limits) {
-  MeshTransform xf;
-  if (auto t = o.optional("translate")) xf.translate = read_point(*t, limits);
-  if (auto s = o.optional("scale")) {
-    if (s->json().is_number()) {
-      const double v = read_number(*s);
-      xf.scale = {v, v, v};
-    } else {
-      xf.scale = read_vec3(*s);
-    }
-    // Negative factors mirror the mesh (allowed); zero flattens it (refused).
-    for (double v : xf.scale) {
-      if (!(std::abs(v) > 0.0) || std::abs(v) > limits.max_abs_coordinate) {
-        fail("out_of_range", s->path,
-             "scale factors must be nonzero with magnitude <= max_abs_coordinate, got " +
-                 format_number(v));
-      }
-    }
-  }
-  if (auto r = o.optional("rotation")) xf.rotation = read_quaternion(*r);
-  return xf;
-}
-
+// The kind's own parse function (protocol/occluders/) reads its fields;
+// "albedo" is common to every kind.
 Occluder parse_occluder(const Node& n, const SceneLoadOptions& opts, std::int64_t* mesh_triangles) {
-  const SceneLimits& limits = opts.limits;
   ObjectReader o(n, "an occluder");
   const Node type = o.required("type");
-  enum class Kind { kPlane, kBox, kSphere, kMesh };
-  const Kind kind = read_enum<Kind>(type, {{"plane", Kind::kPlane},
-                                           {"box", Kind::kBox},
-                                           {"sphere", Kind::kSphere},
-                                           {"mesh", Kind::kMesh}});
   Occluder occ;
-  switch (kind) {
-    case Kind::kPlane: {
-      o.allow_only({"type", "point", "normal", "albedo"});
-      PlaneOccluder p;
-      p.point = read_point(o.required("point"), limits);
-      p.normal = read_direction(o.required("normal"));
-      occ.shape = p;
-      break;
-    }
-    case Kind::kBox: {
-      o.allow_only({"type", "center", "size", "rotation", "albedo"});
-      BoxOccluder b;
-      b.center = read_point(o.required("center"), limits);
-      const Node size = o.required("size");
-      b.size = read_vec3(size);
-      for (std::size_t i = 0; i < 3; ++i) {
-        b.size[i] = read_size(Node{&size.json()[i], child_path(size.path, i)}, limits);
-      }
-      if (auto r = o.optional("rotation")) b.rotation = read_quaternion(*r);
-      occ.shape = b;
-      break;
-    }
-    case Kind::kSphere: {
-      o.allow_only({"type", "center", "radius", "albedo"});
-      SphereOccluder s;
-      s.center = read_point(o.required("center"), limits);
-      s.radius = read_size(o.required("radius"), limits);
-      occ.shape = s;
-      break;
-    }
-    case Kind::kMesh: {
-      o.allow_only({"type", "file", "translate", "scale", "rotation", "albedo"});
-      const Node file = o.required("file");
-      const std::string name = read_string(file);
-      if (name.empty()) fail("invalid_value", file.path, "file must be a non-empty relative path");
-      const MeshTransform xf = parse_mesh_transform(o, limits);
-      const MeshLoadLimits mesh_limits{limits.max_mesh_triangles, *mesh_triangles,
-                                       limits.max_abs_coordinate};
-      MeshOccluder mesh = load_obj_mesh(opts.assets_dir, name, xf, mesh_limits, file.path);
-      *mesh_triangles += static_cast<std::int64_t>(mesh.triangles.size());
-      occ.shape = std::move(mesh);
-      break;
-    }
-  }
+  occ.shape = parse_occluder_shape(read_string(type), type.path,
+                                   OccluderParse{o, opts, mesh_triangles});
   if (auto a = o.optional("albedo")) occ.albedo = read_albedo(*a);
   return occ;
 }
@@ -638,9 +528,9 @@ std::vector<Camera> parse_camera_entry(const json& j, const std::string& path,
   const Node n{&j, path};
   ObjectReader o(n, "a camera rig");
   const Node kind = o.required("rig");
-  enum class Kind { kOrbit, kCubemap, kStereo };
+  using Kind = RigKind;
   const Kind k = read_enum<Kind>(
-      kind, {{"orbit", Kind::kOrbit}, {"cubemap", Kind::kCubemap}, {"stereo", Kind::kStereo}});
+      kind, std::span(kRigKinds));
   std::string prefix = read_string(kind);
   if (auto v = o.optional("name")) prefix = read_camera_name(*v);
   switch (k) {
@@ -783,6 +673,15 @@ Scene load_scene_file(const std::filesystem::path& file, const SceneLoadOptions&
                                   ""});
   }
   return parse_scene(j, opts);
+}
+
+nlohmann::json scene_capabilities() {
+  json densities = density_names();
+  densities.push_back("table");
+  return {{"beam_types", enum_names(kBeamKinds)},
+          {"densities", densities},
+          {"occluder_types", occluder_types()},
+          {"camera_rigs", enum_names(kRigKinds)}};
 }
 
 }  // namespace beamcast

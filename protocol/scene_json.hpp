@@ -87,6 +87,9 @@ AtlasGrid atlas_grid(const std::vector<std::pair<int, int>>& sizes);
 nlohmann::json camera_to_json(const Camera& c);
 // An "output" object (exposure, tone, bit_depth); missing fields take defaults.
 OutputSettings parse_output_settings(const nlohmann::json& j, const std::string& path);
+// The scene element types this parser accepts, from the parser's own tables
+// (hello's capabilities): beam_types, densities, occluder_types, camera_rigs.
+nlohmann::json scene_capabilities();
 // Reads and parses a scene file; JSON syntax errors become code "bad_json".
 Scene load_scene_file(const std::filesystem::path& file, const SceneLoadOptions& opts);
 

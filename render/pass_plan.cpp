@@ -1,24 +1,114 @@
 #include "render/pass_plan.hpp"
 
+#include <algorithm>
+
 namespace beamcast {
 
-const std::vector<PassRule>& pass_catalog() {
-  static const std::vector<PassRule> kCatalog = {
-      // Occluders: depth and shaded colour; without them the beams see no surface.
-      {"surfaces", [](const Scene& s) { return !s.occluders.empty(); }},
-      {"beams", [](const Scene& s) { return !s.beams.empty(); }},
+namespace {
+
+template <class T>
+bool contains(const std::vector<T>& v, std::string_view s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+}  // namespace
+
+const std::vector<TargetDecl>& target_catalog() {
+  static const std::vector<TargetDecl> kTargets = {
+      {"hdr", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kBackground},
+      {"view_depth", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
+      {"depth", TargetFormat::kDepth32f, TargetSize::kRender, TargetClear::kFarDepth},
+      {"output", TargetFormat::kDisplay, TargetSize::kRender, TargetClear::kNone},
+      {"upscaled", TargetFormat::kDisplay, TargetSize::kCamera, TargetClear::kNone},
+  };
+  return kTargets;
+}
+
+const std::vector<PassDecl>& pass_catalog() {
+  static const std::vector<PassDecl> kCatalog = {
+      // Occluders: shaded colour, the view depth of the nearest surface, depth.
+      {PassId::kSurfaces, "surfaces", [](const PlanInput& in) { return !in.scene.occluders.empty(); },
+       {}, {}, {"hdr", "view_depth", "depth"}, {"occluders"}},
+      // Beams: energy added to hdr; a ray ends at the nearest surface if
+      // anything wrote view_depth.
+      {PassId::kBeams, "beams", [](const PlanInput& in) { return !in.scene.beams.empty(); },
+       {"hdr"}, {"view_depth"}, {"hdr"}, {"beams"}},
       // Every frame is tone-mapped into its output format.
-      {"tonemap", [](const Scene&) { return true; }},
+      {PassId::kTonemap, "tonemap", [](const PlanInput&) { return true; }, {"hdr"}, {}, {"output"},
+       {}},
+      // Scaled frames (interactive preview): bilinear blit to the camera's size.
+      {PassId::kUpscale, "upscale", [](const PlanInput& in) { return in.scaled(); }, {"output"}, {},
+       {"upscaled"}, {}},
   };
   return kCatalog;
 }
 
-std::vector<std::string> plan_passes(const Scene& scene) {
-  std::vector<std::string> names;
-  for (const PassRule& rule : pass_catalog()) {
-    if (rule.needed(scene)) names.emplace_back(rule.name);
+bool FramePlan::written(std::string_view target) const {
+  return std::any_of(passes.begin(), passes.end(),
+                     [&](const PassDecl* p) { return contains(p->writes, target); });
+}
+
+bool FramePlan::uses(std::string_view target) const {
+  return std::any_of(targets.begin(), targets.end(),
+                     [&](const TargetDecl* t) { return t->name == target; });
+}
+
+bool FramePlan::uploads_group(std::string_view group) const { return contains(uploads, group); }
+
+std::vector<std::string> FramePlan::names() const {
+  std::vector<std::string> out;
+  for (const PassDecl* p : passes) out.push_back(p->name);
+  return out;
+}
+
+FramePlan make_plan(const PlanInput& in, const std::vector<PassDecl>& catalog,
+                    const std::vector<TargetDecl>& targets) {
+  FramePlan plan;
+  auto target = [&](const PassDecl& pass, const std::string& name) -> const TargetDecl* {
+    for (const TargetDecl& t : targets) {
+      if (t.name == name) return &t;
+    }
+    throw PlanError("pass \"" + pass.name + "\" names target \"" + name +
+                    "\", which is not in the target catalog");
+  };
+  auto use = [&](const TargetDecl* t) {
+    if (std::find(plan.targets.begin(), plan.targets.end(), t) == plan.targets.end()) {
+      plan.targets.push_back(t);
+    }
+  };
+  std::vector<PassId> seen;
+  for (const PassDecl& pass : catalog) {
+    if (std::find(seen.begin(), seen.end(), pass.id) != seen.end()) {
+      throw PlanError("pass \"" + pass.name + "\" repeats the id of an earlier pass");
+    }
+    seen.push_back(pass.id);
+    if (!pass.needed(in)) continue;
+    for (const std::string& r : pass.reads) {
+      const TargetDecl* t = target(pass, r);
+      if (t->clear == TargetClear::kNone && !plan.written(r)) {
+        throw PlanError("pass \"" + pass.name + "\" reads target \"" + r +
+                        "\", which no earlier planned pass writes and nothing clears");
+      }
+      use(t);
+    }
+    for (const std::string& r : pass.optional_reads) {
+      const TargetDecl* t = target(pass, r);
+      if (plan.written(r)) use(t);
+    }
+    for (const std::string& w : pass.writes) use(target(pass, w));
+    for (const std::string& u : pass.uploads) {
+      if (!contains(plan.uploads, u)) plan.uploads.push_back(u);
+    }
+    plan.passes.push_back(&pass);
   }
-  return names;
+  if (!plan.passes.empty() && !plan.passes.back()->writes.empty()) {
+    plan.final_target = plan.passes.back()->writes.front();
+  }
+  return plan;
+}
+
+std::vector<std::string> plan_passes(const Scene& scene, double resolution_scale) {
+  return make_plan(PlanInput{scene, resolution_scale}).names();
 }
 
 }  // namespace beamcast

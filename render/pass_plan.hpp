@@ -1,23 +1,106 @@
-// Which passes a scene calls for, decided from its content alone (no GL), so
-// the server can report a plan and tests can check it without a context.
+// The pass graph, GL-free: one catalog of passes, each declaring when a frame
+// needs it, the named targets it reads and writes and the per-scene data it
+// uploads. A frame's plan (the passes that run, the targets they need, the
+// uploads) is derived from those declarations alone, so the server can report
+// it, tests can check it without a GL context, and the renderer runs exactly
+// what the plan lists (render/passes.cpp makes one executor per PassId).
 #pragma once
 
+#include <cstddef>
+#include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "protocol/scene.hpp"
 
 namespace beamcast {
 
-struct PassRule {
-  const char* name;
-  bool (*needed)(const Scene& scene);
+// Every pass the renderer can execute. The executor of each is made by
+// make_pass (render/passes.cpp), whose switch over this enum has no default:
+// a new id without an executor does not compile (-Wswitch) and fails the
+// renderer's construction check.
+enum class PassId { kSurfaces, kBeams, kTonemap, kUpscale };
+inline constexpr std::size_t kPassCount = 4;
+
+// Pixel formats of targets (the GL side maps them to internal formats).
+enum class TargetFormat {
+  kRgba32f,  // linear HDR colour
+  kR32f,     // one float (view depth)
+  kDepth32f, // depth buffer, reversed Z
+  kDisplay,  // RGBA8 or RGBA16, per the scene's output bit depth
+};
+// What a target holds at frame start (before any pass writes it).
+enum class TargetClear {
+  kNone,        // nothing: a pass must write it before another reads it
+  kBackground,  // the scene's background colour
+  kNoSurface,   // FrameTargets' kNoSurface view depth ("no surface on this ray")
+  kFarDepth,    // reversed-Z far plane (0)
+};
+enum class TargetSize {
+  kRender,  // the render size (camera size times the resolution scale)
+  kCamera,  // the camera's own size (what the client asked for)
 };
 
-// Every pass the renderer has, in execution order, with the rule that turns it on.
-const std::vector<PassRule>& pass_catalog();
+struct TargetDecl {
+  std::string name;
+  TargetFormat format = TargetFormat::kRgba32f;
+  TargetSize size = TargetSize::kRender;
+  TargetClear clear = TargetClear::kNone;
+};
 
-// The names of the passes `scene` needs, in execution order.
-std::vector<std::string> plan_passes(const Scene& scene);
+// What a plan is derived from: the scene and the frame's options.
+struct PlanInput {
+  const Scene& scene;
+  double resolution_scale = 1.0;  // < 1: rendered smaller, then upscaled
+  bool scaled() const { return resolution_scale > 0.0 && resolution_scale < 1.0; }
+};
+
+struct PassDecl {
+  PassId id{};
+  std::string name;  // as reported in `passes` and pass_ms
+  bool (*needed)(const PlanInput& in) = nullptr;
+  std::vector<std::string> reads;           // must hold data (cleared or written earlier)
+  std::vector<std::string> optional_reads;  // used only if a planned pass writes them
+  // Colour targets in attachment order (fragment output locations), then at
+  // most one depth target.
+  std::vector<std::string> writes;
+  std::vector<std::string> uploads;  // per-scene resource groups (SceneResources)
+};
+
+// Broken pass declarations: a required read nobody provides, an unknown
+// target, two passes with one id. A programming error, never a client's.
+class PlanError : public std::logic_error {
+ public:
+  using std::logic_error::logic_error;
+};
+
+struct FramePlan {
+  std::vector<const PassDecl*> passes;  // execution order
+  std::vector<const TargetDecl*> targets;  // read or written by a planned pass, allocated
+  std::vector<std::string> uploads;        // union of the planned passes' uploads
+  std::string final_target;                // the last pass's first write: what is read back
+
+  // True if a planned pass (not just the frame-start clear) writes `target`.
+  bool written(std::string_view target) const;
+  bool uses(std::string_view target) const;
+  bool uploads_group(std::string_view group) const;
+  std::vector<std::string> names() const;
+};
+
+// The built-in targets and passes, in execution order.
+const std::vector<TargetDecl>& target_catalog();
+const std::vector<PassDecl>& pass_catalog();
+
+// The plan of one frame; it points into `catalog` and `targets`, which must
+// outlive it (the built-in catalogs are static). Throws PlanError if the declarations are inconsistent
+// for the passes this input plans (a required read of a target that is neither
+// cleared at frame start nor written by an earlier planned pass, or a target
+// missing from `targets`).
+FramePlan make_plan(const PlanInput& in, const std::vector<PassDecl>& catalog = pass_catalog(),
+                    const std::vector<TargetDecl>& targets = target_catalog());
+
+// The names of the passes a frame of `scene` runs, in execution order.
+std::vector<std::string> plan_passes(const Scene& scene, double resolution_scale = 1.0);
 
 }  // namespace beamcast

@@ -8,64 +8,136 @@
 
 namespace beamcast {
 
-void FrameTargets::ensure(int w, int h, int bits, int layer_count) {
-  if (w == width && h == height && bits == bit_depth && layer_count == layers) return;
-  width = w;
-  height = h;
-  bit_depth = bits;
-  layers = layer_count;
-  auto make = [&](GLenum format) {
-    if (layer_count == 0) return make_texture_2d(format, w, h);
-    GLuint id = 0;
-    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
-    glTextureStorage3D(id, 1, format, w, h, layer_count);
-    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    return GlTexture(id);
-  };
-  hdr = make(GL_RGBA32F);
-  view_depth = make(GL_R32F);
-  depth = make(GL_DEPTH_COMPONENT32F);
-  output = make(bits == 16 ? GL_RGBA16 : GL_RGBA8);
-  GLuint ids[3];
-  glCreateFramebuffers(3, ids);
-  scene_fbo = GlFramebuffer(ids[0]);
-  beam_fbo = GlFramebuffer(ids[1]);
-  output_fbo = GlFramebuffer(ids[2]);
-  // glNamedFramebufferTexture attaches every layer of an array texture (layered).
-  glNamedFramebufferTexture(ids[0], GL_COLOR_ATTACHMENT0, hdr.get(), 0);
-  glNamedFramebufferTexture(ids[0], GL_COLOR_ATTACHMENT1, view_depth.get(), 0);
-  glNamedFramebufferTexture(ids[0], GL_DEPTH_ATTACHMENT, depth.get(), 0);
-  const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glNamedFramebufferDrawBuffers(ids[0], 2, both);
-  glNamedFramebufferTexture(ids[1], GL_COLOR_ATTACHMENT0, hdr.get(), 0);
-  glNamedFramebufferTexture(ids[2], GL_COLOR_ATTACHMENT0, output.get(), 0);
-  check_framebuffer(ids[0], "scene framebuffer");
-  check_framebuffer(ids[1], "beam framebuffer");
-  check_framebuffer(ids[2], "output framebuffer");
-  // One framebuffer triple per layer. Rendering each view through its own
-  // (non-layered) framebuffer measured faster on llvmpipe than one layered
-  // framebuffer with gl_Layer routing (docs/performance.md).
-  layer_fbos.clear();
-  layer_fbos.resize(static_cast<std::size_t>(layer_count));
-  for (int v = 0; v < layer_count; ++v) {
-    GLuint l[3];
-    glCreateFramebuffers(3, l);
-    LayerFbos& f = layer_fbos[static_cast<std::size_t>(v)];
-    f.scene = GlFramebuffer(l[0]);
-    f.beam = GlFramebuffer(l[1]);
-    f.output = GlFramebuffer(l[2]);
-    glNamedFramebufferTextureLayer(l[0], GL_COLOR_ATTACHMENT0, hdr.get(), 0, v);
-    glNamedFramebufferTextureLayer(l[0], GL_COLOR_ATTACHMENT1, view_depth.get(), 0, v);
-    glNamedFramebufferTextureLayer(l[0], GL_DEPTH_ATTACHMENT, depth.get(), 0, v);
-    glNamedFramebufferDrawBuffers(l[0], 2, both);
-    glNamedFramebufferTextureLayer(l[1], GL_COLOR_ATTACHMENT0, hdr.get(), 0, v);
-    glNamedFramebufferTextureLayer(l[2], GL_COLOR_ATTACHMENT0, output.get(), 0, v);
-    check_framebuffer(l[0], "scene framebuffer (layer)");
-    check_framebuffer(l[1], "beam framebuffer (layer)");
-    check_framebuffer(l[2], "output framebuffer (layer)");
+namespace {
+
+GLenum internal_format(TargetFormat f, int bits) {
+  switch (f) {
+    case TargetFormat::kRgba32f:
+      return GL_RGBA32F;
+    case TargetFormat::kR32f:
+      return GL_R32F;
+    case TargetFormat::kDepth32f:
+      return GL_DEPTH_COMPONENT32F;
+    case TargetFormat::kDisplay:
+      return bits == 16 ? GL_RGBA16 : GL_RGBA8;
+  }
+  throw GlError("unknown target format");
+}
+
+}  // namespace
+
+void FrameTargets::ensure(const FramePlan& plan, int render_w, int render_h, int camera_w,
+                          int camera_h, int bits, int layer_count) {
+  if (render_w != render_w_ || render_h != render_h_ || camera_w != camera_w_ ||
+      camera_h != camera_h_ || bits != bits_ || layer_count != layers_) {
+    targets_.clear();
+    for (PassFbos& f : fbos_) f = PassFbos{};
+    render_w_ = render_w;
+    render_h_ = render_h;
+    camera_w_ = camera_w;
+    camera_h_ = camera_h;
+    bits_ = bits;
+    layers_ = layer_count;
+  }
+  for (const TargetDecl* decl : plan.targets) {
+    if (find(decl->name)) continue;
+    const bool camera_size = decl->size == TargetSize::kCamera;
+    const int w = camera_size ? camera_w : render_w;
+    const int h = camera_size ? camera_h : render_h;
+    const GLenum format = internal_format(decl->format, bits);
+    Target t{decl, {}};
+    if (layer_count == 0) {
+      t.texture = make_texture_2d(format, w, h);
+    } else {
+      GLuint id = 0;
+      glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+      t.texture = GlTexture(id);
+      glTextureStorage3D(id, 1, format, w, h, layer_count);
+      glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    targets_.push_back(std::move(t));
   }
   gl_check("FrameTargets::ensure");
+}
+
+const FrameTargets::Target* FrameTargets::find(std::string_view name) const {
+  for (const Target& t : targets_) {
+    if (t.decl->name == name) return &t;
+  }
+  return nullptr;
+}
+
+GLuint FrameTargets::texture(std::string_view name) const {
+  const Target* t = find(name);
+  return t ? t->texture.get() : 0;
+}
+
+void FrameTargets::clear(const FramePlan& plan, const Color& background) {
+  for (const TargetDecl* decl : plan.targets) {
+    const GLuint tex = texture(decl->name);
+    switch (decl->clear) {
+      case TargetClear::kNone:
+        break;
+      case TargetClear::kBackground: {
+        const float bg[4] = {static_cast<float>(background[0]), static_cast<float>(background[1]),
+                             static_cast<float>(background[2]), 0.0f};
+        glClearTexImage(tex, 0, GL_RGBA, GL_FLOAT, bg);
+        break;
+      }
+      case TargetClear::kNoSurface: {
+        const float v = kNoSurface;
+        glClearTexImage(tex, 0, GL_RED, GL_FLOAT, &v);
+        break;
+      }
+      case TargetClear::kFarDepth: {
+        const float v = 0.0f;  // reversed Z
+        glClearTexImage(tex, 0, GL_DEPTH_COMPONENT, GL_FLOAT, &v);
+        break;
+      }
+    }
+  }
+  gl_check("FrameTargets::clear");
+}
+
+GLuint FrameTargets::fbo(const PassDecl& pass, int view) {
+  PassFbos& f = fbos_[static_cast<std::size_t>(pass.id)];
+  if (view < 0 || layers_ == 0) {
+    if (!f.plain) f.plain = GlFramebuffer(make_fbo(pass, -1));
+    return f.plain.get();
+  }
+  if (f.per_layer.empty()) f.per_layer.resize(static_cast<std::size_t>(layers_));
+  GlFramebuffer& l = f.per_layer[static_cast<std::size_t>(view)];
+  if (!l) l = GlFramebuffer(make_fbo(pass, view));
+  return l.get();
+}
+
+// The pass's writes as attachments of one framebuffer (of one layer, or the
+// plain targets with layer < 0). Rendering each view through its own
+// (non-layered) framebuffer measured faster on llvmpipe than one layered
+// framebuffer with gl_Layer routing (docs/performance.md).
+GLuint FrameTargets::make_fbo(const PassDecl& pass, int layer) {
+  GLuint id = 0;
+  glCreateFramebuffers(1, &id);
+  std::vector<GLenum> draw;
+  for (const std::string& name : pass.writes) {
+    const Target* t = find(name);
+    if (!t) throw GlError("pass " + pass.name + " writes target " + name + ", not allocated");
+    GLenum attachment = GL_DEPTH_ATTACHMENT;
+    if (t->decl->format != TargetFormat::kDepth32f) {
+      attachment = GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(draw.size());
+      draw.push_back(attachment);
+    }
+    if (layer < 0) {
+      glNamedFramebufferTexture(id, attachment, t->texture.get(), 0);
+    } else {
+      glNamedFramebufferTextureLayer(id, attachment, t->texture.get(), 0, layer);
+    }
+  }
+  glNamedFramebufferDrawBuffers(id, static_cast<GLsizei>(draw.size()), draw.data());
+  check_framebuffer(id, ("framebuffer of pass " + pass.name).c_str());
+  gl_check("FrameTargets::make_fbo");
+  return id;
 }
 
 namespace {
@@ -101,16 +173,16 @@ class ProgramPair {
 
 // Issues `draw` into `fbo(view)` once per view of a multi-view batch (with
 // u_view = the view), or once into the plain framebuffer for a single camera.
-template <class Fbo, class Draw>
-void for_each_view(const FrameContext& ctx, ProgramPair& program, Fbo fbo, Draw draw) {
+template <class Draw>
+void for_each_view(FrameContext& ctx, const PassDecl& self, ProgramPair& program, Draw draw) {
   if (ctx.views == 0) {
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo(-1));
+    glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, -1));
     draw();
     return;
   }
   const GLint loc = program.uniform(true, "u_view");
   for (int v = 0; v < ctx.views; ++v) {
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo(v));
+    glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, v));
     glUniform1i(loc, v);
     draw();
   }
@@ -124,8 +196,7 @@ class SurfacePass final : public Pass {
       : raster_("surface", {"common.glsl", "surface.vert"}, {"common.glsl", "surface.frag"}),
         analytic_("analytic_occluder", {"common.glsl", "fullscreen.vert"},
                   {"common.glsl", "analytic_occluder.frag"}) {}
-  const char* name() const override { return "surfaces"; }
-  void execute(FrameContext& ctx) override {
+  void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);  // reversed Z
@@ -139,7 +210,7 @@ class SurfacePass final : public Pass {
     // Per view: both draws into the view's framebuffer.
     const int views = multi ? ctx.views : 1;
     for (int v = 0; v < views; ++v) {
-      glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.scene_for(multi ? v : -1));
+      glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, multi ? v : -1));
       if (raster) {
         glUseProgram(raster_.get(multi));
         if (multi) glUniform1i(raster_.uniform(true, "u_view"), v);
@@ -171,13 +242,14 @@ class BeamPass final : public Pass {
   BeamPass()
       : program_("beam", {"common.glsl", "beam.vert"},
                  {"common.glsl", "beam_math.glsl", "beam.frag"}) {}
-  const char* name() const override { return "beams"; }
-  void execute(FrameContext& ctx) override {
+  void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
     glUseProgram(program_.get(multi));
     glUniform3i(program_.uniform(multi, "u_table_size"), ctx.resources.table_d(),
                 ctx.resources.table_s(), ctx.resources.table_f());
-    glUniform1i(program_.uniform(multi, "u_has_surfaces"), ctx.scene.occluders.empty() ? 0 : 1);
+    // A ray ends at the nearest surface if any planned pass wrote view depth.
+    const bool surfaces = ctx.plan.written("view_depth");
+    glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
     if (multi) glUniform1i(program_.uniform(multi, "u_view_beams"), ctx.resources.beam_count());
     const RenderSettings& rs = ctx.scene.render;
     const bool chord = rs.layout == TableLayout::kChord || rs.layout == TableLayout::kChordWarped;
@@ -196,7 +268,7 @@ class BeamPass final : public Pass {
     }
     glBindTextureUnit(0, ctx.resources.g_texture());
     glBindTextureUnit(1, ctx.resources.f_texture());
-    glBindTextureUnit(2, ctx.targets.view_depth.get());
+    glBindTextureUnit(2, surfaces ? ctx.targets.texture("view_depth") : 0);
     glBindTextureUnit(3, ctx.resources.warp_texture());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx.resources.beam_buffer());
     glEnable(GL_BLEND);
@@ -208,7 +280,7 @@ class BeamPass final : public Pass {
     glEnable(GL_DEPTH_CLAMP);  // proxies past the near or far plane still cover their pixels
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(ctx.empty_vao);
-    for_each_view(ctx, program_, [&](int v) { return ctx.targets.beam_for(v); }, [&] {
+    for_each_view(ctx, self, program_, [&] {
       glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count());
     });
     glDisable(GL_BLEND);
@@ -226,18 +298,16 @@ class TonemapPass final : public Pass {
  public:
   TonemapPass()
       : program_("tonemap", {"common.glsl", "fullscreen.vert"}, {"common.glsl", "tonemap.frag"}) {}
-  const char* name() const override { return "tonemap"; }
-  void execute(FrameContext& ctx) override {
+  void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
     glUseProgram(program_.get(multi));
     const OutputSettings& out = ctx.scene.output;
     glUniform1f(program_.uniform(multi, "u_exposure"), static_cast<float>(out.exposure));
     glUniform1i(program_.uniform(multi, "u_curve"), static_cast<int>(out.tone));
     glUniform1f(program_.uniform(multi, "u_levels"), out.bit_depth == 16 ? 65535.0f : 255.0f);
-    glBindTextureUnit(0, ctx.targets.hdr.get());
+    glBindTextureUnit(0, ctx.targets.texture("hdr"));
     glBindVertexArray(ctx.empty_vao);
-    for_each_view(ctx, program_, [&](int v) { return ctx.targets.output_for(v); },
-                  [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
     gl_check("tonemap pass");
   }
 
@@ -245,14 +315,41 @@ class TonemapPass final : public Pass {
   ProgramPair program_;
 };
 
+// The tone-mapped output (render size) to the camera's size, bilinear; only
+// planned for scaled frames. Reads the output through tonemap's framebuffer.
+class UpscalePass final : public Pass {
+ public:
+  void execute(FrameContext& ctx, const PassDecl& self) override {
+    const PassDecl* source = nullptr;
+    for (const PassDecl* p : ctx.plan.passes) {
+      if (p != &self && !p->writes.empty() && p->writes.front() == self.reads.front()) source = p;
+    }
+    if (!source) throw GlError("upscale: no planned pass writes " + self.reads.front());
+    const int views = ctx.views > 0 ? ctx.views : 1;
+    for (int v = 0; v < views; ++v) {
+      const int view = ctx.views > 0 ? v : -1;
+      glBlitNamedFramebuffer(ctx.targets.fbo(*source, view), ctx.targets.fbo(self, view), 0, 0,
+                             ctx.camera.width, ctx.camera.height, 0, 0, ctx.output_width,
+                             ctx.output_height, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    }
+    gl_check("upscale pass");
+  }
+};
+
 }  // namespace
 
-std::vector<std::unique_ptr<Pass>> make_passes() {
-  std::vector<std::unique_ptr<Pass>> passes;
-  passes.push_back(std::make_unique<SurfacePass>());
-  passes.push_back(std::make_unique<BeamPass>());
-  passes.push_back(std::make_unique<TonemapPass>());
-  return passes;
+std::unique_ptr<Pass> make_pass(PassId id) {
+  switch (id) {
+    case PassId::kSurfaces:
+      return std::make_unique<SurfacePass>();
+    case PassId::kBeams:
+      return std::make_unique<BeamPass>();
+    case PassId::kTonemap:
+      return std::make_unique<TonemapPass>();
+    case PassId::kUpscale:
+      return std::make_unique<UpscalePass>();
+  }
+  throw GlError("make_pass: unknown pass id");
 }
 
 }  // namespace beamcast

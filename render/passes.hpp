@@ -1,57 +1,63 @@
-// The pass interface and the GPU-side state a frame passes between passes.
-// A new effect (photon splatting, media, point surfaces, volumes) is a new Pass
-// here plus its rule in pass_plan.cpp; the frame loop does not change.
+// Pass executors and the GPU-side state a frame passes between passes. A new
+// effect (photon splatting, media, point surfaces, volumes) is a declaration in
+// pass_plan.cpp (rule, targets, uploads) and its executor here; the frame loop
+// does not change.
 #pragma once
 
 #include <array>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "protocol/camera.hpp"
 #include "protocol/scene.hpp"
 #include "render/gl_util.hpp"
+#include "render/pass_plan.hpp"
 #include "render/scene_resources.hpp"
 
 namespace beamcast {
 
-// Render targets of one frame size: linear HDR colour, view depth (surfaces'
-// distance along the view axis; cleared to kNoSurface), depth buffer, output.
-// With layers > 0 every target is a 2D array texture of that many layers
-// (one per view of a multi-view batch), with one framebuffer triple per layer
-// (`layer_fbos`); the layered triple (`scene_fbo` ...) is then unused.
-struct FrameTargets {
+// The render targets of one frame size, allocated from plans: a target is
+// allocated the first time a plan uses it (read or written by a planned pass)
+// and kept for later frames of the same sizes; one framebuffer per pass (its
+// declared writes: colour attachments in order, then depth) is made when the
+// pass first runs. With layers > 0 every target is a 2D array texture of that
+// many layers (one per view of a multi-view batch), with one framebuffer per
+// pass and layer.
+class FrameTargets {
+ public:
   static constexpr float kNoSurface = 1e30f;
-  int width = 0;
-  int height = 0;
-  int bit_depth = 0;
-  int layers = 0;  // 0: plain 2D textures
-  GlTexture hdr;         // RGBA32F
-  GlTexture view_depth;  // R32F
-  GlTexture depth;       // DEPTH32F, reversed Z
-  GlTexture output;      // RGBA8 or RGBA16
-  GlFramebuffer scene_fbo;   // hdr + view_depth + depth
-  GlFramebuffer beam_fbo;    // hdr only (beams read view_depth as a texture)
-  GlFramebuffer output_fbo;  // output
-  struct LayerFbos {
-    GlFramebuffer scene, beam, output;
+  // Sizes: render (camera x resolution scale) and camera (the client's size).
+  // A change of size, bit depth or layer count frees everything first.
+  void ensure(const FramePlan& plan, int render_w, int render_h, int camera_w, int camera_h,
+              int bits, int layer_count = 0);
+  // Clears every cleared target of the plan (all layers) to its start value.
+  void clear(const FramePlan& plan, const Color& background);
+  GLuint texture(std::string_view name) const;  // 0: not allocated
+  // The framebuffer of `pass` for `view` (view < 0 or no layers: the plain one).
+  GLuint fbo(const PassDecl& pass, int view);
+  int layers() const { return layers_; }
+
+ private:
+  struct Target {
+    const TargetDecl* decl = nullptr;
+    GlTexture texture;
   };
-  std::vector<LayerFbos> layer_fbos;
-  void ensure(int w, int h, int bits, int layer_count = 0);
-  // The framebuffer of a view (view < 0 or no layers: the plain one).
-  GLuint scene_for(int view) const {
-    return view < 0 || layers == 0 ? scene_fbo.get() : layer_fbos[view].scene.get();
-  }
-  GLuint beam_for(int view) const {
-    return view < 0 || layers == 0 ? beam_fbo.get() : layer_fbos[view].beam.get();
-  }
-  GLuint output_for(int view) const {
-    return view < 0 || layers == 0 ? output_fbo.get() : layer_fbos[view].output.get();
-  }
+  struct PassFbos {
+    GlFramebuffer plain;
+    std::vector<GlFramebuffer> per_layer;
+  };
+  int render_w_ = 0, render_h_ = 0, camera_w_ = 0, camera_h_ = 0, bits_ = 0, layers_ = 0;
+  std::vector<Target> targets_;
+  std::array<PassFbos, kPassCount> fbos_;
+  const Target* find(std::string_view name) const;
+  GLuint make_fbo(const PassDecl& pass, int layer);
 };
 
 struct FrameContext {
   const Scene& scene;
+  const FramePlan& plan;
   const Camera& camera;
   const CameraBasis& basis;
   SceneResources& resources;
@@ -62,6 +68,10 @@ struct FrameContext {
   // targets), drawn by the multi-view programs, each draw once per view into
   // that view's layer with the uniform u_view; `camera` is the first.
   int views = 0;
+  // The camera's own size (`camera` is at the render size; they differ only
+  // for scaled frames, which the upscale pass brings back to this size).
+  int output_width = 0;
+  int output_height = 0;
 };
 
 // Views in one multi-view batch: the size of the shaders' camera array
@@ -69,16 +79,16 @@ struct FrameContext {
 // the 16 KiB every GL 4.5 driver must allow a uniform block).
 inline constexpr int kMaxBatchViews = 64;
 
+// How a declared pass (PassDecl) executes. `self` is its declaration (its
+// targets' framebuffers come from ctx.targets.fbo(self, view)).
 class Pass {
  public:
   virtual ~Pass() = default;
-  virtual const char* name() const = 0;
-  virtual void execute(FrameContext& ctx) = 0;
+  virtual void execute(FrameContext& ctx, const PassDecl& self) = 0;
 };
 
-// Every pass, in execution order (the order of pass_catalog()); programs are
-// compiled here, so a GL context must be current. Multi-view programs are
-// compiled on first use, so a context without layered rendering never needs them.
-std::vector<std::unique_ptr<Pass>> make_passes();
+// The executor of a catalog pass; programs are compiled here, so a GL context
+// must be current. Multi-view programs are compiled on first use.
+std::unique_ptr<Pass> make_pass(PassId id);
 
 }  // namespace beamcast

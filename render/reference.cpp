@@ -241,131 +241,17 @@ struct Hit {
   const Color* albedo = nullptr;  // null: no hit
 };
 
-struct PreparedOccluder {
-  const Occluder* occ = nullptr;
-  Vec3 normal{};                        // plane: unit normal
-  std::array<double, 4> q{1, 0, 0, 0};  // box: unit rotation
-  std::array<double, 4> qc{1, 0, 0, 0}; // box: inverse rotation
-  Vec3 half{};                          // box: half extents
-  Vec3 lo{}, hi{};                      // mesh: bounding box
-  bool empty = false;
-};
-
-PreparedOccluder prepare_occluder(const Occluder& o) {
-  PreparedOccluder p;
-  p.occ = &o;
-  if (const auto* pl = std::get_if<PlaneOccluder>(&o.shape)) {
-    p.normal = normalize(pl->normal);
-  } else if (const auto* b = std::get_if<BoxOccluder>(&o.shape)) {
-    const auto& r = b->rotation;
-    const double n = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]);
-    p.q = {r[0] / n, r[1] / n, r[2] / n, r[3] / n};
-    p.qc = {p.q[0], -p.q[1], -p.q[2], -p.q[3]};
-    p.half = 0.5 * b->size;
-  } else if (const auto* m = std::get_if<MeshOccluder>(&o.shape)) {
-    p.empty = m->vertices.empty() || m->triangles.empty();
-    p.lo = {kInf, kInf, kInf};
-    p.hi = {-kInf, -kInf, -kInf};
-    for (const auto& v : m->vertices) {
-      for (int k = 0; k < 3; ++k) {
-        p.lo[k] = std::min(p.lo[k], v[k]);
-        p.hi[k] = std::max(p.hi[k], v[k]);
-      }
-    }
+// The nearest occluder hit of a ray with t in [t_min, t_max], if any; each
+// kind intersects itself (protocol/occluders/).
+Hit nearest_hit(const Scene& scene, const Vec3& o, const Vec3& v, double t_min, double t_max) {
+  Hit best;
+  for (const Occluder& occ : scene.occluders) {
+    const std::optional<OccluderHit> h = std::visit(
+        [&](const auto& shape) { return shape.intersect(o, v, t_min, std::min(t_max, best.t)); },
+        occ.shape);
+    if (h) best = {h->t, h->n, &occ.albedo};
   }
-  return p;
-}
-
-// Slab test of an axis-aligned box [lo, hi]; returns the entry/exit parameters
-// and the axes that produced them. False when the ray misses the box.
-bool slab(const Vec3& o, const Vec3& v, const Vec3& lo, const Vec3& hi, double* tn, double* tf,
-          int* an, int* af) {
-  *tn = -kInf;
-  *tf = kInf;
-  *an = *af = -1;
-  for (int k = 0; k < 3; ++k) {
-    if (v[k] == 0.0) {
-      if (o[k] < lo[k] || o[k] > hi[k]) return false;
-      continue;
-    }
-    const double inv = 1.0 / v[k];
-    double ta = (lo[k] - o[k]) * inv;
-    double tb = (hi[k] - o[k]) * inv;
-    if (ta > tb) std::swap(ta, tb);
-    if (ta > *tn) *tn = ta, *an = k;
-    if (tb < *tf) *tf = tb, *af = k;
-  }
-  return *tn <= *tf;
-}
-
-// Nearest hit of one occluder with t in [tmin, tmax]; updates `best` if closer.
-void intersect(const PreparedOccluder& p, const Vec3& o, const Vec3& v, double tmin, double tmax,
-               Hit* best) {
-  tmax = std::min(tmax, best->t);
-  const Occluder& occ = *p.occ;
-  if (const auto* pl = std::get_if<PlaneOccluder>(&occ.shape)) {
-    const double denom = dot(v, p.normal);
-    if (denom == 0.0) return;
-    const double t = dot(pl->point - o, p.normal) / denom;
-    if (t >= tmin && t <= tmax) *best = {t, p.normal, &occ.albedo};
-  } else if (const auto* b = std::get_if<BoxOccluder>(&occ.shape)) {
-    const Vec3 ol = rotate(p.qc, o - b->center);
-    const Vec3 vl = rotate(p.qc, v);
-    const Vec3 lo = -1.0 * p.half;
-    double tn, tf;
-    int an, af;
-    if (!slab(ol, vl, lo, p.half, &tn, &tf, &an, &af)) return;
-    double t = kInf;
-    int axis = -1;
-    if (tn >= tmin && tn <= tmax) {
-      t = tn, axis = an;
-    } else if (tf >= tmin && tf <= tmax) {  // ray starts inside the box
-      t = tf, axis = af;
-    }
-    if (axis < 0) return;
-    Vec3 nl{0.0, 0.0, 0.0};
-    nl[axis] = 1.0;
-    *best = {t, rotate(p.q, nl), &occ.albedo};
-  } else if (const auto* s = std::get_if<SphereOccluder>(&occ.shape)) {
-    const Vec3 e = s->center - o;
-    const double tc = dot(e, v);
-    const Vec3 perp = e - tc * v;
-    const double d = length(perp);
-    if (!(d <= s->radius)) return;
-    const double h = std::sqrt((s->radius - d) * (s->radius + d));
-    double t = tc - h;
-    if (!(t >= tmin && t <= tmax)) t = tc + h;
-    if (!(t >= tmin && t <= tmax)) return;
-    *best = {t, (1.0 / s->radius) * ((o + t * v) - s->center), &occ.albedo};
-  } else if (const auto* m = std::get_if<MeshOccluder>(&occ.shape)) {
-    if (p.empty) return;
-    double tn, tf;
-    int an, af;
-    if (!slab(o, v, p.lo, p.hi, &tn, &tf, &an, &af)) return;
-    if (tf < tmin || tn > tmax) return;
-    const std::size_t nv = m->vertices.size();
-    for (const auto& tri : m->triangles) {
-      if (tri[0] >= nv || tri[1] >= nv || tri[2] >= nv) continue;
-      const Vec3& p0 = m->vertices[tri[0]];
-      const Vec3 e1 = m->vertices[tri[1]] - p0;
-      const Vec3 e2 = m->vertices[tri[2]] - p0;
-      const Vec3 pv = cross(v, e2);
-      const double det = dot(e1, pv);
-      if (det == 0.0) continue;
-      const double inv = 1.0 / det;
-      const Vec3 tv = o - p0;
-      const double bu = dot(tv, pv) * inv;
-      if (bu < 0.0 || bu > 1.0) continue;
-      const Vec3 qv = cross(tv, e1);
-      const double bv = dot(v, qv) * inv;
-      if (bv < 0.0 || bu + bv > 1.0) continue;
-      const double t = dot(e2, qv) * inv;
-      if (t >= tmin && t <= tmax) {
-        tmax = t;
-        *best = {t, normalize(cross(e1, e2)), &occ.albedo};
-      }
-    }
-  }
+  return best;
 }
 
 }  // namespace
@@ -397,8 +283,6 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
     beams.push_back(prepare_beam(b));
     beam_src.push_back(&b);
   }
-  std::vector<PreparedOccluder> occs;
-  for (const Occluder& o : scene.occluders) occs.push_back(prepare_occluder(o));
 
   const DirectionalLight& light = scene.light;
   const double llen = length(light.direction);
@@ -408,8 +292,7 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
     const int py = cam.height - 1 - y;  // GL pixel rows count from the bottom
     for (int x = 0; x < cam.width; ++x) {
       const Ray ray = camera_ray(cam, basis, x, py);
-      Hit hit;
-      for (const auto& o : occs) intersect(o, ray.origin, ray.dir, ray.t_min, ray.t_max, &hit);
+      const Hit hit = nearest_hit(scene, ray.origin, ray.dir, ray.t_min, ray.t_max);
       Color c = scene.background;
       double t_end = ray.t_max;
       if (hit.albedo) {

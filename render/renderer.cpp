@@ -3,9 +3,11 @@
 #include <GL/glcorearb.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <string>
 
 #include "protocol/camera.hpp"
 #include "render/gl_util.hpp"
@@ -37,22 +39,24 @@ void split_views(const std::vector<T>& src, int w, int h, std::size_t first, std
 
 struct Renderer::Impl {
   std::unique_ptr<EglContext> context;
-  std::vector<std::unique_ptr<Pass>> passes;
+  std::array<std::unique_ptr<Pass>, kPassCount> passes;  // by PassId
   TableCache tables;
   FrameTargets targets;
   FrameTargets layered;  // multi-view batches
   GlVertexArray empty_vao;
   std::vector<GlQuery> queries;  // timestamps: frame start, then one after each pass
-  bool multiview = true;  // multi-view batches need only GL 4.5
   int max_layers = 0;
-  // Target of the bilinear upscale when FrameOptions::resolution_scale < 1.
-  GlTexture upscaled;
-  GlFramebuffer upscaled_fbo;
-  int up_width = 0, up_height = 0, up_bits = 0;
 
   explicit Impl(const RendererOptions& opts)
       : context(EglContext::create(opts.egl)), tables(opts.table_cache_entries) {
-    passes = make_passes();
+    // One executor per catalog pass: a declaration the renderer cannot run is
+    // an error here, not a pass silently missing from frames.
+    for (const PassDecl& decl : pass_catalog()) {
+      passes[static_cast<std::size_t>(decl.id)] = make_pass(decl.id);
+    }
+    for (std::size_t i = 0; i < passes.size(); ++i) {
+      if (!passes[i]) throw GlError("pass id " + std::to_string(i) + " has no catalog entry");
+    }
     GLuint id = 0;
     glCreateVertexArrays(1, &id);
     empty_vao = GlVertexArray(id);
@@ -63,83 +67,47 @@ struct Renderer::Impl {
     gl_check("renderer setup");
   }
 
-  GLuint query(std::size_t i) {
-    while (queries.size() <= i) {
+  // Clears the plan's targets and runs its passes, with a timestamp before
+  // the first and after each (plan.passes.size() + 1 queries).
+  void run_passes(const Scene& scene, FrameContext& ctx) {
+    const FramePlan& plan = ctx.plan;
+    while (queries.size() < plan.passes.size() + 1) {
       GLuint id = 0;
       glGenQueries(1, &id);
       queries.emplace_back(id);
     }
-    return queries[i].get();
-  }
-
-  // Clears the targets and runs the passes, with timestamps around each.
-  void run_passes(const Scene& scene, FrameContext& ctx, const std::vector<Pass*>& plan) {
-    const float bg[4] = {static_cast<float>(scene.background[0]),
-                         static_cast<float>(scene.background[1]),
-                         static_cast<float>(scene.background[2]), 0.0f};
-    const float no_surface[4] = {FrameTargets::kNoSurface, 0.0f, 0.0f, 0.0f};
-    const float far_depth = 0.0f;  // reversed Z
     glDepthMask(GL_TRUE);
-    glQueryCounter(query(0), GL_TIMESTAMP);
-    // Single camera: the plain framebuffer (view -1); a batch: each view's.
-    for (int v = ctx.views > 0 ? 0 : -1; v < ctx.views; ++v) {
-      const GLuint fbo = ctx.targets.scene_for(v);
-      glClearNamedFramebufferfv(fbo, GL_COLOR, 0, bg);
-      glClearNamedFramebufferfv(fbo, GL_COLOR, 1, no_surface);
-      glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &far_depth);
-    }
-    for (std::size_t i = 0; i < plan.size(); ++i) {
-      plan[i]->execute(ctx);
-      glQueryCounter(query(i + 1), GL_TIMESTAMP);
+    glQueryCounter(queries[0].get(), GL_TIMESTAMP);
+    ctx.targets.clear(plan, scene.background);
+    for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+      const PassDecl& decl = *plan.passes[i];
+      passes[static_cast<std::size_t>(decl.id)]->execute(ctx, decl);
+      glQueryCounter(queries[i + 1].get(), GL_TIMESTAMP);
     }
     gl_check("frame");
   }
 
-  // Bilinear upscale of the output (render size) to w x h, into `upscaled`.
-  void upscale(int rw, int rh, int w, int h, int bits) {
-    if (w != up_width || h != up_height || bits != up_bits) {
-      up_width = w;
-      up_height = h;
-      up_bits = bits;
-      upscaled = make_texture_2d(bits == 16 ? GL_RGBA16 : GL_RGBA8, w, h);
-      GLuint id = 0;
-      glCreateFramebuffers(1, &id);
-      upscaled_fbo = GlFramebuffer(id);
-      glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, upscaled.get(), 0);
-      check_framebuffer(id, "upscale framebuffer");
-    }
-    glBlitNamedFramebuffer(targets.output_fbo.get(), upscaled_fbo.get(), 0, 0, rw, rh, 0, 0, w, h,
-                           GL_COLOR_BUFFER_BIT, GL_LINEAR);
-    gl_check("upscale blit");
-  }
-
-  // Pass times of the last run_passes (waits for the GPU); with `upscaled`,
-  // one more stamp after the upscale blit.
-  BatchTiming read_timings(const std::vector<Pass*>& plan, bool upscaled_frame = false) {
-    const std::size_t stamp_count = plan.size() + (upscaled_frame ? 2 : 1);
-    GLuint64 stamps[16] = {};
-    for (std::size_t i = 0; i < stamp_count; ++i) {
-      glGetQueryObjectui64v(query(i), GL_QUERY_RESULT, &stamps[i]);
+  // Pass times of the last run_passes (waits for the GPU).
+  BatchTiming read_timings(const FramePlan& plan) {
+    std::vector<GLuint64> stamps(plan.passes.size() + 1);
+    for (std::size_t i = 0; i < stamps.size(); ++i) {
+      glGetQueryObjectui64v(queries[i].get(), GL_QUERY_RESULT, &stamps[i]);
     }
     BatchTiming t;
-    for (std::size_t i = 0; i < plan.size(); ++i) {
-      t.passes.push_back({plan[i]->name(), (stamps[i + 1] - stamps[i]) * 1e-6});
+    for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+      t.passes.push_back({plan.passes[i]->name, (stamps[i + 1] - stamps[i]) * 1e-6});
     }
-    if (upscaled_frame) {
-      t.passes.push_back({"upscale", (stamps[plan.size() + 1] - stamps[plan.size()]) * 1e-6});
-    }
-    t.gpu_ms = (stamps[stamp_count - 1] - stamps[0]) * 1e-6;
+    t.gpu_ms = (stamps.back() - stamps.front()) * 1e-6;
     return t;
   }
 
   FrameResult render_camera(const Scene& scene, const Camera& full_cam, SceneResources& res,
-                            const std::vector<Pass*>& plan, const FrameOptions& opts) {
+                            const FramePlan& plan, const FrameOptions& opts) {
     const auto wall0 = std::chrono::steady_clock::now();
     FrameResult result;
     // A scaled frame renders a smaller copy of the camera (same view, fewer pixels).
     Camera small = full_cam;
-    const bool scaled = opts.resolution_scale > 0.0 && opts.resolution_scale < 1.0;
-    if (scaled) {
+    if (PlanInput{scene, opts.resolution_scale}.scaled()) {
       small.width = std::max(1, static_cast<int>(std::lround(full_cam.width * opts.resolution_scale)));
       small.height =
           std::max(1, static_cast<int>(std::lround(full_cam.height * opts.resolution_scale)));
@@ -147,16 +115,13 @@ struct Renderer::Impl {
     const Camera& cam = small;
     const CameraBasis basis = camera_basis(cam);
     res.bind_camera(cam, basis);
-    targets.ensure(cam.width, cam.height, scene.output.bit_depth);
+    targets.ensure(plan, cam.width, cam.height, full_cam.width, full_cam.height,
+                   scene.output.bit_depth);
     glViewport(0, 0, cam.width, cam.height);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.camera_buffer());
-    FrameContext ctx{scene, cam, basis, res, targets, empty_vao.get()};
-    run_passes(scene, ctx, plan);
-    if (scaled) {
-      upscale(cam.width, cam.height, full_cam.width, full_cam.height, scene.output.bit_depth);
-      glQueryCounter(query(plan.size() + 1), GL_TIMESTAMP);
-      gl_check("frame");
-    }
+    FrameContext ctx{scene,           plan, cam, basis, res, targets, empty_vao.get(), 0,
+                     full_cam.width, full_cam.height};
+    run_passes(scene, ctx);
 
     // Read-back (synchronous: it waits for the GPU to finish the frame).
     const auto rb0 = std::chrono::steady_clock::now();
@@ -166,8 +131,8 @@ struct Renderer::Impl {
     result.image.bit_depth = scene.output.bit_depth;
     result.image.rgb.resize(3 * static_cast<std::size_t>(w) * h);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER,
-                      scaled ? upscaled_fbo.get() : targets.output_fbo.get());
+    // The last pass's framebuffer holds the final target at attachment 0.
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, targets.fbo(*plan.passes.back(), -1));
     if (scene.output.bit_depth == 16) {
       glReadnPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_SHORT,
                     static_cast<GLsizei>(result.image.rgb.size() * 2), result.image.rgb.data());
@@ -192,18 +157,16 @@ struct Renderer::Impl {
       result.hdr.width = hw;
       result.hdr.height = hh;
       std::vector<float> buf(hrow * hh);
-      glBindFramebuffer(GL_READ_FRAMEBUFFER, targets.scene_fbo.get());
-      glReadBuffer(GL_COLOR_ATTACHMENT0);
-      glReadnPixels(0, 0, hw, hh, GL_RGB, GL_FLOAT, static_cast<GLsizei>(buf.size() * 4),
-                    buf.data());
-      gl_check("glReadnPixels(hdr)");
+      glGetTextureImage(targets.texture("hdr"), 0, GL_RGB, GL_FLOAT,
+                        static_cast<GLsizei>(buf.size() * sizeof(float)), buf.data());
+      gl_check("glGetTextureImage(hdr)");
       result.hdr.rgb.resize(buf.size());
       for (int y = 0; y < hh; ++y) {
         std::memcpy(&result.hdr.rgb[y * hrow], &buf[(hh - 1 - y) * hrow], hrow * sizeof(float));
       }
     }
 
-    result.batch = read_timings(plan, scaled);
+    result.batch = read_timings(plan);
     result.passes = result.batch.passes;
     result.gpu_ms = result.batch.gpu_ms;
     result.wall_ms = ms_since(wall0);
@@ -216,7 +179,7 @@ struct Renderer::Impl {
   // frames[idx[...]]; one read-back transfers every view.
   void render_batch(const Scene& scene, const std::vector<Camera>& cameras,
                     const std::vector<std::size_t>& idx, SceneResources& res,
-                    const std::vector<Pass*>& plan, const FrameOptions& opts,
+                    const FramePlan& plan, const FrameOptions& opts,
                     std::vector<FrameResult>& frames) {
     const auto wall0 = std::chrono::steady_clock::now();
     const std::size_t k = idx.size();
@@ -228,11 +191,12 @@ struct Renderer::Impl {
     }
     const int w = cams[0].width, h = cams[0].height;
     res.bind_views(cams, bases, kMaxBatchViews);
-    layered.ensure(w, h, scene.output.bit_depth, static_cast<int>(k));
+    layered.ensure(plan, w, h, w, h, scene.output.bit_depth, static_cast<int>(k));
     glViewport(0, 0, w, h);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.views_camera_buffer());
-    FrameContext ctx{scene, cams[0], bases[0], res, layered, empty_vao.get(), static_cast<int>(k)};
-    run_passes(scene, ctx, plan);
+    FrameContext ctx{scene, plan, cams[0], bases[0], res, layered, empty_vao.get(),
+                     static_cast<int>(k), w, h};
+    run_passes(scene, ctx);
 
     // One read-back of every layer (synchronous: waits for the passes).
     const auto rb0 = std::chrono::steady_clock::now();
@@ -248,12 +212,12 @@ struct Renderer::Impl {
     auto image_of = [&](std::size_t v) { return frames[idx[v]].image.rgb.data(); };
     if (scene.output.bit_depth == 16) {
       std::vector<std::uint16_t> all(per_view * k);
-      glGetTextureImage(layered.output.get(), 0, GL_RGB, GL_UNSIGNED_SHORT,
+      glGetTextureImage(layered.texture(plan.final_target), 0, GL_RGB, GL_UNSIGNED_SHORT,
                         static_cast<GLsizei>(all.size() * 2), all.data());
       split_views(all, w, h, 0, k, image_of);
     } else {
       std::vector<std::uint8_t> all(per_view * k);
-      glGetTextureImage(layered.output.get(), 0, GL_RGB, GL_UNSIGNED_BYTE,
+      glGetTextureImage(layered.texture(plan.final_target), 0, GL_RGB, GL_UNSIGNED_BYTE,
                         static_cast<GLsizei>(all.size()), all.data());
       split_views(all, w, h, 0, k, image_of);
     }
@@ -261,7 +225,7 @@ struct Renderer::Impl {
     const double readback_ms = ms_since(rb0);
     if (opts.read_hdr) {
       std::vector<float> all(per_view * k);
-      glGetTextureImage(layered.hdr.get(), 0, GL_RGB, GL_FLOAT,
+      glGetTextureImage(layered.texture("hdr"), 0, GL_RGB, GL_FLOAT,
                         static_cast<GLsizei>(all.size() * sizeof(float)), all.data());
       gl_check("glGetTextureImage(hdr layers)");
       for (std::size_t v = 0; v < k; ++v) {
@@ -295,29 +259,22 @@ Renderer::~Renderer() = default;
 
 const std::string& Renderer::description() const { return impl_->context->description(); }
 
-bool Renderer::multiview_supported() const { return impl_->multiview; }
-
 std::vector<FrameResult> Renderer::render(const Scene& scene, const FrameOptions& opts) {
   return render(scene, scene.cameras, opts);
 }
 
 std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<Camera>& cameras,
                                           const FrameOptions& opts) {
-  std::vector<Pass*> plan;
-  for (const std::string& name : plan_passes(scene)) {
-    for (auto& pass : impl_->passes) {
-      if (name == pass->name()) plan.push_back(pass.get());
-    }
-  }
-  SceneResources res(scene, impl_->tables);
+  const FramePlan plan = make_plan(PlanInput{scene, opts.resolution_scale});
+  SceneResources res(scene, impl_->tables, plan);
   std::vector<FrameResult> frames(cameras.size());
   // Batches: cameras of one size, in order of first appearance, split where a
   // batch would pass the view or memory bound. A batch of one takes the
   // per-camera path, and so do scaled frames (resolution_scale < 1: the
   // interactive preview, one camera per request).
   std::vector<std::vector<std::size_t>> batches;
-  const bool scaled = opts.resolution_scale > 0.0 && opts.resolution_scale < 1.0;
-  if (opts.batch && impl_->multiview && !scaled) {
+  const bool scaled = PlanInput{scene, opts.resolution_scale}.scaled();
+  if (opts.batch && !scaled) {
     std::vector<std::pair<int, int>> sizes;
     std::vector<std::vector<std::size_t>> groups;
     for (std::size_t i = 0; i < cameras.size(); ++i) {

@@ -75,9 +75,6 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   const std::string& description() const;
-  // True if the context can render multi-view batches (every GL 4.5 context
-  // can: they need array textures and per-layer framebuffers only).
-  bool multiview_supported() const;
 
   // Renders every camera of the scene; scene resources (tables, occluder
   // geometry) are uploaded once and shared by the cameras.

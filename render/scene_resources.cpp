@@ -55,6 +55,7 @@ struct Vertex {
   float position[3];
   float normal[3];
   float albedo[3];
+  float one_sided;  // 1: drawn only from the side the normal points to
 };
 
 void set3(float* dst, const Vec3& v, float w) {
@@ -97,53 +98,50 @@ void view_projection(const Camera& cam, const CameraBasis& b, float out[16]) {
   }
 }
 
-// Appends one flat-shaded triangle (anchor-relative corners); degenerate
-// triangles cover no pixel and are skipped.
-void push_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Color& albedo,
-                   std::vector<Vertex>* out) {
-  const Vec3 cr = cross(b - a, c - a);
-  const double len = length(cr);
-  if (!(len > 0.0)) return;
-  const Vec3 n = (1.0 / len) * cr;
-  for (const Vec3* p : {&a, &b, &c}) {
-    Vertex v;
-    for (int k = 0; k < 3; ++k) {
-      v.position[k] = static_cast<float>((*p)[k]);
-      v.normal[k] = static_cast<float>(n[k]);
-      v.albedo[k] = static_cast<float>(albedo[k]);
+// Collects a triangles kind's triangles as flat-shaded vertices relative to
+// `anchor`; degenerate triangles cover no pixel and are skipped.
+class VertexSink final : public TriangleSink {
+ public:
+  VertexSink(const Vec3& anchor, std::vector<Vertex>* out) : anchor_(anchor), out_(out) {}
+  Color albedo{};
+  void add(const Vec3& wa, const Vec3& wb, const Vec3& wc, bool one_sided) override {
+    const Vec3 a = wa - anchor_, b = wb - anchor_, c = wc - anchor_;
+    const Vec3 cr = cross(b - a, c - a);
+    const double len = length(cr);
+    if (!(len > 0.0)) return;
+    const Vec3 n = (1.0 / len) * cr;
+    for (const Vec3* p : {&a, &b, &c}) {
+      Vertex v;
+      for (int k = 0; k < 3; ++k) {
+        v.position[k] = static_cast<float>((*p)[k]);
+        v.normal[k] = static_cast<float>(n[k]);
+        v.albedo[k] = static_cast<float>(albedo[k]);
+      }
+      v.one_sided = one_sided ? 1.0f : 0.0f;
+      out_->push_back(v);
     }
-    out->push_back(v);
   }
-}
 
-// Appends the 12 triangles of a box occluder.
-void box_triangles(const BoxOccluder& box, const Color& albedo, const Vec3& anchor,
-                   std::vector<Vertex>* out) {
-  static const int kIndex[36] = {4, 6, 2, 4, 2, 0, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
-                                 6, 7, 3, 6, 3, 2, 2, 3, 1, 2, 1, 0, 4, 5, 7, 4, 7, 6};
-  Vec3 corners[8];
-  for (int i = 0; i < 8; ++i) {
-    const Vec3 local{(i & 1 ? 0.5 : -0.5) * box.size[0], (i & 2 ? 0.5 : -0.5) * box.size[1],
-                     (i & 4 ? 0.5 : -0.5) * box.size[2]};
-    corners[i] = box.center + rotate(box.rotation, local) - anchor;
-  }
-  for (int t = 0; t < 12; ++t) {
-    push_triangle(corners[kIndex[3 * t]], corners[kIndex[3 * t + 1]], corners[kIndex[3 * t + 2]],
-                  albedo, out);
-  }
-}
-
-void mesh_triangles(const MeshOccluder& mesh, const Color& albedo, const Vec3& anchor,
-                    std::vector<Vertex>* out) {
-  for (const auto& tri : mesh.triangles) {
-    push_triangle(mesh.vertices[tri[0]] - anchor, mesh.vertices[tri[1]] - anchor,
-                  mesh.vertices[tri[2]] - anchor, albedo, out);
-  }
-}
+ private:
+  Vec3 anchor_;
+  std::vector<Vertex>* out_;
+};
 
 }  // namespace
 
-SceneResources::SceneResources(const Scene& scene, TableCache& tables) : scene_(scene) {
+SceneResources::SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan)
+    : scene_(scene) {
+  if (plan.uploads_group("beams")) upload_beams(tables);
+  if (plan.uploads_group("occluders")) upload_occluders();
+  GLuint id = 0;
+  glCreateBuffers(1, &id);
+  camera_ubo_ = GlBuffer(id);
+  glNamedBufferStorage(id, sizeof(CameraBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  gl_check("create scene buffers");
+}
+
+void SceneResources::upload_beams(TableCache& tables) {
+  const Scene& scene = scene_;
   nd_ = scene.render.table_d;
   ns_ = scene.render.table_s;
   nf_ = scene.render.f_table;
@@ -198,39 +196,39 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables) : scene_(
     glNamedBufferStorage(id, static_cast<GLsizeiptr>(sizeof(BeamData) * scene.beams.size()),
                          nullptr, GL_DYNAMIC_STORAGE_BIT);
   }
+}
 
-  // Rasterized occluders go into one vertex buffer, stored relative to an
-  // anchor (their bounding-box centre) so float precision follows the geometry.
-  std::vector<Vertex> verts;
-  double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
-                  std::numeric_limits<double>::max()};
-  double hi[3] = {-lo[0], -lo[1], -lo[2]};
-  auto grow = [&](const Vec3& p) {
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
-  };
-  bool any_raster = false;
+void SceneResources::upload_occluders() {
+  const Scene& scene = scene_;
+  // Triangle kinds go into one vertex buffer, stored relative to an anchor
+  // (the centre of their bounds) so float precision follows the geometry;
+  // analytic kinds are ray-traced from a per-camera record (fill_analytic).
+  Aabb bounds;
   for (const Occluder& occ : scene.occluders) {
-    if (const auto* box = std::get_if<BoxOccluder>(&occ.shape)) {
-      grow(box->center);
-      any_raster = true;
-    } else if (const auto* mesh = std::get_if<MeshOccluder>(&occ.shape)) {
-      for (const Vec3& v : mesh->vertices) grow(v);
-      any_raster = true;
-    } else {
-      analytic_.push_back(&occ);
-    }
+    std::visit(
+        [&](const auto& shape) {
+          using Kind = std::decay_t<decltype(shape)>;
+          if constexpr (Kind::kGpu == GpuForm::kTriangles) {
+            bounds.grow(shape.bounds());
+          } else {
+            analytic_.push_back(&occ);
+          }
+        },
+        occ.shape);
   }
-  if (any_raster) {
-    for (int k = 0; k < 3; ++k) mesh_anchor_[k] = 0.5 * (lo[k] + hi[k]);
+  std::vector<Vertex> verts;
+  if (!bounds.empty()) {
+    mesh_anchor_ = bounds.centre();
+    VertexSink sink(mesh_anchor_, &verts);
     for (const Occluder& occ : scene.occluders) {
-      if (const auto* box = std::get_if<BoxOccluder>(&occ.shape)) {
-        box_triangles(*box, occ.albedo, mesh_anchor_, &verts);
-      } else if (const auto* mesh = std::get_if<MeshOccluder>(&occ.shape)) {
-        mesh_triangles(*mesh, occ.albedo, mesh_anchor_, &verts);
-      }
+      sink.albedo = occ.albedo;
+      std::visit(
+          [&](const auto& shape) {
+            if constexpr (std::decay_t<decltype(shape)>::kGpu == GpuForm::kTriangles) {
+              shape.gpu_triangles(sink);
+            }
+          },
+          occ.shape);
     }
   }
   if (!verts.empty()) {
@@ -242,9 +240,10 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables) : scene_(
     glCreateVertexArrays(1, &id);
     tri_vao_ = GlVertexArray(id);
     glVertexArrayVertexBuffer(id, 0, tri_vbo_.get(), 0, sizeof(Vertex));
-    for (GLuint a = 0; a < 3; ++a) {
+    // position, normal, albedo (3 floats each), one_sided (1 float).
+    for (GLuint a = 0; a < 4; ++a) {
       glEnableVertexArrayAttrib(id, a);
-      glVertexArrayAttribFormat(id, a, 3, GL_FLOAT, GL_FALSE,
+      glVertexArrayAttribFormat(id, a, a < 3 ? 3 : 1, GL_FLOAT, GL_FALSE,
                                 static_cast<GLuint>(a * 3 * sizeof(float)));
       glVertexArrayAttribBinding(id, a, 0);
     }
@@ -258,11 +257,6 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables) : scene_(
     glNamedBufferStorage(id, static_cast<GLsizeiptr>(sizeof(AnalyticData) * analytic_.size()),
                          nullptr, GL_DYNAMIC_STORAGE_BIT);
   }
-  GLuint id = 0;
-  glCreateBuffers(1, &id);
-  camera_ubo_ = GlBuffer(id);
-  glNamedBufferStorage(id, sizeof(CameraBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
-  gl_check("create scene buffers");
 }
 
 void SceneResources::fill_camera(const Camera& cam, const CameraBasis& basis, void* block) const {
@@ -287,7 +281,7 @@ void SceneResources::fill_camera(const Camera& cam, const CameraBasis& basis, vo
 
 void SceneResources::fill_beams(const Vec3& eye, void* beams) const {
   auto* data = static_cast<BeamData*>(beams);
-  for (std::size_t i = 0; i < scene_.beams.size(); ++i) {
+  for (std::size_t i = 0; i < beam_layers_.size(); ++i) {
     const Beam& beam = scene_.beams[i];
     BeamData& d = data[i];
     d = BeamData{};
@@ -318,16 +312,18 @@ void SceneResources::fill_analytic(const Vec3& eye, void* analytic) const {
     AnalyticData& d = data[i];
     d = AnalyticData{};
     set3(d.albedo, occ.albedo, 1.0f);
-    if (const auto* plane = std::get_if<PlaneOccluder>(&occ.shape)) {
-      // The plane's point nearest the eye, computed in double, keeps the
-      // plane exact near the camera whatever point the scene gave.
-      const Vec3 n = normalize(plane->normal);
-      set3(d.a, dot(plane->point - eye, n) * n, 0.0f);
-      set3(d.b, n, 0.0f);
-    } else {
-      const auto& sphere = std::get<SphereOccluder>(occ.shape);
-      set3(d.a, sphere.center - eye, static_cast<float>(sphere.radius));
-      set3(d.b, {0.0, 0.0, 0.0}, 1.0f);
+    const AnalyticGpu g = std::visit(
+        [&](const auto& shape) {
+          if constexpr (std::decay_t<decltype(shape)>::kGpu == GpuForm::kAnalytic) {
+            return shape.analytic(eye);
+          } else {
+            return AnalyticGpu{};  // not in analytic_
+          }
+        },
+        occ.shape);
+    for (int k = 0; k < 4; ++k) {
+      d.a[k] = static_cast<float>(g.a[k]);
+      d.b[k] = static_cast<float>(g.b[k]);
     }
   }
 }
@@ -338,7 +334,7 @@ void SceneResources::bind_camera(const Camera& cam, const CameraBasis& basis) {
   fill_camera(cam, basis, &cb);
   glNamedBufferSubData(camera_ubo_.get(), 0, sizeof cb, &cb);
   if (beam_ssbo_) {
-    std::vector<BeamData> data(scene_.beams.size());
+    std::vector<BeamData> data(beam_layers_.size());
     fill_beams(basis.eye, data.data());
     glNamedBufferSubData(beam_ssbo_.get(), 0,
                          static_cast<GLsizeiptr>(data.size() * sizeof(BeamData)), data.data());
@@ -356,7 +352,7 @@ void SceneResources::bind_camera(const Camera& cam, const CameraBasis& basis) {
 void SceneResources::bind_views(const std::vector<Camera>& cams,
                                 const std::vector<CameraBasis>& bases, int max_views) {
   const std::size_t k = cams.size();
-  const std::size_t nb = scene_.beams.size(), na = analytic_.size();
+  const std::size_t nb = beam_layers_.size(), na = analytic_.size();
   if (k > views_capacity_) {
     // Sized for the largest batch seen; a buffer of zero bytes is not allowed.
     auto make = [](GlBuffer& buf, std::size_t bytes) {

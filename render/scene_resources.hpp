@@ -15,6 +15,7 @@
 #include "protocol/scene.hpp"
 #include "render/gl_util.hpp"
 #include "render/lut.hpp"
+#include "render/pass_plan.hpp"
 
 namespace beamcast {
 
@@ -32,7 +33,9 @@ class TableCache {
 
 class SceneResources {
  public:
-  SceneResources(const Scene& scene, TableCache& tables);
+  // Uploads the resource groups the plan's passes declare: "beams" (tables,
+  // beam instances), "occluders" (triangles, analytic occluders).
+  SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan);
   // Uploads the camera block and camera-relative beam and occluder data.
   void bind_camera(const Camera& cam, const CameraBasis& basis);
   // Multi-view: uploads one camera block per view (the CameraBlocks uniform
@@ -74,6 +77,8 @@ class SceneResources {
   GlBuffer views_camera_ubo_, views_beam_ssbo_, views_analytic_ssbo_;
   std::size_t views_capacity_ = 0;  // views the multi-view buffers hold
 
+  void upload_beams(TableCache& tables);
+  void upload_occluders();
   // The per-camera data of bind_camera, written to `out` (for bind_views).
   void fill_camera(const Camera& cam, const CameraBasis& basis, void* block) const;
   void fill_beams(const Vec3& eye, void* beams) const;

@@ -66,21 +66,18 @@ json hello_result(const ServerCore& core, const json& params) {
     }
   }
   json passes = json::array();
-  for (const PassRule& rule : pass_catalog()) passes.push_back(rule.name);
+  for (const PassDecl& pass : pass_catalog()) passes.push_back(pass.name);
+  json capabilities = {{"formats", {"png", "jpeg"}},
+                       {"quality", {"full", "auto"}},
+                       {"encodings", {"binary", "base64"}},
+                       {"batch_window_ms", core.config.batch_window_ms},
+                       {"passes", passes}};
+  capabilities.update(scene_capabilities());
   return {{"protocol", kProtocolVersion},
           {"server", "beamcast-server 0.1.0"},
           {"renderer", core.renderer_description},
           {"methods", {"hello", "ping", "render", "scene.put", "scene.update", "scene.delete", "stats"}},
-          {"capabilities",
-           {{"formats", {"png", "jpeg"}},
-            {"quality", {"full", "auto"}},
-            {"encodings", {"binary", "base64"}},
-            {"beam_types", {"sphere", "capsule"}},
-            {"densities", {"abe", "shell", "linear", "quadratic", "gaussian", "table"}},
-            {"occluder_types", {"plane", "box", "sphere", "mesh"}},
-            {"camera_rigs", {"orbit", "cubemap", "stereo"}},
-            {"batch_window_ms", core.config.batch_window_ms},
-            {"passes", passes}}},
+          {"capabilities", capabilities},
           {"limits", limits_json(core.config)}};
 }
 

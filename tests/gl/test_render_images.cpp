@@ -19,10 +19,12 @@
 // 0.6, >2-level fractions 0.45% to 100%).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
@@ -55,19 +57,24 @@ struct Tolerance {
   double rel_l1;
   double over2_fraction;
 };
+constexpr Tolerance kDefault{1e-3, 1e-3};
 
-struct Case {
-  const char* example;
-  Tolerance tol;
-};
+// Every scene in examples/ (a new example gets this test without a line here).
+std::vector<std::string> example_names() {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(fs::path(BEAMCAST_SOURCE_DIR) / "examples")) {
+    if (e.path().extension() == ".json") names.push_back(e.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
 
-void PrintTo(const Case& c, std::ostream* os) { *os << c.example; }
-
-class ExampleImage : public ::testing::TestWithParam<Case> {};
+class ExampleImage : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ExampleImage, GpuMatchesCpuReference) {
-  const Case& c = GetParam();
-  const Scene scene = load_example(c.example);
+  const std::string& example = GetParam();
+  const Tolerance tol = kDefault;
+  const Scene scene = load_example(example);
   const auto frames = shared_renderer().render(scene, FrameOptions{.read_hdr = true});
   ASSERT_EQ(frames.size(), scene.cameras.size());
   for (std::size_t i = 0; i < frames.size(); ++i) {
@@ -88,17 +95,17 @@ TEST_P(ExampleImage, GpuMatchesCpuReference) {
     const double over_fraction = static_cast<double>(le.over) / static_cast<double>(a.rgb.size());
     std::printf("%-14s %-11s hdr rel_l1 %.3e max_abs %.3e rms %.3e | 8-bit max %d rms %.3f "
                 "psnr %.1f dB, >2 levels %.4f%%\n",
-                c.example, cam.name.c_str(), he.rel_l1, he.max_abs, he.rms, le.max_abs, le.rms,
+                example.c_str(), cam.name.c_str(), he.rel_l1, he.max_abs, he.rms, le.max_abs, le.rms,
                 le.psnr_db, 100.0 * over_fraction);
-    const bool ok = he.nonfinite == 0 && he.rel_l1 <= c.tol.rel_l1 &&
-                    over_fraction <= c.tol.over2_fraction;
+    const bool ok = he.nonfinite == 0 && he.rel_l1 <= tol.rel_l1 &&
+                    over_fraction <= tol.over2_fraction;
     EXPECT_EQ(he.nonfinite, 0) << cam.name;
-    EXPECT_LE(he.rel_l1, c.tol.rel_l1) << cam.name;
-    EXPECT_LE(over_fraction, c.tol.over2_fraction) << cam.name;
+    EXPECT_LE(he.rel_l1, tol.rel_l1) << cam.name;
+    EXPECT_LE(over_fraction, tol.over2_fraction) << cam.name;
     if (!ok) {
       const fs::path dir = fs::path(BEAMCAST_ARTIFACT_DIR) / "image-tests";
       fs::create_directories(dir);
-      const std::string stem = std::string(c.example) + "_" + cam.name;
+      const std::string stem = example + "_" + cam.name;
       write_png(dir / (stem + "_gpu.png"), a);
       write_png(dir / (stem + "_reference.png"), b);
       write_png(dir / (stem + "_diff.png"), diff_image(a, b));
@@ -107,27 +114,22 @@ TEST_P(ExampleImage, GpuMatchesCpuReference) {
   }
 }
 
-constexpr Tolerance kDefault{1e-3, 1e-3};
+INSTANTIATE_TEST_SUITE_P(Examples, ExampleImage, ::testing::ValuesIn(example_names()),
+                         [](const auto& info) { return info.param; });
 
-INSTANTIATE_TEST_SUITE_P(Examples, ExampleImage,
-                         ::testing::Values(Case{"paper_1set", kDefault}, Case{"paper_5sets", kDefault},
-                                           Case{"paper_10sets", kDefault},
-                                           Case{"thin_shell", kDefault},
-                                           Case{"beam_occluder", kDefault},
-                                           Case{"camera_inside", kDefault},
-                                           Case{"mesh_occluder", kDefault},
-                                           Case{"multi_camera", kDefault}),
-                         [](const auto& info) { return std::string(info.param.example); });
-
-// The frame reports exactly the passes the scene's content calls for.
+// The frame runs and reports exactly the passes of the scene's plan (the
+// expected lists come from the plan's rules, render/pass_plan.cpp).
 TEST(Passes, BeamOnlySceneRunsNoSurfacePass) {
   Scene scene = load_example("paper_1set");
   scene.cameras[0].width = scene.cameras[0].height = 64;
   const auto frames = shared_renderer().render(scene);
-  ASSERT_EQ(frames[0].passes.size(), 2u);
-  EXPECT_EQ(frames[0].passes[0].name, "beams");
-  EXPECT_EQ(frames[0].passes[1].name, "tonemap");
-  for (const auto& p : frames[0].passes) EXPECT_GE(p.gpu_ms, 0.0);
+  const FramePlan plan = make_plan(PlanInput{scene});
+  EXPECT_FALSE(plan.written("view_depth"));
+  ASSERT_EQ(frames[0].passes.size(), plan.passes.size());
+  for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+    EXPECT_EQ(frames[0].passes[i].name, plan.passes[i]->name);
+    EXPECT_GE(frames[0].passes[i].gpu_ms, 0.0);
+  }
 }
 
 TEST(Passes, OccluderOnlySceneRunsNoBeamPass) {
@@ -135,10 +137,24 @@ TEST(Passes, OccluderOnlySceneRunsNoBeamPass) {
   scene.beams.clear();
   scene.cameras[0].width = scene.cameras[0].height = 64;
   const auto frames = shared_renderer().render(scene);
-  ASSERT_EQ(frames[0].passes.size(), 2u);
-  EXPECT_EQ(frames[0].passes[0].name, "surfaces");
-  EXPECT_EQ(frames[0].passes[1].name, "tonemap");
-  EXPECT_EQ(plan_passes(scene), (std::vector<std::string>{"surfaces", "tonemap"}));
+  std::vector<std::string> names;
+  for (const auto& p : frames[0].passes) names.push_back(p.name);
+  EXPECT_EQ(names, plan_passes(scene));
+  EXPECT_EQ(std::count(names.begin(), names.end(), "beams"), 0);
+}
+
+// Scaled frames add the upscale pass; the frame keeps the camera's size.
+TEST(Passes, ScaledFrameRunsUpscale) {
+  Scene scene = load_example("beam_occluder");
+  scene.cameras[0].width = 64;
+  scene.cameras[0].height = 48;
+  const auto frames = shared_renderer().render(scene, FrameOptions{.resolution_scale = 0.5});
+  std::vector<std::string> names;
+  for (const auto& p : frames[0].passes) names.push_back(p.name);
+  EXPECT_EQ(names, plan_passes(scene, 0.5));
+  EXPECT_EQ(names.back(), "upscale");
+  EXPECT_EQ(frames[0].image.width, 64);
+  EXPECT_EQ(frames[0].image.height, 48);
 }
 
 TEST(Passes, EmptySceneIsBackgroundOnly) {
@@ -147,7 +163,7 @@ TEST(Passes, EmptySceneIsBackgroundOnly) {
   scene.background = {0.5, 0.25, 0.0};
   scene.cameras[0].width = scene.cameras[0].height = 16;
   const auto frames = shared_renderer().render(scene, FrameOptions{.read_hdr = true});
-  ASSERT_EQ(frames[0].passes.size(), 1u);
+  ASSERT_EQ(frames[0].passes.size(), plan_passes(scene).size());
   // Every pixel is the background, tone-mapped like the reference does it.
   const Image expected = tone_map(frames[0].hdr, scene.output);
   EXPECT_EQ(compare_levels(frames[0].image, expected).max_abs, 0);

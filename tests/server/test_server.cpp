@@ -11,6 +11,7 @@
 
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
+#include "render/pass_plan.hpp"
 #include "render/renderer.hpp"
 #include "server/server.hpp"
 #include "tests/server/test_client.hpp"
@@ -97,7 +98,7 @@ TEST(Server, RemoteRenderIsPixelIdenticalToOfflineRender) {
   Conn c(s.port());
   const Reply r = c.call(render_req("a", scene));
   ASSERT_TRUE(r.json["ok"]) << r.json;
-  EXPECT_EQ(r.json["result"]["passes"], json({"surfaces", "beams", "tonemap"}));
+  EXPECT_EQ(r.json["result"]["passes"], json(plan_passes(parse_scene(scene, SceneLoadOptions{}))));
   const Image remote = frame_png(r, 0);
 
   SceneLoadOptions opts;

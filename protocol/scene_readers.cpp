@@ -1,0 +1,70 @@
+// Typed reads of scene values that need the scene's limits (positions,
+// sizes) or its conventions (directions, albedo, quaternions).
+#include "protocol/scene_readers.hpp"
+
+#include <cmath>
+
+#include "protocol/camera.hpp"
+
+namespace beamcast::json_read {
+
+Vec3 read_point(const Node& n, const SceneLimits& limits) {
+  return check_coordinates(n, read_vec3(n), limits.max_abs_coordinate);
+}
+
+// A length: > 0, finite, at most max_abs_coordinate.
+double read_size(const Node& n, const SceneLimits& limits) {
+  const double v = check_positive(n, read_number(n));
+  if (v > limits.max_abs_coordinate) {
+    fail("out_of_range", n.path,
+         n.name() + " must be <= " + format_number(limits.max_abs_coordinate) +
+             " (limit max_abs_coordinate), got " + format_number(v));
+  }
+  return v;
+}
+
+// True if normalize(v) is finite: nonzero, and not so tiny (denormal) that 1/|v| overflows.
+bool normalizable(const Vec3& v) {
+  const double len = length(v);
+  return len > 0.0 && std::isfinite(len) && std::isfinite(1.0 / len);
+}
+
+// A direction: finite, not the zero vector (need not be unit).
+Vec3 read_direction(const Node& n) {
+  const Vec3 v = read_vec3(n);
+  if (!normalizable(v)) {
+    fail("invalid_value", n.path,
+         n.name() + " must be a nonzero direction vector (length > 1e-300), got [" +
+             format_number(v[0]) + ", " + format_number(v[1]) + ", " + format_number(v[2]) + "]");
+  }
+  return v;
+}
+
+Color read_color(const Node& n) {
+  Color c = read_vec3(n);
+  for (std::size_t i = 0; i < 3; ++i)
+    check_non_negative(Node{&n.json()[i], child_path(n.path, i)}, c[i]);
+  return c;
+}
+
+Color read_albedo(const Node& n) {
+  Color c = read_vec3(n);
+  for (std::size_t i = 0; i < 3; ++i)
+    check_closed(Node{&n.json()[i], child_path(n.path, i)}, c[i], 0.0, 1.0);
+  return c;
+}
+
+// [w, x, y, z] with finite nonzero norm, returned normalized.
+std::array<double, 4> read_quaternion(const Node& n) {
+  auto q = read_numbers<4>(n);
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(norm > 0.0) || !std::isfinite(norm)) {
+    fail("invalid_value", n.path,
+         n.name() + " must be a quaternion [w, x, y, z] with finite nonzero norm, got norm " +
+             format_number(norm));
+  }
+  for (double& c : q) c /= norm;
+  return q;
+}
+
+}  // namespace beamcast::json_read

@@ -1,0 +1,28 @@
+// Typed reads of scene values shared by the scene parser and the element
+// modules (protocol/occluders/). Failures throw ProtocolError with the
+// value's JSON pointer, like every reader in json_reader.hpp.
+#pragma once
+
+#include <array>
+
+#include "protocol/json_reader.hpp"
+#include "protocol/scene_json.hpp"
+
+namespace beamcast::json_read {
+
+// A position: finite, |component| <= max_abs_coordinate.
+Vec3 read_point(const Node& n, const SceneLimits& limits);
+// A length: > 0, finite, at most max_abs_coordinate.
+double read_size(const Node& n, const SceneLimits& limits);
+// True if normalize(v) is finite: nonzero, and not so tiny (denormal) that 1/|v| overflows.
+bool normalizable(const Vec3& v);
+// A direction: finite, not the zero vector (need not be unit).
+Vec3 read_direction(const Node& n);
+// Non-negative components.
+Color read_color(const Node& n);
+// Components in [0, 1].
+Color read_albedo(const Node& n);
+// [w, x, y, z] with finite nonzero norm, returned normalized.
+std::array<double, 4> read_quaternion(const Node& n);
+
+}  // namespace beamcast::json_read

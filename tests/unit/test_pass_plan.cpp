@@ -1,0 +1,119 @@
+// The pass graph without GL: plans derived from the catalog's declarations,
+// and the errors a broken declaration raises at plan time.
+#include "render/pass_plan.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace beamcast {
+namespace {
+
+Scene scene_with(bool beams, bool occluders) {
+  Scene s;
+  if (beams) s.beams.emplace_back();
+  if (occluders) s.occluders.push_back(Occluder{SphereOccluder{}, {0.5, 0.5, 0.5}});
+  return s;
+}
+
+std::vector<std::string> target_names(const FramePlan& plan) {
+  std::vector<std::string> out;
+  for (const TargetDecl* t : plan.targets) out.push_back(t->name);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(PassPlan, BeamOnlySceneAllocatesNoSurfaceTargets) {
+  const FramePlan plan = make_plan(PlanInput{scene_with(true, false)});
+  EXPECT_EQ(plan.names(), (std::vector<std::string>{"beams", "tonemap"}));
+  // view_depth is an optional read of the beams: nobody writes it, so it is
+  // neither allocated nor reported as written; nor is the depth buffer.
+  EXPECT_FALSE(plan.written("view_depth"));
+  EXPECT_EQ(target_names(plan), (std::vector<std::string>{"hdr", "output"}));
+  EXPECT_EQ(plan.uploads, (std::vector<std::string>{"beams"}));
+  EXPECT_EQ(plan.final_target, "output");
+}
+
+TEST(PassPlan, OccludersWriteViewDepthThatBeamsRead) {
+  const FramePlan plan = make_plan(PlanInput{scene_with(true, true)});
+  EXPECT_EQ(plan.names(), (std::vector<std::string>{"surfaces", "beams", "tonemap"}));
+  EXPECT_TRUE(plan.written("view_depth"));
+  EXPECT_EQ(target_names(plan),
+            (std::vector<std::string>{"depth", "hdr", "output", "view_depth"}));
+  EXPECT_TRUE(plan.uploads_group("occluders"));
+  EXPECT_TRUE(plan.uploads_group("beams"));
+}
+
+TEST(PassPlan, EmptySceneOnlyTonemapsTheClearedBackground) {
+  const FramePlan plan = make_plan(PlanInput{scene_with(false, false)});
+  EXPECT_EQ(plan.names(), (std::vector<std::string>{"tonemap"}));
+  EXPECT_TRUE(plan.uploads.empty());
+}
+
+TEST(PassPlan, ScaledFramesEndWithUpscale) {
+  const FramePlan plan = make_plan(PlanInput{scene_with(true, false), 0.5});
+  EXPECT_EQ(plan.names(), (std::vector<std::string>{"beams", "tonemap", "upscale"}));
+  EXPECT_EQ(plan.final_target, "upscaled");
+  // Scale 1 (and out-of-range values, which the server never sends) is native.
+  EXPECT_EQ(plan_passes(scene_with(true, false), 1.0).back(), "tonemap");
+}
+
+// Every declaration of the built-in catalog is planned for some input, so no
+// rule is dead, and every pass writes something.
+TEST(PassPlan, EveryCatalogPassIsReachable) {
+  std::vector<std::string> seen;
+  for (bool b : {false, true}) {
+    for (bool o : {false, true}) {
+      for (double scale : {1.0, 0.5}) {
+        for (const auto& n : make_plan(PlanInput{scene_with(b, o), scale}).names()) {
+          seen.push_back(n);
+        }
+      }
+    }
+  }
+  for (const PassDecl& p : pass_catalog()) {
+    EXPECT_NE(std::find(seen.begin(), seen.end(), p.name), seen.end()) << p.name;
+    EXPECT_FALSE(p.writes.empty()) << p.name;
+  }
+}
+
+bool always(const PlanInput&) { return true; }
+
+TEST(PassPlan, ReadingATargetNobodyWritesFailsAtPlanTime) {
+  std::vector<TargetDecl> targets = target_catalog();
+  targets.push_back({"gbuffer.normal", TargetFormat::kRgba32f, TargetSize::kRender,
+                     TargetClear::kNone});
+  const PassDecl lighting{PassId::kBeams, "lighting", always, {"gbuffer.normal"}, {}, {"hdr"}, {}};
+  const PassDecl gbuffer{PassId::kSurfaces, "gbuffer", always, {}, {}, {"gbuffer.normal"}, {}};
+  const Scene scene = scene_with(true, false);
+  try {
+    make_plan(PlanInput{scene}, {lighting}, targets);
+    FAIL() << "expected PlanError";
+  } catch (const PlanError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "pass \"lighting\" reads target \"gbuffer.normal\", which no earlier planned pass "
+              "writes and nothing clears");
+  }
+  // Written too late is not written.
+  EXPECT_THROW(make_plan(PlanInput{scene}, {lighting, gbuffer}, targets), PlanError);
+  // Written by an earlier pass: planned, and the target is allocated. (A plan
+  // points into its catalog, which must outlive it.)
+  const std::vector<PassDecl> catalog{gbuffer, lighting};
+  const FramePlan plan = make_plan(PlanInput{scene}, catalog, targets);
+  EXPECT_EQ(plan.names(), (std::vector<std::string>{"gbuffer", "lighting"}));
+  EXPECT_TRUE(plan.uses("gbuffer.normal"));
+}
+
+TEST(PassPlan, UnknownTargetsAndRepeatedIdsFail) {
+  std::vector<PassDecl> catalog = pass_catalog();
+  catalog[2].writes = {"outptu"};
+  EXPECT_THROW(make_plan(PlanInput{scene_with(false, false)}, catalog), PlanError);
+  catalog = pass_catalog();
+  catalog[1].id = PassId::kSurfaces;
+  EXPECT_THROW(make_plan(PlanInput{scene_with(false, false)}, catalog), PlanError);
+}
+
+}  // namespace
+}  // namespace beamcast
