@@ -12,11 +12,13 @@
 #include "protocol/occluders/box.hpp"
 #include "protocol/occluders/mesh.hpp"
 #include "protocol/occluders/plane.hpp"
+#include "protocol/occluders/quad.hpp"
 #include "protocol/occluders/sphere.hpp"
 
 namespace beamcast {
 
-using OccluderShape = std::variant<PlaneOccluder, BoxOccluder, SphereOccluder, MeshOccluder>;
+using OccluderShape =
+    std::variant<PlaneOccluder, BoxOccluder, SphereOccluder, MeshOccluder, QuadOccluder>;
 
 // The "type" strings of every kind, in OccluderShape's order.
 std::vector<std::string_view> occluder_types();
