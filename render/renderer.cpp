@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 #include "protocol/camera.hpp"
 #include "render/gl_util.hpp"
@@ -49,6 +50,7 @@ struct Renderer::Impl {
   GlTexture upscaled;
   GlFramebuffer upscaled_fbo;
   int up_width = 0, up_height = 0, up_bits = 0;
+  bool fail_next = false;  // fail_next_render_for_test()
 
   explicit Impl(const RendererOptions& opts)
       : context(EglContext::create(opts.egl)), tables(opts.table_cache_entries) {
@@ -297,6 +299,8 @@ const std::string& Renderer::description() const { return impl_->context->descri
 
 bool Renderer::multiview_supported() const { return impl_->multiview; }
 
+void Renderer::fail_next_render_for_test() { impl_->fail_next = true; }
+
 std::vector<FrameResult> Renderer::render(const Scene& scene, const FrameOptions& opts) {
   return render(scene, scene.cameras, opts);
 }
@@ -310,6 +314,10 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
     }
   }
   SceneResources res(scene, impl_->tables);
+  if (std::exchange(impl_->fail_next, false)) {
+    glEnable(0);  // GL_INVALID_ENUM
+    gl_check("glEnable(0) (injected test failure)");
+  }
   std::vector<FrameResult> frames(cameras.size());
   // Batches: cameras of one size, in order of first appearance, split where a
   // batch would pass the view or memory bound. A batch of one takes the

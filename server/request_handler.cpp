@@ -407,6 +407,7 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
       s["inflight"] = core.renders->inflight();
       s["queue_depth"] = core.renders->queued();
       s["renders_dropped"] = core.renders->dropped();
+      s["renderer_rebuilds"] = core.renders->renderer_rebuilds();
       s["scenes"] = {{"count", core.scenes.count()}, {"bytes", core.scenes.bytes()}};
       session->send(ok_response(id, std::move(s)));
     } else if (req.method == "render") {
