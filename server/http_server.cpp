@@ -171,9 +171,20 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
                         });
   }
 
+  void arm_message_deadline() {
+    message_timer_.expires_at(message_clock_.deadline(core_));
+    message_timer_.async_wait([self = shared_from_this()](beast::error_code e) {
+      self->on_message_deadline(e);
+    });
+  }
+
   void on_message_deadline(beast::error_code ec) {
     if (ec == asio::error::operation_aborted || closed_ || !in_message_) return;
     if (message_timer_.expiry() > std::chrono::steady_clock::now()) return;
+    if (message_clock_.deadline(core_) > std::chrono::steady_clock::now()) {
+      arm_message_deadline();  // the server was busy meanwhile: not the client's time
+      return;
+    }
     const ErrorInfo e{"timeout",
                       "message incomplete after read_timeout_ms (" +
                           std::to_string(core_.config.read_timeout_ms) + " ms)",
@@ -192,10 +203,8 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
     if (ec || closed_ || close_after_write_) return close_now();
     if (!in_message_) {
       in_message_ = true;
-      message_timer_.expires_after(std::chrono::milliseconds(core_.config.read_timeout_ms));
-      message_timer_.async_wait([self = shared_from_this()](beast::error_code e) {
-        self->on_message_deadline(e);
-      });
+      message_clock_.start(core_);
+      arm_message_deadline();
     }
     if (!ws_.is_message_done()) return do_read();
     in_message_ = false;
@@ -206,7 +215,8 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
                                     "binary WebSocket messages are not requests; send each "
                                     "request as one text message (PROTOCOL.md, WebSocket)",
                                     ""});
-    } else {
+    } else if (MemoryBudget::Reservation reserved;
+               reserve_request_memory(core_, *this, bytes, &reserved)) {
       const std::string text = beast::buffers_to_string(buffer_.data());
       buffer_.consume(buffer_.size());
       buffer_.shrink_to_fit();
@@ -264,6 +274,7 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
   websocket::stream<Stream> ws_;
   ServerCore& core_;
   asio::steady_timer message_timer_;  // read_timeout_ms of the message being read
+  MessageClock message_clock_;
   std::shared_ptr<std::atomic<bool>> alive_;
   std::atomic<int> inflight_{0};
   // Strand-only state.

@@ -369,12 +369,29 @@ std::string base64_encode(const std::vector<std::uint8_t>& in) {
   return out;
 }
 
+bool reserve_request_memory(ServerCore& core, Connection& connection, std::uint64_t message_bytes,
+                            MemoryBudget::Reservation* reservation) {
+  ErrorInfo refused;
+  if (core.request_memory.try_reserve(message_bytes, reservation, &refused)) return true;
+  connection.send_error(nullptr, refused);
+  return false;
+}
+
 void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
                     std::string_view json_text, Clock::time_point arrived) {
+  // Time spent here is not the client's (MessageClock).
+  struct HandlingTime {
+    ServerCore& core;
+    Clock::time_point start = Clock::now();
+    ~HandlingTime() {
+      core.handling_ns.fetch_add(
+          std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
+    }
+  } handling{core};
   json id;
   std::string method = "(invalid)";  // metrics key: a known method or a fixed placeholder
   try {
-    const Request req = parse_request(json_text, &id, core.config.json_limits);
+    Request req = parse_request(json_text, &id, core.config.json_limits);
     static const char* kMethods[] = {"hello", "ping", "stats", "render", "scene.put",
                                      "scene.update", "scene.delete"};
     // Count unknown methods under one key: client-chosen strings must not grow the map.
@@ -394,7 +411,9 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
       if (token_required(core.config)) session->set_authenticated();
       session->send(ok_response(id, std::move(result)));
     } else if (req.method == "ping") {
-      session->send(ok_response(id, {{"echo", params}}));
+      json result = json::object();
+      result["echo"] = std::move(req.params);  // moved: a large ping's document is not copied
+      session->send(ok_response(id, std::move(result)));
     } else if (req.method == "stats" && stats_format(params) == "prometheus") {
       // The Prometheus exposition (server/metrics.hpp) inside a JSON response.
       session->send(ok_response(id, {{"format", "prometheus"},

@@ -52,7 +52,7 @@ void Session::on_first_byte(const boost::system::error_code& ec, std::size_t) {
     return;
   }
   state_ = ReadState::kHeader;
-  message_deadline_ = Clock::now() + std::chrono::milliseconds(core_.config.read_timeout_ms);
+  message_clock_.start(core_);
   arm_read_deadline();
   read_pending_ = true;
   asio::async_read(socket_, asio::buffer(header_.data() + 1, header_.size() - 1),
@@ -90,18 +90,21 @@ void Session::on_header(const boost::system::error_code& ec, std::size_t) {
       enqueue(encode_frame(error_response(nullptr, e).dump()), true);
       return;
     }
-    case HeaderStatus::kTooLarge: {
-      const ErrorInfo e{"message_too_large",
-                        "message body of " + std::to_string(h.body_length()) +
-                            " bytes exceeds max_message_bytes (" +
-                            std::to_string(core_.config.max_message_bytes) + ")",
-                        ""};
-      send_error(nullptr, e);
-      discard_left_ = h.body_length();
-      state_ = ReadState::kDiscard;
-      do_discard();
+    case HeaderStatus::kTooLarge:
+      refuse_and_discard({"message_too_large",
+                          "message body of " + std::to_string(h.body_length()) +
+                              " bytes exceeds max_message_bytes (" +
+                              std::to_string(core_.config.max_message_bytes) + ")",
+                          ""},
+                         h.body_length());
       return;
-    }
+  }
+  // Reserved before the body buffer is allocated, so concurrent large
+  // messages are bounded while they arrive as well as while they are parsed.
+  ErrorInfo refused;
+  if (!core_.request_memory.try_reserve(h.body_length(), &reservation_, &refused)) {
+    refuse_and_discard(refused, h.body_length());
+    return;
   }
   body_.resize(h.body_length());
   state_ = ReadState::kBody;
@@ -129,8 +132,16 @@ void Session::on_body(const boost::system::error_code& ec, std::size_t) {
     bytes = text.size();
     handle_message(core_, shared_from_this(), text, Clock::now());
   }  // the text is freed before the trim
+  reservation_.release();
   release_large_message_memory(bytes);
   do_read_header();
+}
+
+void Session::refuse_and_discard(const ErrorInfo& error, std::uint64_t body_bytes) {
+  send_error(nullptr, error);
+  discard_left_ = body_bytes;
+  state_ = ReadState::kDiscard;
+  do_discard();
 }
 
 void Session::do_discard() {
@@ -156,7 +167,7 @@ void Session::arm_read_deadline() {
   if (state_ == ReadState::kIdle) {
     read_timer_.expires_after(std::chrono::milliseconds(core_.config.idle_timeout_ms));
   } else {
-    read_timer_.expires_at(message_deadline_);
+    read_timer_.expires_at(message_clock_.deadline(core_));
   }
   read_timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
     self->on_read_deadline(ec);
@@ -174,6 +185,10 @@ void Session::on_read_deadline(const boost::system::error_code& ec) {
   }
   if (state_ == ReadState::kHeader || state_ == ReadState::kBody ||
       state_ == ReadState::kDiscard) {
+    if (message_clock_.deadline(core_) > Clock::now()) {
+      arm_read_deadline();  // the server was busy meanwhile: that time is not the client's
+      return;
+    }
     const ErrorInfo e{"timeout",
                       "message incomplete after read_timeout_ms (" +
                           std::to_string(core_.config.read_timeout_ms) + " ms)",
@@ -276,6 +291,7 @@ void Session::close_now() {
   socket_.close(ignored);
   writes_.clear();
   queued_bytes_ = 0;
+  reservation_.release();  // a client gone mid-message holds no budget
 }
 
 }  // namespace beamcast
