@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "protocol/base64.hpp"
 #include "protocol/request.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/pass_plan.hpp"
@@ -347,27 +348,6 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
 }
 
 }  // namespace
-
-std::string base64_encode(const std::vector<std::uint8_t>& in) {
-  static const char* kAlphabet =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((in.size() + 2) / 3 * 4);
-  std::size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    const std::uint32_t v = (in[i] << 16) | (in[i + 1] << 8) | in[i + 2];
-    for (int k = 18; k >= 0; k -= 6) out.push_back(kAlphabet[(v >> k) & 63]);
-  }
-  if (i < in.size()) {
-    std::uint32_t v = in[i] << 16;
-    if (i + 1 < in.size()) v |= in[i + 1] << 8;
-    out.push_back(kAlphabet[(v >> 18) & 63]);
-    out.push_back(kAlphabet[(v >> 12) & 63]);
-    out.push_back(i + 1 < in.size() ? kAlphabet[(v >> 6) & 63] : '=');
-    out.push_back('=');
-  }
-  return out;
-}
 
 bool reserve_request_memory(ServerCore& core, Connection& connection, std::uint64_t message_bytes,
                             MemoryBudget::Reservation* reservation) {

@@ -21,7 +21,4 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
 bool reserve_request_memory(ServerCore& core, Connection& connection, std::uint64_t message_bytes,
                             MemoryBudget::Reservation* reservation);
 
-// Standard base64 (RFC 4648) for the "base64" encoding of frames.
-std::string base64_encode(const std::vector<std::uint8_t>& bytes);
-
 }  // namespace beamcast
