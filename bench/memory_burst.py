@@ -22,14 +22,6 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import test_hostile as th  # noqa: E402
 
 
-def peak_mib(pid):
-    with open(f"/proc/{pid}/status") as f:
-        for line in f:
-            if line.startswith("VmHWM"):
-                return int(line.split()[1]) / 1024
-    raise RuntimeError("no VmHWM")
-
-
 def main():
     th.SERVER = sys.argv[1]
     n = int(sys.argv[2]) if len(sys.argv) > 2 else 1_100_000
@@ -50,14 +42,14 @@ def main():
         base = th.settle_rss(srv, 1.0)
         first = []
         one(first)
-        after1, peak1 = th.settle_rss(srv, 3.0), peak_mib(srv.pid)
+        after1, peak1 = th.settle_rss(srv, 3.0), srv.status_mib("VmHWM")
         burst = []
         threads = [threading.Thread(target=one, args=(burst,)) for _ in range(12)]
         for t in threads:
             t.start()
         for t in threads:
             t.join()
-        after12, peak12 = th.settle_rss(srv, 3.0), peak_mib(srv.pid)
+        after12, peak12 = th.settle_rss(srv, 3.0), srv.status_mib("VmHWM")
         print(f"baseline {base:.1f} MiB")
         print(f"after 1: {after1:.1f} MiB (+{after1 - base:.1f}), peak {peak1:.1f} MiB, answer {first[0]}")
         print(f"after 12 concurrent: {after12:.1f} MiB (+{after12 - base:.1f}), peak {peak12:.1f} MiB, "

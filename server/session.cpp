@@ -17,11 +17,12 @@ namespace asio = boost::asio;
 using Clock = std::chrono::steady_clock;
 
 Session::Session(asio::ip::tcp::socket socket, ServerCore& core)
-    : socket_(std::move(socket)),
+    : Connection(core.config.max_inflight_per_connection),
+      socket_(std::move(socket)),
       core_(core),
       read_timer_(socket_.get_executor()),
       write_timer_(socket_.get_executor()),
-      alive_(std::make_shared<std::atomic<bool>>(true)) {
+      writes_(core.config.max_write_queue_bytes) {
   core_.stats.connection_opened();
 }
 
@@ -34,39 +35,36 @@ void Session::start() {
 void Session::do_read_header() {
   if (closed_) return;
   state_ = ReadState::kIdle;
-  if (paused_) return;  // resumed by on_write once the client has read enough
+  if (writes_.paused()) return;  // resumed by on_write once the client has read enough
   arm_read_deadline();
-  read_pending_ = true;
   // The first byte alone: it starts the message's read_timeout_ms, so a client
   // that sends part of a header and stops is timed out like a slow body.
-  asio::async_read(socket_, asio::buffer(header_.data(), 1),
-                   [self = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
-                     self->on_first_byte(ec, n);
+  read_header_part(0, 1);
+}
+
+void Session::read_header_part(std::size_t begin, std::size_t end) {
+  read_pending_ = true;
+  asio::async_read(socket_, asio::buffer(header_.data() + begin, end - begin),
+                   [self = shared_from_this(), end](const boost::system::error_code& ec, std::size_t) {
+                     self->read_pending_ = false;
+                     if (ec || self->closed_) {
+                       self->close_now();  // peer closed or reset: nothing to answer
+                     } else if (end == 1) {
+                       self->on_first_byte();
+                     } else {
+                       self->on_header();
+                     }
                    });
 }
 
-void Session::on_first_byte(const boost::system::error_code& ec, std::size_t) {
-  read_pending_ = false;
-  if (ec || closed_) {
-    close_now();  // peer closed or reset: nothing to answer
-    return;
-  }
+void Session::on_first_byte() {
   state_ = ReadState::kHeader;
   message_clock_.start(core_);
   arm_read_deadline();
-  read_pending_ = true;
-  asio::async_read(socket_, asio::buffer(header_.data() + 1, header_.size() - 1),
-                   [self = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
-                     self->on_header(ec, n);
-                   });
+  read_header_part(1, header_.size());
 }
 
-void Session::on_header(const boost::system::error_code& ec, std::size_t) {
-  read_pending_ = false;
-  if (ec || closed_) {
-    close_now();  // peer closed or reset: nothing to answer
-    return;
-  }
+void Session::on_header() {
   FrameHeader h;
   switch (parse_frame_header(header_, core_.config.max_message_bytes, &h)) {
     case HeaderStatus::kOk:
@@ -77,7 +75,7 @@ void Session::on_header(const boost::system::error_code& ec, std::size_t) {
       state_ = ReadState::kStopped;
       read_timer_.cancel();
       // Earlier requests still in flight are answered by nobody: say how many.
-      const int dropped = inflight_.load();
+      const int dropped = renders_in_flight();
       const ErrorInfo e{"bad_framing",
                         "expected a frame starting with \"BCP1\" and a non-zero JSON length "
                         "(see PROTOCOL.md, Framing); the connection is closed" +
@@ -216,10 +214,9 @@ void Session::send_error(const nlohmann::json& id, const ErrorInfo& error) {
 
 void Session::enqueue(std::vector<std::uint8_t> frame, bool close_after) {
   if (closed_) return;
-  queued_bytes_ += frame.size();
-  writes_.push_back(std::move(frame));
+  const std::size_t bytes = frame.size();
+  writes_.push(std::move(frame), bytes);
   if (close_after) close_after_write_ = true;
-  if (queued_bytes_ > core_.config.max_write_queue_bytes) paused_ = true;
   if (!writing_) do_write();
 }
 
@@ -244,8 +241,7 @@ void Session::on_write(const boost::system::error_code& ec, std::size_t) {
     close_now();
     return;
   }
-  queued_bytes_ -= writes_.front().size();
-  writes_.pop_front();
+  writes_.pop();
   if (!writes_.empty()) {
     do_write();
     return;
@@ -259,21 +255,8 @@ void Session::on_write(const boost::system::error_code& ec, std::size_t) {
 }
 
 void Session::resume_reading_if_paused() {
-  if (paused_ && queued_bytes_ <= core_.config.max_write_queue_bytes / 2) {
-    paused_ = false;
-    if (state_ == ReadState::kIdle && !read_pending_) do_read_header();
-  }
+  if (writes_.resume() && state_ == ReadState::kIdle && !read_pending_) do_read_header();
 }
-
-bool Session::try_begin_render() {
-  int current = inflight_.load();
-  do {
-    if (current >= core_.config.max_inflight_per_connection) return false;
-  } while (!inflight_.compare_exchange_weak(current, current + 1));
-  return true;
-}
-
-void Session::end_render() { inflight_.fetch_sub(1); }
 
 void Session::close() {
   asio::post(socket_.get_executor(), [self = shared_from_this()] { self->close_now(); });
@@ -282,7 +265,7 @@ void Session::close() {
 void Session::close_now() {
   if (closed_) return;
   closed_ = true;
-  alive_->store(false);  // queued renders of this client are dropped
+  mark_gone();  // queued renders of this client are dropped
   state_ = ReadState::kStopped;
   read_timer_.cancel();
   write_timer_.cancel();
@@ -290,7 +273,6 @@ void Session::close_now() {
   socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
   socket_.close(ignored);
   writes_.clear();
-  queued_bytes_ = 0;
   reservation_.release();  // a client gone mid-message holds no budget
 }
 

@@ -60,12 +60,16 @@ class Server:
     def alive(self):
         return self.proc.poll() is None
 
-    def rss_mib(self):
+    def status_mib(self, field):
+        """A memory field of /proc/PID/status in MiB: VmRSS (resident), VmHWM (peak)."""
         with open(f"/proc/{self.pid}/status") as f:
             for line in f:
-                if line.startswith("VmRSS:"):
+                if line.startswith(field + ":"):
                     return int(line.split()[1]) / 1024.0
-        raise RuntimeError("no VmRSS")
+        raise RuntimeError(f"no {field}")
+
+    def rss_mib(self):
+        return self.status_mib("VmRSS")
 
     def stop(self):
         if self.alive():
