@@ -21,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "protocol/base64.hpp"
 #include "protocol/errors.hpp"
 
 namespace beamcast::client {
@@ -36,11 +37,7 @@ struct Endpoint {
 // naming the text and what is wrong with it.
 Endpoint parse_endpoint(std::string_view text);
 
-// RFC 4648 base64 with padding. Decoding skips no characters: whitespace,
-// URL-safe letters, bad padding or a truncated final group throw
-// std::invalid_argument.
-std::string base64_encode(std::span<const std::uint8_t> bytes);
-std::vector<std::uint8_t> base64_decode(std::string_view text);
+// base64_encode / base64_decode: protocol/base64.hpp.
 
 // --- responses ---
 

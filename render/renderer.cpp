@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <utility>
 
 #include "protocol/camera.hpp"
 #include "render/gl_util.hpp"
@@ -46,6 +47,7 @@ struct Renderer::Impl {
   GlVertexArray empty_vao;
   std::vector<GlQuery> queries;  // timestamps: frame start, then one after each pass
   int max_layers = 0;
+  bool fail_next = false;  // fail_next_render_for_test()
 
   explicit Impl(const RendererOptions& opts)
       : context(EglContext::create(opts.egl)), tables(opts.table_cache_entries) {
@@ -259,6 +261,8 @@ Renderer::~Renderer() = default;
 
 const std::string& Renderer::description() const { return impl_->context->description(); }
 
+void Renderer::fail_next_render_for_test() { impl_->fail_next = true; }
+
 std::vector<FrameResult> Renderer::render(const Scene& scene, const FrameOptions& opts) {
   return render(scene, scene.cameras, opts);
 }
@@ -267,6 +271,10 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
                                           const FrameOptions& opts) {
   const FramePlan plan = make_plan(PlanInput{scene, opts.resolution_scale});
   SceneResources res(scene, impl_->tables, plan);
+  if (std::exchange(impl_->fail_next, false)) {
+    glEnable(0);  // GL_INVALID_ENUM
+    gl_check("glEnable(0) (injected test failure)");
+  }
   std::vector<FrameResult> frames(cameras.size());
   // Batches: cameras of one size, in order of first appearance, split where a
   // batch would pass the view or memory bound. A batch of one takes the

@@ -83,6 +83,11 @@ class Renderer {
   std::vector<FrameResult> render(const Scene& scene, const std::vector<Camera>& cameras,
                                   const FrameOptions& opts = {});
 
+  // Test hook (the server's context-rebuild test): the next render issues an
+  // invalid GL call after uploading its scene and throws the GlError that
+  // gl_check reports, as a driver fault mid-frame would.
+  void fail_next_render_for_test();
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -42,6 +42,10 @@ struct ServerConfig {
 
   SceneLimits scene_limits = kServerSceneLimits;
   std::uint64_t max_message_bytes = 16u << 20;
+  // Server-wide budget of the requests being read and parsed, each counted
+  // at its estimated cost (server/memory.hpp): 40 x 16 MiB, so one request of
+  // max_message_bytes fits alone.
+  std::uint64_t max_request_memory_bytes = 640ull << 20;
   // Enforced while a request's JSON is parsed (protocol/bounded_json.hpp):
   // max_json_depth (nesting) and max_json_values (values in one request).
   JsonLimits json_limits;

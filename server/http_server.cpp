@@ -110,10 +110,11 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
  public:
   // Takes over the HTTP session's stream (and its TLS state) after the upgrade.
   WsSession(Stream stream, ServerCore& core)
-      : ws_(std::move(stream)),
+      : Connection(core.config.max_inflight_per_connection),
+        ws_(std::move(stream)),
         core_(core),
         message_timer_(ws_.get_executor()),
-        alive_(std::make_shared<std::atomic<bool>>(true)) {
+        writes_(core.config.max_write_queue_bytes) {
     core_.stats.connection_opened();
   }
   ~WsSession() override { core_.stats.connection_closed(); }
@@ -143,15 +144,6 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
     core_.stats.count_error(error.code);
     send(error_response(id, error), {});
   }
-  bool try_begin_render() override {
-    int current = inflight_.load();
-    do {
-      if (current >= core_.config.max_inflight_per_connection) return false;
-    } while (!inflight_.compare_exchange_weak(current, current + 1));
-    return true;
-  }
-  void end_render() override { inflight_.fetch_sub(1); }
-  std::shared_ptr<const std::atomic<bool>> alive_flag() const override { return alive_; }
 
   void close() override {
     asio::post(ws_.get_executor(), [self = shared_from_this()] { self->close_now(); });
@@ -163,7 +155,7 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
   // within read_timeout_ms (PROTOCOL.md, "Limits"). Between messages only
   // Beast's idle timeout (idle_timeout_ms, with pings) applies.
   void do_read() {
-    if (closed_ || (paused_ && !in_message_)) return;
+    if (closed_ || (writes_.paused() && !in_message_)) return;
     read_pending_ = true;
     ws_.async_read_some(buffer_, 64 * 1024,
                         [self = shared_from_this()](beast::error_code ec, std::size_t) {
@@ -171,9 +163,20 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
                         });
   }
 
+  void arm_message_deadline() {
+    message_timer_.expires_at(message_clock_.deadline(core_));
+    message_timer_.async_wait([self = shared_from_this()](beast::error_code e) {
+      self->on_message_deadline(e);
+    });
+  }
+
   void on_message_deadline(beast::error_code ec) {
     if (ec == asio::error::operation_aborted || closed_ || !in_message_) return;
     if (message_timer_.expiry() > std::chrono::steady_clock::now()) return;
+    if (message_clock_.deadline(core_) > std::chrono::steady_clock::now()) {
+      arm_message_deadline();  // the server was busy meanwhile: not the client's time
+      return;
+    }
     const ErrorInfo e{"timeout",
                       "message incomplete after read_timeout_ms (" +
                           std::to_string(core_.config.read_timeout_ms) + " ms)",
@@ -192,10 +195,8 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
     if (ec || closed_ || close_after_write_) return close_now();
     if (!in_message_) {
       in_message_ = true;
-      message_timer_.expires_after(std::chrono::milliseconds(core_.config.read_timeout_ms));
-      message_timer_.async_wait([self = shared_from_this()](beast::error_code e) {
-        self->on_message_deadline(e);
-      });
+      message_clock_.start(core_);
+      arm_message_deadline();
     }
     if (!ws_.is_message_done()) return do_read();
     in_message_ = false;
@@ -206,7 +207,8 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
                                     "binary WebSocket messages are not requests; send each "
                                     "request as one text message (PROTOCOL.md, WebSocket)",
                                     ""});
-    } else {
+    } else if (MemoryBudget::Reservation reserved;
+               reserve_request_memory(core_, *this, bytes, &reserved)) {
       const std::string text = beast::buffers_to_string(buffer_.data());
       buffer_.consume(buffer_.size());
       buffer_.shrink_to_fit();
@@ -219,11 +221,9 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
 
   void enqueue(bool text, std::vector<std::uint8_t> data) {
     if (closed_) return;
-    queued_bytes_ += data.size();
-    writes_.push_back({text, std::move(data)});
-    // Same rule as the TCP session: stop reading requests while the client
-    // is not reading its responses.
-    if (queued_bytes_ > core_.config.max_write_queue_bytes) paused_ = true;
+    const std::size_t bytes = data.size();
+    // Pauses reading, as on TCP, while the client is not taking its responses.
+    writes_.push({text, std::move(data)}, bytes);
     if (!writing_) do_write();
   }
 
@@ -238,23 +238,18 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
 
   void on_write(beast::error_code ec) {
     if (ec || closed_) return close_now();
-    queued_bytes_ -= writes_.front().second.size();
-    writes_.pop_front();
+    writes_.pop();
     if (!writes_.empty()) return do_write();
     writing_ = false;
     if (close_after_write_) return close_now();
-    if (paused_ && queued_bytes_ <= core_.config.max_write_queue_bytes / 2) {
-      paused_ = false;
-      if (!read_pending_) do_read();
-    }
+    if (writes_.resume() && !read_pending_) do_read();
   }
 
   void close_now() {
     if (closed_) return;
     closed_ = true;
-    alive_->store(false);
+    mark_gone();
     writes_.clear();
-    queued_bytes_ = 0;
     message_timer_.cancel();
     beast::error_code ignored;
     beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ignored);
@@ -264,14 +259,11 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
   websocket::stream<Stream> ws_;
   ServerCore& core_;
   asio::steady_timer message_timer_;  // read_timeout_ms of the message being read
-  std::shared_ptr<std::atomic<bool>> alive_;
-  std::atomic<int> inflight_{0};
+  MessageClock message_clock_;
   // Strand-only state.
   beast::flat_buffer buffer_;
-  std::deque<std::pair<bool, std::vector<std::uint8_t>>> writes_;
-  std::uint64_t queued_bytes_ = 0;
+  WriteQueue<std::pair<bool, std::vector<std::uint8_t>>> writes_;  // (text?, bytes)
   bool writing_ = false;
-  bool paused_ = false;
   bool read_pending_ = false;
   bool in_message_ = false;         // part of a message has arrived
   bool close_after_write_ = false;  // a timeout was sent: close once written

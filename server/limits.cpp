@@ -31,6 +31,9 @@ const std::vector<LimitEntry>& limit_table() {
   static const std::vector<LimitEntry> kTable = {
       BEAMCAST_LIMIT("max_message_bytes", max_message_bytes, 12, kI32,
                      "Largest request (JSON + binary) in bytes: message_too_large"),
+      BEAMCAST_LIMIT("max_request_memory_bytes", max_request_memory_bytes, 1, kI64,
+                     "Estimated memory (40 x message bytes) of the requests being read and "
+                     "parsed, server-wide: busy (limit_exceeded for one request over it)"),
       BEAMCAST_LIMIT("max_json_depth", json_limits.max_depth, 1, 100000,
                      "Deepest nesting of objects and arrays in a request (the request is 1)"),
       BEAMCAST_LIMIT("max_json_values", json_limits.max_values, 1, kI64,

@@ -109,6 +109,9 @@ std::string Metrics::prometheus(const Gauges& g) const {
   o += "beamcast_bytes_out_total " + std::to_string(g.bytes_out) + "\n";
   header(o, "beamcast_renders_dropped_total", "counter", "Queued renders dropped because their client left.");
   o += "beamcast_renders_dropped_total " + std::to_string(g.renders_dropped) + "\n";
+  header(o, "beamcast_renderer_rebuilds_total", "counter",
+         "Render contexts discarded and recreated after a GL error.");
+  o += "beamcast_renderer_rebuilds_total " + std::to_string(g.renderer_rebuilds) + "\n";
   header(o, "beamcast_queue_depth", "gauge", "Render jobs waiting for a GL worker.");
   o += "beamcast_queue_depth " + std::to_string(g.queue_depth) + "\n";
   header(o, "beamcast_inflight", "gauge", "Render jobs admitted and not yet answered.");

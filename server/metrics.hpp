@@ -35,6 +35,7 @@ class Metrics {
     std::uint64_t frames = 0;
     std::uint64_t bytes_out = 0;
     std::uint64_t renders_dropped = 0;
+    std::uint64_t renderer_rebuilds = 0;
     std::map<std::string, std::uint64_t> errors;  // by code
     double uptime_s = 0;
   };

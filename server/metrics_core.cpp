@@ -22,6 +22,7 @@ Metrics::Gauges sample_gauges(const ServerCore& core) {
     g.queue_depth = core.renders->queued();
     g.inflight = core.renders->inflight();
     g.renders_dropped = core.renders->dropped();
+    g.renderer_rebuilds = core.renders->renderer_rebuilds();
   }
   return g;
 }

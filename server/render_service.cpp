@@ -7,6 +7,7 @@
 #include <iterator>
 #include <optional>
 
+#include "render/gl_util.hpp"
 #include "render/image.hpp"
 #include "render/jpeg.hpp"
 
@@ -30,6 +31,7 @@ class GlFrameRenderer final : public FrameRenderer {
                                   const FrameOptions& options) override {
     return renderer_.render(scene, cameras, options);
   }
+  void fail_next_render_for_test() override { renderer_.fail_next_render_for_test(); }
 
  private:
   Renderer renderer_;
@@ -92,17 +94,23 @@ void RenderService::finish(RenderJob& job, RenderOutcome&& outcome) {
   done(std::move(outcome));
 }
 
-void RenderService::worker_main(int index) {
-  std::unique_ptr<FrameRenderer> renderer;
+std::unique_ptr<FrameRenderer> RenderService::make_renderer(int index) {
   try {
-    renderer = factory_();
+    auto renderer = factory_();
     std::lock_guard lock(mu_);
     if (description_.empty()) description_ = renderer->description();
+    return renderer;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "beamcast-server: render worker %d: %s\n", index, e.what());
     std::lock_guard lock(mu_);
     failure_ = e.what();
+    return nullptr;
   }
+}
+
+void RenderService::worker_main(int index) {
+  std::unique_ptr<FrameRenderer> renderer = make_renderer(index);
+  bool rebuild_pending = false;  // a GL error discarded the renderer, no new one yet
   {
     std::lock_guard lock(mu_);
     ++ready_;
@@ -138,13 +146,23 @@ void RenderService::worker_main(int index) {
     for (const RenderJob& job : live) cameras.insert(cameras.end(), job.cameras.begin(), job.cameras.end());
     std::optional<ErrorInfo> error;
     std::vector<FrameResult> frames;
+    bool gl_failed = false;
     if (!renderer) {
       error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
     } else {
       try {
+        int inject = inject_failures_.load();
+        while (inject > 0 && !inject_failures_.compare_exchange_weak(inject, inject - 1)) {
+        }
+        if (inject > 0) renderer->fail_next_render_for_test();
         // Jobs share a render only with the same stored scene and default
         // options (RenderJob::batch_key), so the first job's options hold for all.
         frames = renderer->render(*live.front().scene, cameras, live.front().options);
+      } catch (const GlError& e) {
+        std::fprintf(stderr, "beamcast-server: render worker %d: GL error, rebuilding its context: %s\n",
+                     index, e.what());
+        error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
+        gl_failed = true;
       } catch (const std::exception& e) {
         std::fprintf(stderr, "beamcast-server: render failed: %s\n", e.what());
         error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
@@ -168,6 +186,18 @@ void RenderService::worker_main(int index) {
                         std::make_move_iterator(frames.begin() + static_cast<std::ptrdiff_t>(at + n)));
       at += n;
       encode_and_finish(std::move(job), std::move(out));
+    }
+    // After the failed jobs are answered: the old context goes before the
+    // new one is made current on this thread. A worker whose rebuild fails
+    // tries again before its next job (and answers `internal` meanwhile).
+    rebuild_pending = rebuild_pending || gl_failed;
+    if (gl_failed || !renderer) {
+      renderer.reset();
+      renderer = make_renderer(index);
+      if (renderer && rebuild_pending) {
+        rebuilds_.fetch_add(1);
+        rebuild_pending = false;
+      }
     }
   }
 }

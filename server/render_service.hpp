@@ -39,6 +39,9 @@ class FrameRenderer {
     (void)options;
     return render(scene, cameras);
   }
+  // Test hook (RenderService::fail_next_render_for_test): the next render
+  // throws GlError from inside the renderer.
+  virtual void fail_next_render_for_test() = 0;
 };
 
 // Called on each worker thread, so a GL context is created on the thread that uses it.
@@ -104,12 +107,24 @@ class RenderService {
   int queued() const;
   // Jobs dropped because their client had gone (never rendered).
   std::uint64_t dropped() const { return dropped_.load(); }
+  // Renderers discarded and recreated after a render threw GlError: a GL
+  // error leaves the context in an unknown state, so the worker answers the
+  // failed jobs `internal` and builds a new renderer (a new EGL context)
+  // before it takes the next job.
+  std::uint64_t renderer_rebuilds() const { return rebuilds_.load(); }
+  // Test hook, compiled in always and reached only from tests: the next render
+  // (on whichever worker takes it) fails with a real GL error
+  // (Renderer::fail_next_render_for_test).
+  void fail_next_render_for_test() { inject_failures_.fetch_add(1); }
   // Stops the workers; jobs still queued are dropped (their `done` is called
   // with dropped = true).
   void stop();
 
  private:
   void worker_main(int index);
+  // Creates a renderer on the calling (worker) thread; null, with the reason
+  // in failure_, if it cannot.
+  std::unique_ptr<FrameRenderer> make_renderer(int index);
   void finish(RenderJob& job, RenderOutcome&& outcome);
   // Takes the queued jobs that may join `first` (same batch key) once its
   // window has passed; called with `lock` held, may wait on it.
@@ -124,6 +139,8 @@ class RenderService {
   int batch_max_views_ = 64;
   std::atomic<int> inflight_{0};
   std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<std::uint64_t> rebuilds_{0};
+  std::atomic<int> inject_failures_{0};
   mutable std::mutex mu_;
   std::condition_variable cv_;
   std::condition_variable window_cv_;  // batch windows wait here (stop() wakes them)

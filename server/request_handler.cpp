@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "protocol/base64.hpp"
 #include "protocol/request.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/pass_plan.hpp"
@@ -345,33 +346,29 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
 
 }  // namespace
 
-std::string base64_encode(const std::vector<std::uint8_t>& in) {
-  static const char* kAlphabet =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((in.size() + 2) / 3 * 4);
-  std::size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    const std::uint32_t v = (in[i] << 16) | (in[i + 1] << 8) | in[i + 2];
-    for (int k = 18; k >= 0; k -= 6) out.push_back(kAlphabet[(v >> k) & 63]);
-  }
-  if (i < in.size()) {
-    std::uint32_t v = in[i] << 16;
-    if (i + 1 < in.size()) v |= in[i + 1] << 8;
-    out.push_back(kAlphabet[(v >> 18) & 63]);
-    out.push_back(kAlphabet[(v >> 12) & 63]);
-    out.push_back(i + 1 < in.size() ? kAlphabet[(v >> 6) & 63] : '=');
-    out.push_back('=');
-  }
-  return out;
+bool reserve_request_memory(ServerCore& core, Connection& connection, std::uint64_t message_bytes,
+                            MemoryBudget::Reservation* reservation) {
+  ErrorInfo refused;
+  if (core.request_memory.try_reserve(message_bytes, reservation, &refused)) return true;
+  connection.send_error(nullptr, refused);
+  return false;
 }
 
 void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
                     std::string_view json_text, Clock::time_point arrived) {
+  // Time spent here is not the client's (MessageClock).
+  struct HandlingTime {
+    ServerCore& core;
+    Clock::time_point start = Clock::now();
+    ~HandlingTime() {
+      core.handling_ns.fetch_add(
+          std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
+    }
+  } handling{core};
   json id;
   std::string method = "(invalid)";  // metrics key: a known method or a fixed placeholder
   try {
-    const Request req = parse_request(json_text, &id, core.config.json_limits);
+    Request req = parse_request(json_text, &id, core.config.json_limits);
     static const char* kMethods[] = {"hello", "ping", "stats", "render", "scene.put",
                                      "scene.update", "scene.delete"};
     // Count unknown methods under one key: client-chosen strings must not grow the map.
@@ -391,7 +388,9 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
       if (token_required(core.config)) session->set_authenticated();
       session->send(ok_response(id, std::move(result)));
     } else if (req.method == "ping") {
-      session->send(ok_response(id, {{"echo", params}}));
+      json result = json::object();
+      result["echo"] = std::move(req.params);  // moved: a large ping's document is not copied
+      session->send(ok_response(id, std::move(result)));
     } else if (req.method == "stats" && stats_format(params) == "prometheus") {
       // The Prometheus exposition (server/metrics.hpp) inside a JSON response.
       session->send(ok_response(id, {{"format", "prometheus"},
@@ -404,6 +403,7 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
       s["inflight"] = core.renders->inflight();
       s["queue_depth"] = core.renders->queued();
       s["renders_dropped"] = core.renders->dropped();
+      s["renderer_rebuilds"] = core.renders->renderer_rebuilds();
       s["scenes"] = {{"count", core.scenes.count()}, {"bytes", core.scenes.bytes()}};
       session->send(ok_response(id, std::move(s)));
     } else if (req.method == "render") {

@@ -15,7 +15,10 @@ class Connection;
 void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
                     std::string_view json_text, std::chrono::steady_clock::time_point arrived);
 
-// Standard base64 (RFC 4648) for the "base64" encoding of frames.
-std::string base64_encode(const std::vector<std::uint8_t>& bytes);
+// Reserves a message's estimated memory against max_request_memory_bytes
+// (server/memory.hpp); if it does not fit, answers the connection (`busy` or
+// `limit_exceeded`, id null: the message has not been parsed) and returns false.
+bool reserve_request_memory(ServerCore& core, Connection& connection, std::uint64_t message_bytes,
+                            MemoryBudget::Reservation* reservation);
 
 }  // namespace beamcast

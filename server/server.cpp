@@ -14,6 +14,7 @@
 #include "protocol/request.hpp"
 #include "server/threads.hpp"
 #include "server/auth.hpp"
+#include "server/memory.hpp"
 #include "server/session.hpp"
 
 namespace beamcast {
@@ -28,6 +29,7 @@ Server::Server(const ServerConfig& config, RendererFactory renderers)
       signals_(io_),
       drain_timer_(io_),
       http_(std::make_unique<HttpServer>(io_, core_)) {
+  configure_allocator();
   register_preview_routes(*http_, core_);
   register_metrics_routes(*http_, core_);
 }

@@ -17,11 +17,12 @@ namespace asio = boost::asio;
 using Clock = std::chrono::steady_clock;
 
 Session::Session(asio::ip::tcp::socket socket, ServerCore& core)
-    : socket_(std::move(socket)),
+    : Connection(core.config.max_inflight_per_connection),
+      socket_(std::move(socket)),
       core_(core),
       read_timer_(socket_.get_executor()),
       write_timer_(socket_.get_executor()),
-      alive_(std::make_shared<std::atomic<bool>>(true)) {
+      writes_(core.config.max_write_queue_bytes) {
   core_.stats.connection_opened();
 }
 
@@ -34,39 +35,36 @@ void Session::start() {
 void Session::do_read_header() {
   if (closed_) return;
   state_ = ReadState::kIdle;
-  if (paused_) return;  // resumed by on_write once the client has read enough
+  if (writes_.paused()) return;  // resumed by on_write once the client has read enough
   arm_read_deadline();
-  read_pending_ = true;
   // The first byte alone: it starts the message's read_timeout_ms, so a client
   // that sends part of a header and stops is timed out like a slow body.
-  asio::async_read(socket_, asio::buffer(header_.data(), 1),
-                   [self = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
-                     self->on_first_byte(ec, n);
-                   });
+  read_header_part(0, 1);
 }
 
-void Session::on_first_byte(const boost::system::error_code& ec, std::size_t) {
-  read_pending_ = false;
-  if (ec || closed_) {
-    close_now();  // peer closed or reset: nothing to answer
-    return;
-  }
-  state_ = ReadState::kHeader;
-  message_deadline_ = Clock::now() + std::chrono::milliseconds(core_.config.read_timeout_ms);
-  arm_read_deadline();
+void Session::read_header_part(std::size_t begin, std::size_t end) {
   read_pending_ = true;
-  asio::async_read(socket_, asio::buffer(header_.data() + 1, header_.size() - 1),
-                   [self = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
-                     self->on_header(ec, n);
+  asio::async_read(socket_, asio::buffer(header_.data() + begin, end - begin),
+                   [self = shared_from_this(), end](const boost::system::error_code& ec, std::size_t) {
+                     self->read_pending_ = false;
+                     if (ec || self->closed_) {
+                       self->close_now();  // peer closed or reset: nothing to answer
+                     } else if (end == 1) {
+                       self->on_first_byte();
+                     } else {
+                       self->on_header();
+                     }
                    });
 }
 
-void Session::on_header(const boost::system::error_code& ec, std::size_t) {
-  read_pending_ = false;
-  if (ec || closed_) {
-    close_now();  // peer closed or reset: nothing to answer
-    return;
-  }
+void Session::on_first_byte() {
+  state_ = ReadState::kHeader;
+  message_clock_.start(core_);
+  arm_read_deadline();
+  read_header_part(1, header_.size());
+}
+
+void Session::on_header() {
   FrameHeader h;
   switch (parse_frame_header(header_, core_.config.max_message_bytes, &h)) {
     case HeaderStatus::kOk:
@@ -77,7 +75,7 @@ void Session::on_header(const boost::system::error_code& ec, std::size_t) {
       state_ = ReadState::kStopped;
       read_timer_.cancel();
       // Earlier requests still in flight are answered by nobody: say how many.
-      const int dropped = inflight_.load();
+      const int dropped = renders_in_flight();
       const ErrorInfo e{"bad_framing",
                         "expected a frame starting with \"BCP1\" and a non-zero JSON length "
                         "(see PROTOCOL.md, Framing); the connection is closed" +
@@ -90,18 +88,21 @@ void Session::on_header(const boost::system::error_code& ec, std::size_t) {
       enqueue(encode_frame(error_response(nullptr, e).dump()), true);
       return;
     }
-    case HeaderStatus::kTooLarge: {
-      const ErrorInfo e{"message_too_large",
-                        "message body of " + std::to_string(h.body_length()) +
-                            " bytes exceeds max_message_bytes (" +
-                            std::to_string(core_.config.max_message_bytes) + ")",
-                        ""};
-      send_error(nullptr, e);
-      discard_left_ = h.body_length();
-      state_ = ReadState::kDiscard;
-      do_discard();
+    case HeaderStatus::kTooLarge:
+      refuse_and_discard({"message_too_large",
+                          "message body of " + std::to_string(h.body_length()) +
+                              " bytes exceeds max_message_bytes (" +
+                              std::to_string(core_.config.max_message_bytes) + ")",
+                          ""},
+                         h.body_length());
       return;
-    }
+  }
+  // Reserved before the body buffer is allocated, so concurrent large
+  // messages are bounded while they arrive as well as while they are parsed.
+  ErrorInfo refused;
+  if (!core_.request_memory.try_reserve(h.body_length(), &reservation_, &refused)) {
+    refuse_and_discard(refused, h.body_length());
+    return;
   }
   body_.resize(h.body_length());
   state_ = ReadState::kBody;
@@ -129,8 +130,16 @@ void Session::on_body(const boost::system::error_code& ec, std::size_t) {
     bytes = text.size();
     handle_message(core_, shared_from_this(), text, Clock::now());
   }  // the text is freed before the trim
+  reservation_.release();
   release_large_message_memory(bytes);
   do_read_header();
+}
+
+void Session::refuse_and_discard(const ErrorInfo& error, std::uint64_t body_bytes) {
+  send_error(nullptr, error);
+  discard_left_ = body_bytes;
+  state_ = ReadState::kDiscard;
+  do_discard();
 }
 
 void Session::do_discard() {
@@ -156,7 +165,7 @@ void Session::arm_read_deadline() {
   if (state_ == ReadState::kIdle) {
     read_timer_.expires_after(std::chrono::milliseconds(core_.config.idle_timeout_ms));
   } else {
-    read_timer_.expires_at(message_deadline_);
+    read_timer_.expires_at(message_clock_.deadline(core_));
   }
   read_timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
     self->on_read_deadline(ec);
@@ -174,6 +183,10 @@ void Session::on_read_deadline(const boost::system::error_code& ec) {
   }
   if (state_ == ReadState::kHeader || state_ == ReadState::kBody ||
       state_ == ReadState::kDiscard) {
+    if (message_clock_.deadline(core_) > Clock::now()) {
+      arm_read_deadline();  // the server was busy meanwhile: that time is not the client's
+      return;
+    }
     const ErrorInfo e{"timeout",
                       "message incomplete after read_timeout_ms (" +
                           std::to_string(core_.config.read_timeout_ms) + " ms)",
@@ -201,10 +214,9 @@ void Session::send_error(const nlohmann::json& id, const ErrorInfo& error) {
 
 void Session::enqueue(std::vector<std::uint8_t> frame, bool close_after) {
   if (closed_) return;
-  queued_bytes_ += frame.size();
-  writes_.push_back(std::move(frame));
+  const std::size_t bytes = frame.size();
+  writes_.push(std::move(frame), bytes);
   if (close_after) close_after_write_ = true;
-  if (queued_bytes_ > core_.config.max_write_queue_bytes) paused_ = true;
   if (!writing_) do_write();
 }
 
@@ -229,8 +241,7 @@ void Session::on_write(const boost::system::error_code& ec, std::size_t) {
     close_now();
     return;
   }
-  queued_bytes_ -= writes_.front().size();
-  writes_.pop_front();
+  writes_.pop();
   if (!writes_.empty()) {
     do_write();
     return;
@@ -244,21 +255,8 @@ void Session::on_write(const boost::system::error_code& ec, std::size_t) {
 }
 
 void Session::resume_reading_if_paused() {
-  if (paused_ && queued_bytes_ <= core_.config.max_write_queue_bytes / 2) {
-    paused_ = false;
-    if (state_ == ReadState::kIdle && !read_pending_) do_read_header();
-  }
+  if (writes_.resume() && state_ == ReadState::kIdle && !read_pending_) do_read_header();
 }
-
-bool Session::try_begin_render() {
-  int current = inflight_.load();
-  do {
-    if (current >= core_.config.max_inflight_per_connection) return false;
-  } while (!inflight_.compare_exchange_weak(current, current + 1));
-  return true;
-}
-
-void Session::end_render() { inflight_.fetch_sub(1); }
 
 void Session::close() {
   asio::post(socket_.get_executor(), [self = shared_from_this()] { self->close_now(); });
@@ -267,7 +265,7 @@ void Session::close() {
 void Session::close_now() {
   if (closed_) return;
   closed_ = true;
-  alive_->store(false);  // queued renders of this client are dropped
+  mark_gone();  // queued renders of this client are dropped
   state_ = ReadState::kStopped;
   read_timer_.cancel();
   write_timer_.cancel();
@@ -275,7 +273,7 @@ void Session::close_now() {
   socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
   socket_.close(ignored);
   writes_.clear();
-  queued_bytes_ = 0;
+  reservation_.release();  // a client gone mid-message holds no budget
 }
 
 }  // namespace beamcast

@@ -33,10 +33,6 @@ class Session : public Connection, public std::enable_shared_from_this<Session> 
   // Thread-safe: closes the connection (pending writes are dropped).
   void close() override;
 
-  // Per-connection admission of render work (thread-safe).
-  bool try_begin_render() override;
-  void end_render() override;
-  std::shared_ptr<const std::atomic<bool>> alive_flag() const override { return alive_; }
 
  private:
   // kIdle: between messages (idle_timeout_ms); kHeader, kBody, kDiscard: a
@@ -45,13 +41,17 @@ class Session : public Connection, public std::enable_shared_from_this<Session> 
   enum class ReadState { kIdle, kHeader, kBody, kDiscard, kStopped };
 
   void do_read_header();
-  void on_first_byte(const boost::system::error_code& ec, std::size_t n);
-  void on_header(const boost::system::error_code& ec, std::size_t n);
+  // Reads header_[begin, end); then on_first_byte (end 1) or on_header.
+  void read_header_part(std::size_t begin, std::size_t end);
+  void on_first_byte();
+  void on_header();
   void do_read_body();
   void on_body(const boost::system::error_code& ec, std::size_t n);
+  // Answers `error` (id null) and reads the message's body away.
+  void refuse_and_discard(const ErrorInfo& error, std::uint64_t body_bytes);
   void do_discard();
   // Idle: idle_timeout_ms from now. A started message: read_timeout_ms from
-  // its first byte (message_deadline_), not re-armed per read.
+  // its first byte (message_clock_), not re-armed per read.
   void arm_read_deadline();
   void on_read_deadline(const boost::system::error_code& ec);
   void enqueue(std::vector<std::uint8_t> frame, bool close_after);
@@ -64,19 +64,18 @@ class Session : public Connection, public std::enable_shared_from_this<Session> 
   ServerCore& core_;
   boost::asio::steady_timer read_timer_;
   boost::asio::steady_timer write_timer_;
-  std::shared_ptr<std::atomic<bool>> alive_;
-  std::atomic<int> inflight_{0};
 
   // Strand-only state.
   ReadState state_ = ReadState::kIdle;
-  std::chrono::steady_clock::time_point message_deadline_{};
+  MessageClock message_clock_;  // read_timeout_ms of the message being read
   bool read_pending_ = false;  // an async read is outstanding
-  bool paused_ = false;        // reading stopped: write queue over its limit
   std::array<std::uint8_t, kFrameHeaderSize> header_{};
   std::vector<std::uint8_t> body_;
+  // The message's estimated memory (max_request_memory_bytes), held from its
+  // header until it has been handled.
+  MemoryBudget::Reservation reservation_;
   std::uint64_t discard_left_ = 0;
-  std::deque<std::vector<std::uint8_t>> writes_;
-  std::uint64_t queued_bytes_ = 0;
+  WriteQueue<std::vector<std::uint8_t>> writes_;
   bool writing_ = false;
   bool close_after_write_ = false;
   bool closed_ = false;

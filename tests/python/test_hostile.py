@@ -60,12 +60,16 @@ class Server:
     def alive(self):
         return self.proc.poll() is None
 
-    def rss_mib(self):
+    def status_mib(self, field):
+        """A memory field of /proc/PID/status in MiB: VmRSS (resident), VmHWM (peak)."""
         with open(f"/proc/{self.pid}/status") as f:
             for line in f:
-                if line.startswith("VmRSS:"):
+                if line.startswith(field + ":"):
                     return int(line.split()[1]) / 1024.0
-        raise RuntimeError("no VmRSS")
+        raise RuntimeError(f"no {field}")
+
+    def rss_mib(self):
+        return self.status_mib("VmRSS")
 
     def stop(self):
         if self.alive():
@@ -430,6 +434,75 @@ def test_scene_store_bytes_never_exceeded():
 
 
 # ---- Defect 6: slow headers and the idle timeout ----------------------------------
+
+def padded_ping(rid, size):
+    """A ping request of exactly `size` bytes."""
+    head, tail = '{"id":"%s","method":"ping","params":{"pad":"' % rid, '"}}'
+    return (head + "x" * (size - len(head) - len(tail)) + tail).encode()
+
+
+def test_request_memory_budget():
+    # 40 bytes of budget per message byte (server/memory.hpp): 4 MB admits
+    # one message of up to 100 000 bytes.
+    with Server("--no-demo", "--max-request-memory-bytes", "4000000") as srv:
+        c = Bcp(srv.port)
+        c.send_text(padded_ping("big", 150_000))
+        e = expect_error(c.recv()[0], "limit_exceeded", rid=None)
+        assert "max_request_memory_bytes = 4000000" in e["message"], e
+        assert c.call({"id": 1, "method": "ping"})["ok"]  # the connection carries on
+
+        # A message whose body is still arriving holds 60 000 x 40 bytes...
+        a = Bcp(srv.port)
+        body = padded_ping("a", 60_000)
+        a.s.sendall(b"BCP1" + struct.pack(">II", len(body), 0) + body[:1000])
+        time.sleep(0.5)
+        # ...so another like it does not fit, over TCP or WebSocket...
+        b = Bcp(srv.port)
+        b.send_text(padded_ping("b", 60_000))
+        e = expect_error(b.recv()[0], "busy", rid=None)
+        assert "max_request_memory_bytes = 4000000" in e["message"], e
+        w = Ws(srv.http_port)
+        e = expect_error(w.call_text(padded_ping("w", 60_000)), "busy", rid=None)
+        assert "max_request_memory_bytes" in e["message"], e
+        assert b.call({"id": 2, "method": "ping"})["ok"]  # small ones still do
+        # ...until the first is complete and answered.
+        a.s.sendall(body[1000:])
+        assert a.recv()[0]["id"] == "a"
+        b.send_text(padded_ping("b2", 60_000))
+        r = b.recv()[0]
+        assert r.get("ok") and r["id"] == "b2", str(r)[:200]
+        assert w.call_text(padded_ping("w2", 60_000))["ok"]
+        for conn in (a, b, c, w):
+            conn.close()
+
+
+def test_read_timeout_does_not_count_the_servers_parse_time():
+    # Two 10 MB pings sent at once to one network thread: while it parses and
+    # answers one (over a second here), the other's bytes stop arriving (the
+    # socket buffers are full) and its read_timeout_ms passes in wall time.
+    # That time is the server's, not the client's (MessageClock,
+    # server_core.hpp): both must be answered. Before, the second timed out.
+    keys = ",".join(f'"k{i}":{i % 10}' for i in range(900_000))
+    with Server("--no-demo", "--read-timeout-ms", "600", "--network-threads", "1",
+                "--max-request-memory-bytes", "4000000000") as srv:
+        answers = {}
+
+        def one(rid):
+            try:
+                c = Bcp(srv.port, timeout=120)
+                c.send_text('{"id":"%s","method":"ping","params":{%s}}' % (rid, keys))
+                r = c.recv()[0]
+                answers[rid] = "ok" if r.get("ok") else r["error"]["code"]
+                c.close()
+            except OSError as e:
+                answers[rid] = type(e).__name__
+        threads = [threading.Thread(target=one, args=(rid,)) for rid in ("a", "b")]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        assert answers == {"a": "ok", "b": "ok"}, answers
+
 
 def test_partial_header_times_out_with_read_timeout():
     with Server("--read-timeout-ms", "1000", "--no-demo") as srv:

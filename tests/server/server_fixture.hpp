@@ -1,5 +1,6 @@
-// An in-process beamcast server on an ephemeral port (GL worker on llvmpipe),
-// shared by the access-control, overload and soak tests.
+// An in-process beamcast server on an ephemeral port (GL worker on llvmpipe,
+// or the renderer a test passes: fake_renderer.hpp), shared by the
+// access-control, overload, soak and renderer tests.
 #pragma once
 
 #include <filesystem>
@@ -16,10 +17,10 @@ namespace beamcast::test {
 
 class LocalServer {
  public:
-  explicit LocalServer(ServerConfig c = {}) {
+  explicit LocalServer(ServerConfig c = {}, RendererFactory renderers = gl_renderer_factory({})) {
     c.port = 0;
     c.assets_dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
-    server_ = std::make_unique<Server>(c, gl_renderer_factory({}));
+    server_ = std::make_unique<Server>(c, std::move(renderers));
     port_ = server_->start();
     thread_ = std::thread([this] { server_->run(false); });
   }

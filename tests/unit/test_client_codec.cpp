@@ -1,5 +1,6 @@
-// The client's pure helpers: base64 (checked against RFC 4648 vectors and by
-// round trips over many lengths and byte values) and HOST:PORT parsing.
+// Pure helpers the client uses: base64 (protocol/base64.hpp; checked against
+// RFC 4648 vectors and by round trips over many lengths and byte values) and
+// HOST:PORT parsing.
 #include <gtest/gtest.h>
 
 #include <cstdint>

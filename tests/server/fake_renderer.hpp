@@ -1,0 +1,56 @@
+// A FrameRenderer without GL for the server's logic tests: each frame is one
+// flat grey at the scene's bit depth, and the next render can be made to fail
+// with a GL error or with another exception. The GL integration tests
+// (test_server.cpp, test_renderer_rebuild.cpp) keep the real renderer.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <stdexcept>
+#include <utility>
+
+#include "render/gl_util.hpp"
+#include "server/render_service.hpp"
+
+namespace beamcast::test {
+
+struct FakeRendererControl {
+  std::atomic<int> created{0};          // renderers the factory has made
+  std::atomic<bool> fail_other{false};  // next render throws std::runtime_error
+  static constexpr std::uint16_t kGrey8 = 100;
+};
+
+class FakeFrameRenderer final : public FrameRenderer {
+ public:
+  explicit FakeFrameRenderer(std::shared_ptr<FakeRendererControl> control)
+      : control_(std::move(control)) {
+    control_->created.fetch_add(1);
+  }
+  std::string description() const override { return "fake renderer (no GL)"; }
+  std::vector<FrameResult> render(const Scene& scene, const std::vector<Camera>& cameras) override {
+    if (std::exchange(fail_gl_next_, false)) throw GlError("fake: injected GL error");
+    if (control_->fail_other.exchange(false)) throw std::runtime_error("fake: not a GL error");
+    std::vector<FrameResult> frames(cameras.size());
+    for (std::size_t i = 0; i < cameras.size(); ++i) {
+      Image& img = frames[i].image;
+      img.width = cameras[i].width;
+      img.height = cameras[i].height;
+      img.bit_depth = scene.output.bit_depth;
+      const std::uint16_t grey = img.bit_depth == 16 ? FakeRendererControl::kGrey8 * 257
+                                                     : FakeRendererControl::kGrey8;
+      img.rgb.assign(3 * static_cast<std::size_t>(img.width) * img.height, grey);
+    }
+    return frames;
+  }
+  void fail_next_render_for_test() override { fail_gl_next_ = true; }
+
+ private:
+  std::shared_ptr<FakeRendererControl> control_;
+  bool fail_gl_next_ = false;
+};
+
+inline RendererFactory fake_renderer_factory(std::shared_ptr<FakeRendererControl> control) {
+  return [control] { return std::make_unique<FakeFrameRenderer>(control); };
+}
+
+}  // namespace beamcast::test
