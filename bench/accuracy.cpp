@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "bench/accuracy_report.hpp"
+#include "protocol/data_dir.hpp"
 #include "render/image.hpp"
 #include "render/reference.hpp"
 #include "render/renderer.hpp"
@@ -237,7 +238,7 @@ int run_accuracy(const AccuracyOptions& opts) {
   namespace fs = std::filesystem;
   const auto start = std::chrono::steady_clock::now();
   const int size = opts.size > 0 ? opts.size : (opts.quick ? 128 : 512);
-  const fs::path examples = fs::path(BEAMCAST_SOURCE_DIR) / "examples";
+  const fs::path examples = find_data_dir("examples");
   std::vector<BenchScene> scenes =
       opts.quick ? quick_scene_set(examples, size) : full_scene_set(examples, size);
   if (!opts.scenes.empty()) {

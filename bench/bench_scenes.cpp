@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "protocol/camera.hpp"
+#include "protocol/check.hpp"
 #include "protocol/scene_json.hpp"
 
 namespace beamcast::bench {
@@ -14,7 +15,7 @@ namespace {
 
 Density builtin(const char* name) {
   Density d;
-  if (!density_from_name(name, &d)) throw std::logic_error(std::string("no density ") + name);
+  BEAMCAST_CHECK(density_from_name(name, &d), std::string("no density ") + name);
   return d;
 }
 

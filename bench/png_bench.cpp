@@ -6,6 +6,7 @@
 
 #include <filesystem>
 
+#include "protocol/data_dir.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
 #include "render/reference.hpp"
@@ -18,7 +19,7 @@ const Image& frame(int which) {
   static Image frames[2];
   if (frames[which].rgb.empty()) {
     const char* names[2] = {"paper_10sets", "beam_occluder"};
-    const auto dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
+    const auto dir = find_data_dir("examples");
     SceneLoadOptions opts;
     opts.assets_dir = dir;
     const Scene scene = load_scene_file(dir / (std::string(names[which]) + ".json"), opts);
@@ -32,7 +33,7 @@ void BM_EncodePng(benchmark::State& state) {
   const int level = static_cast<int>(state.range(1));
   const int filters = static_cast<int>(state.range(2));
   std::size_t bytes = 0;
-  for (auto _ : state) {
+  for ([[maybe_unused]] auto _ : state) {  // the analyzer sees a dead store
     auto png = encode_png(img, level, filters);
     bytes = png.size();
     benchmark::DoNotOptimize(png.data());

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "protocol/data_dir.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
 #include "render/jpeg.hpp"
@@ -39,7 +40,7 @@ constexpr int kPngLevel = 2;
 constexpr int kPngSub = 0x10;
 
 Scene demo_scene() {
-  const auto dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
+  const auto dir = find_data_dir("examples");
   SceneLoadOptions opts;
   opts.assets_dir = dir;
   return load_scene_file(dir / "paper_10sets.json", opts);

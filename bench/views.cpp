@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "client/client.hpp"
+#include "protocol/data_dir.hpp"
 #include "protocol/rigs.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/renderer.hpp"
@@ -167,7 +168,7 @@ Row renderer_run(Renderer& renderer, const Scene& scene, const std::vector<Camer
 }
 
 std::string run_plot(const fs::path& out) {
-  const fs::path script = fs::path(BEAMCAST_SOURCE_DIR) / "bench" / "plot_views.py";
+  const fs::path script = find_data_dir("bench") / "plot_views.py";
   const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" +
                           (out / "views.csv").string() + "' '" + (out / "views.png").string() +
                           "'";
@@ -186,7 +187,7 @@ int run_views(const ViewsOptions& opts) {
   fs::create_directories(opts.out);
 
   // The paper's 10-set scene; K cameras on the orbit through its camera.
-  const fs::path file = fs::path(BEAMCAST_SOURCE_DIR) / "examples" / "paper_10sets.json";
+  const fs::path file = find_data_dir("examples") / "paper_10sets.json";
   std::ifstream in(file);
   json scene_json = json::parse(in);
   scene_json["cameras"][0]["width"] = size;

@@ -12,6 +12,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "protocol/check.hpp"
+
 namespace beamcast::client {
 
 class LatencyHistogram {
@@ -23,6 +25,7 @@ class LatencyHistogram {
   void record_ms(double ms) { record_us(ms <= 0 ? 0 : static_cast<std::uint64_t>(ms * 1000.0)); }
   void record_us(std::uint64_t us) {
     us = std::min<std::uint64_t>(us, (std::uint64_t{1} << kMaxExp) - 1);
+    BEAMCAST_DCHECK(index_of(us) < counts_.size(), "latency bucket out of range");
     ++counts_[index_of(us)];
     ++count_;
     max_us_ = std::max(max_us_, us);

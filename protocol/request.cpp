@@ -1,5 +1,6 @@
 #include "protocol/request.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -9,6 +10,23 @@
 #include "protocol/utf8.hpp"
 
 namespace beamcast {
+
+const std::vector<std::string>& request_methods() {
+  static const std::vector<std::string> kMethods = {
+      "hello", "ping", "render", "scene.put", "scene.update", "scene.delete", "stats"};
+  return kMethods;
+}
+
+bool is_request_method(std::string_view method) {
+  const auto& m = request_methods();
+  return std::find(m.begin(), m.end(), method) != m.end();
+}
+
+std::string request_methods_text() {
+  std::string out;
+  for (const auto& m : request_methods()) out += (out.empty() ? "" : ", ") + m;
+  return out;
+}
 namespace {
 [[noreturn]] void fail(std::string code, std::string path, std::string message) {
   throw ProtocolError(ErrorInfo{std::move(code), std::move(message), std::move(path)});

@@ -19,6 +19,14 @@ namespace beamcast {
 
 inline constexpr int kProtocolVersion = 1;
 
+// The request methods, in PROTOCOL.md's order ("## Methods"): the one list the
+// server's dispatcher (its metrics key and unknown-method error) and hello's
+// "methods" read; tests compare it with PROTOCOL.md and with the dispatcher.
+const std::vector<std::string>& request_methods();
+bool is_request_method(std::string_view method);
+// "hello, ping, ...", for messages.
+std::string request_methods_text();
+
 struct Request {
   nlohmann::json id;  // string or integer, echoed in the response
   std::string method;

@@ -1,5 +1,6 @@
 #include "render/atlas.hpp"
 
+#include "protocol/check.hpp"
 #include "protocol/scene_json.hpp"
 
 #include <algorithm>
@@ -9,14 +10,12 @@
 namespace beamcast {
 
 Atlas make_atlas(const std::vector<const Image*>& frames) {
-  if (frames.empty()) throw std::invalid_argument("make_atlas: no frames");
+  BEAMCAST_CHECK(!frames.empty(), "make_atlas: no frames");
   Atlas a;
   const int k = static_cast<int>(frames.size());
   std::vector<std::pair<int, int>> sizes;
   for (const Image* f : frames) {
-    if (f->bit_depth != frames[0]->bit_depth) {
-      throw std::invalid_argument("make_atlas: frames of different bit depths");
-    }
+    BEAMCAST_CHECK(f->bit_depth == frames[0]->bit_depth, "make_atlas: frames of different bit depths");
     sizes.emplace_back(f->width, f->height);
   }
   const AtlasGrid g = atlas_grid(sizes);  // the grid the server checked against its limits

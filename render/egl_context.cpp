@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "render/gl_debug.hpp"
+
 namespace beamcast {
 namespace {
 
@@ -54,7 +56,8 @@ struct Attempt {
 
 // Initializes `dpy` and creates a 4.5 core context on it, current on this
 // thread. On failure returns an empty Attempt and sets `why`.
-Attempt try_display(EGLDisplay dpy, std::string* why) {
+// `debug`: ask for a debug context (KHR_debug messages), else a plain one if refused.
+Attempt try_display(EGLDisplay dpy, bool debug, std::string* why) {
   if (dpy == EGL_NO_DISPLAY) {
     *why = "no display (" + egl_error_name(eglGetError()) + ")";
     return {};
@@ -84,12 +87,18 @@ Attempt try_display(EGLDisplay dpy, std::string* why) {
     // Some drivers offer no config without a surface type; KHR_no_config_context.
     config = EGL_NO_CONFIG_KHR;
   }
-  const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4,
-                                EGL_CONTEXT_MINOR_VERSION, 5,
-                                EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                EGL_NONE};
+  // clang-format off
+  EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4,
+                          EGL_CONTEXT_MINOR_VERSION, 5,
+                          EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                          EGL_CONTEXT_OPENGL_DEBUG, debug ? EGL_TRUE : EGL_FALSE,
+                          EGL_NONE};
+  // clang-format on
   EGLContext ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, ctx_attribs);
+  if (ctx == EGL_NO_CONTEXT && debug) {
+    ctx_attribs[7] = EGL_FALSE;  // EGL_CONTEXT_OPENGL_DEBUG
+    ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, ctx_attribs);
+  }
   if (ctx == EGL_NO_CONTEXT) return fail("eglCreateContext(OpenGL 4.5 core) failed");
   if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) {
     eglDestroyContext(dpy, ctx);
@@ -123,6 +132,7 @@ std::unique_ptr<EglContext> EglContext::create(const EglOptions& opts) {
   const int device_index =
       opts.device_index >= 0 ? opts.device_index : env_int("BEAMCAST_EGL_DEVICE", -1);
 
+  const bool debug = gl_debug_requested();
   std::vector<std::string> tried;
   Attempt got;
   std::string how;
@@ -151,7 +161,7 @@ std::unique_ptr<EglContext> EglContext::create(const EglOptions& opts) {
         for (int i = first; i <= last && got.display == EGL_NO_DISPLAY; ++i) {
           std::string why;
           got = try_display(get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr),
-                            &why);
+                            debug, &why);
           if (got.display != EGL_NO_DISPLAY) {
             how = "EGL device " + std::to_string(i) + " (EGL_EXT_platform_device)";
           } else {
@@ -167,7 +177,8 @@ std::unique_ptr<EglContext> EglContext::create(const EglOptions& opts) {
     } else {
       std::string why;
       got = try_display(
-          get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr), &why);
+          get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr), debug,
+          &why);
       if (got.display != EGL_NO_DISPLAY) {
         how = "Mesa surfaceless platform";
       } else {
@@ -188,6 +199,7 @@ std::unique_ptr<EglContext> EglContext::create(const EglOptions& opts) {
   const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
   c->gl_renderer_ = renderer ? renderer : "?";
   c->description_ = how + ": " + c->gl_renderer_ + " / OpenGL " + (version ? version : "?");
+  c->gl_debug_ = debug && install_gl_debug_output();
   return c;
 }
 

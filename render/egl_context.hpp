@@ -32,6 +32,8 @@ class EglContext {
   // e.g. "EGL device 0 (EGL_EXT_platform_device): NVIDIA H100 ... / 4.5.0 NVIDIA 550"
   const std::string& description() const { return description_; }
   const std::string& gl_renderer() const { return gl_renderer_; }
+  // A debug context with KHR_debug output installed (render/gl_debug.hpp).
+  bool gl_debug() const { return gl_debug_; }
 
  private:
   EglContext() = default;
@@ -39,6 +41,7 @@ class EglContext {
   void* context_ = nullptr;  // EGLContext
   std::string description_;
   std::string gl_renderer_;
+  bool gl_debug_ = false;
 };
 
 }  // namespace beamcast

@@ -1,7 +1,10 @@
 #include "render/gl_util.hpp"
 
 #include <cstdio>
-#include <sstream>
+#include <cstring>
+
+#include "render/gl_debug.hpp"
+#include "shaders/shader_sources.hpp"
 
 namespace beamcast {
 
@@ -17,18 +20,6 @@ const char* gl_error_name(GLenum e) {
   }
 }
 
-std::string numbered(const std::string& src) {
-  std::ostringstream out;
-  std::istringstream in(src);
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
-    char buf[16];
-    std::snprintf(buf, sizeof buf, "%4d | ", n);
-    out << buf << line << '\n';
-  }
-  return out.str();
-}
-
 GLuint compile_stage(std::string_view program, GLenum stage, const char* stage_name,
                      const std::string& src) {
   GLuint s = glCreateShader(stage);
@@ -42,9 +33,12 @@ GLuint compile_stage(std::string_view program, GLenum stage, const char* stage_n
     glGetShaderiv(s, GL_INFO_LOG_LENGTH, &len);
     std::string log(static_cast<std::size_t>(len > 0 ? len : 1), '\0');
     glGetShaderInfoLog(s, len, nullptr, log.data());
+    log.resize(std::strlen(log.c_str()));  // the terminating NUL would end what()
     glDeleteShader(s);
+    // The log and the listing name each assembled file and its own line numbers.
     throw GlError("compiling " + std::string(stage_name) + " shader of program '" +
-                  std::string(program) + "' failed:\n" + log + "\n" + numbered(src));
+                  std::string(program) + "' failed:\n" + annotate_shader_log(log, src) + "\n" +
+                  numbered_shader_source(src));
   }
   return s;
 }
@@ -52,9 +46,12 @@ GLuint compile_stage(std::string_view program, GLenum stage, const char* stage_n
 
 void gl_check(const char* call) {
   GLenum e = glGetError();
-  if (e == GL_NO_ERROR) return;
-  std::string msg = std::string(call) + ": " + gl_error_name(e);
+  // In a debug context, high-severity KHR_debug messages say what went wrong.
+  const std::string debug = take_gl_debug_errors();
+  if (e == GL_NO_ERROR && debug.empty()) return;
+  std::string msg = std::string(call) + ": " + (e == GL_NO_ERROR ? "" : gl_error_name(e));
   while ((e = glGetError()) != GL_NO_ERROR) msg += std::string(", ") + gl_error_name(e);
+  if (!debug.empty()) msg += " (" + debug + ")";
   throw GlError(msg);
 }
 
@@ -88,6 +85,7 @@ GlProgram build_program(std::string_view name, const std::string& vertex_src,
     glGetProgramiv(prog.get(), GL_INFO_LOG_LENGTH, &len);
     std::string log(static_cast<std::size_t>(len > 0 ? len : 1), '\0');
     glGetProgramInfoLog(prog.get(), len, nullptr, log.data());
+    log.resize(std::strlen(log.c_str()));
     throw GlError("linking program '" + std::string(name) + "' failed:\n" + log);
   }
   gl_check("build_program");

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "protocol/check.hpp"
+
 namespace beamcast {
 
 double tone_curve(ToneCurve curve, double x) {
@@ -249,9 +251,9 @@ Image read_png(const std::filesystem::path& file) {
 // Metrics
 
 HdrError compare_hdr(const HdrImage& img, const HdrImage& ref) {
-  if (img.width != ref.width || img.height != ref.height || img.rgb.size() != ref.rgb.size()) {
-    throw std::invalid_argument("compare_hdr: image sizes differ");
-  }
+  BEAMCAST_CHECK(
+      img.width == ref.width && img.height == ref.height && img.rgb.size() == ref.rgb.size(),
+      "compare_hdr: image sizes differ");
   HdrError e;
   double sum_sq = 0.0;
   double sum_abs = 0.0;
@@ -283,10 +285,9 @@ HdrError compare_hdr(const HdrImage& img, const HdrImage& ref) {
 
 namespace {
 void check_same_layout(const Image& img, const Image& ref, const char* what) {
-  if (img.width != ref.width || img.height != ref.height || img.bit_depth != ref.bit_depth ||
-      img.rgb.size() != ref.rgb.size()) {
-    throw std::invalid_argument(std::string(what) + ": images differ in size or bit depth");
-  }
+  BEAMCAST_CHECK(img.width == ref.width && img.height == ref.height &&
+                     img.bit_depth == ref.bit_depth && img.rgb.size() == ref.rgb.size(),
+                 std::string(what) + ": images differ in size or bit depth");
 }
 }  // namespace
 

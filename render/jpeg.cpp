@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "protocol/check.hpp"
+
 namespace beamcast {
 namespace {
 
@@ -22,7 +24,7 @@ struct TjHandle {
 }  // namespace
 
 std::vector<std::uint8_t> encode_jpeg(const Image& img, int quality) {
-  if (img.width <= 0 || img.height <= 0) throw std::runtime_error("encode_jpeg: empty image");
+  BEAMCAST_CHECK(img.width > 0 && img.height > 0, "encode_jpeg: empty image");
   std::vector<unsigned char> rgb(img.rgb.size());
   const int shift = img.bit_depth == 16 ? 8 : 0;
   for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = static_cast<unsigned char>(img.rgb[i] >> shift);

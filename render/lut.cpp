@@ -64,11 +64,9 @@ struct Row {
     double pts[64];
     std::vector<double> big;
     double* p = pts;
-    std::size_t cap = 64;
-    if (t.size() + 2 > cap) {
+    if (t.size() + 2 > std::size(pts)) {
       big.resize(t.size() + 2);
       p = big.data();
-      cap = big.size();
     }
     std::size_t n = 0;
     p[n++] = lo;

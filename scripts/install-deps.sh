@@ -13,6 +13,7 @@ PACKAGES=(
   libboost-dev libboost-system-dev
   libssl-dev                                          # TLS of the HTTP listener (--tls-cert)
   clang-14 libclang-rt-14-dev                         # libFuzzer targets (fuzz/, --preset fuzz)
+  clang-tidy-14                                       # the clang-tidy stage of scripts/test.sh
   python3 python3-numpy python3-matplotlib            # plots and analysis scripts
   nodejs chromium                                     # the preview page's browser test (ctest -L preview)
 )

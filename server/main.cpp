@@ -8,6 +8,7 @@
 
 #include "protocol/scene_json.hpp"
 #include "protocol/bounded_json.hpp"
+#include "protocol/data_dir.hpp"
 #include "server/demo_scene.hpp"
 #include "server/limits.hpp"
 #include "server/server.hpp"
@@ -15,7 +16,7 @@
 int main(int argc, char** argv) {
   using namespace beamcast;
   ServerConfig c;
-  c.assets_dir = BEAMCAST_DEFAULT_ASSETS;
+  c.assets_dir = find_data_dir("examples");
   c.http_port = 7879;
   std::string assets = c.assets_dir.string();
   bool no_demo = false;

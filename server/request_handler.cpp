@@ -77,7 +77,7 @@ json hello_result(const ServerCore& core, const json& params) {
   return {{"protocol", kProtocolVersion},
           {"server", "beamcast-server 0.1.0"},
           {"renderer", core.renderer_description},
-          {"methods", {"hello", "ping", "render", "scene.put", "scene.update", "scene.delete", "stats"}},
+          {"methods", request_methods()},
           {"capabilities", capabilities},
           {"limits", limits_json(core.config)}};
 }
@@ -369,11 +369,8 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
   std::string method = "(invalid)";  // metrics key: a known method or a fixed placeholder
   try {
     Request req = parse_request(json_text, &id, core.config.json_limits);
-    static const char* kMethods[] = {"hello", "ping", "stats", "render", "scene.put",
-                                     "scene.update", "scene.delete"};
     // Count unknown methods under one key: client-chosen strings must not grow the map.
-    const bool known = std::any_of(std::begin(kMethods), std::end(kMethods),
-                                   [&](const char* m) { return req.method == m; });
+    const bool known = is_request_method(req.method);
     method = known ? req.method : "(unknown)";
     core.stats.count_request(method);
     const json& params = req.params;
@@ -432,8 +429,7 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
       session->send(ok_response(id, {{"deleted", true}}));
     } else {
       fail("unknown_method", "/method",
-           "unknown method \"" + req.method +
-               "\" (hello, ping, render, scene.put, scene.update, scene.delete, stats)");
+           "unknown method \"" + req.method + "\" (" + request_methods_text() + ")");
     }
     if (method != "render") {  // render is counted when its answer is ready
       core.metrics.count_request(method, true);

@@ -164,7 +164,7 @@ TEST(AccuracyController, ExplicitMotionOverridesInference) {
   EXPECT_TRUE(d.moving);
   EXPECT_FALSE(d.still);
   // A different pose but the client says still: full accuracy now.
-  d = c.decide(t += 20.0, pose(1), Motion::kStill);
+  d = c.decide(t + 20.0, pose(1), Motion::kStill);
   EXPECT_TRUE(d.still);
   EXPECT_EQ(d.level, 0);
 }

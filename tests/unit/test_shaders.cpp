@@ -7,7 +7,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "shaders/shader_sources.hpp"
@@ -15,47 +17,71 @@
 namespace beamcast {
 namespace {
 
-struct Stage {
-  std::vector<std::string_view> parts;
-  const char* extension;
-};
-
-// Must match the programs built in render/passes.cpp.
-const std::vector<Stage> kStages = {
-    {{"common.glsl", "surface.vert"}, "vert"},
-    {{"common.glsl", "surface.frag"}, "frag"},
-    {{"common.glsl", "fullscreen.vert"}, "vert"},
-    {{"common.glsl", "analytic_occluder.frag"}, "frag"},
-    {{"common.glsl", "beam.vert"}, "vert"},
-    {{"common.glsl", "beam_math.glsl", "beam.frag"}, "frag"},
-    {{"common.glsl", "tonemap.frag"}, "frag"},
-    // Multi-view variants (one draw, K layers).
-    {{"multiview.glsl", "common.glsl", "surface.vert"}, "vert"},
-    {{"multiview.glsl", "common.glsl", "surface.frag"}, "frag"},
-    {{"multiview.glsl", "common.glsl", "fullscreen.vert"}, "vert"},
-    {{"multiview.glsl", "common.glsl", "analytic_occluder.frag"}, "frag"},
-    {{"multiview.glsl", "common.glsl", "beam.vert"}, "vert"},
-    {{"multiview.glsl", "common.glsl", "beam_math.glsl", "beam.frag"}, "frag"},
-    {{"multiview.glsl", "common.glsl", "tonemap.frag"}, "frag"},
-};
-
-TEST(Shaders, EveryStageCompilesWithGlslangValidator) {
+// Runs glslangValidator on `src` (stage from the file extension of `name`);
+// returns its exit status and output.
+std::pair<int, std::string> validate(const std::string& name, const std::string& src) {
   const std::string validator = GLSLANG_VALIDATOR;
-  ASSERT_FALSE(validator.empty() || validator.ends_with("NOTFOUND"))
-      << "glslangValidator not found at configure time (apt-get install glslang-tools)";
+  if (validator.empty() || validator.ends_with("NOTFOUND")) {
+    return {-1, "glslangValidator not found at configure time (apt-get install glslang-tools)"};
+  }
   const auto dir = std::filesystem::temp_directory_path() / "beamcast_shader_check";
   std::filesystem::create_directories(dir);
-  for (const Stage& stage : kStages) {
-    const std::string name = std::string(stage.parts.front()) + "_" +
-                             std::string(stage.parts.back()) + "." + stage.extension;
-    const auto file = dir / name;
-    std::ofstream(file) << assemble_shader(stage.parts);
-    const std::string cmd = validator + " " + file.string() + " > " + file.string() + ".log 2>&1";
-    const int rc = std::system(cmd.c_str());
-    std::ifstream log(file.string() + ".log");
-    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
-    EXPECT_EQ(rc, 0) << name << ":\n" << text;
+  const auto file = dir / name;
+  std::ofstream(file) << src;
+  const std::string cmd = validator + " " + file.string() + " > " + file.string() + ".log 2>&1";
+  const int rc = std::system(cmd.c_str());
+  std::ifstream log(file.string() + ".log");
+  return {rc, std::string((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>())};
+}
+
+// Every program and variant of shaders/programs.txt (the list the renderer builds).
+TEST(Shaders, EveryStageCompilesWithGlslangValidator) {
+  ASSERT_GE(shader_programs().size(), 8u);
+  for (const ShaderProgramSpec& p : shader_programs()) {
+    for (const auto& [parts, ext] : {std::pair{p.vertex, "vert"}, std::pair{p.fragment, "frag"}}) {
+      const auto [rc, log] = validate(p.name + "." + ext, assemble_shader(parts));
+      EXPECT_EQ(rc, 0) << p.name << "." << ext << ":\n" << log;
+    }
   }
+}
+
+// The manifest names every GLSL file of shaders/ (an unlisted file would be
+// neither embedded nor compiled by the test above).
+TEST(Shaders, ManifestNamesEveryShaderFile) {
+  std::set<std::string> listed;
+  for (const ShaderProgramSpec& p : shader_programs()) {
+    listed.insert(p.vertex.begin(), p.vertex.end());
+    listed.insert(p.fragment.begin(), p.fragment.end());
+  }
+  std::set<std::string> on_disk;
+  for (const auto& e : std::filesystem::directory_iterator(BEAMCAST_SOURCE_DIR "/shaders")) {
+    const auto ext = e.path().extension();
+    if (ext == ".glsl" || ext == ".vert" || ext == ".frag") on_disk.insert(e.path().filename());
+  }
+  EXPECT_EQ(listed, on_disk);
+  EXPECT_EQ(shader_program("beam_multiview").fragment.front(), "multiview.glsl");
+  EXPECT_EQ(shader_program("beam").fragment.back(), "beam.frag");
+}
+
+// A compile error names the file and its own line, in the log and the listing.
+TEST(Shaders, CompileErrorNamesFileAndLine) {
+  const std::string src = assemble_shader_text(
+      {{"common.glsl", shader_text("common.glsl")},
+       {"broken.frag", "out vec4 o;\nvoid main() {\n  o = vec4(undefined_name);\n}"}});
+  const auto [rc, log] = validate("broken.frag", src);
+  ASSERT_NE(rc, 0) << log;
+  // glslang: "ERROR: 1:3: 'undefined_name' : undeclared identifier".
+  const std::string annotated = annotate_shader_log(log, src);
+  EXPECT_NE(annotated.find("ERROR: broken.frag:3:"), std::string::npos) << annotated;
+  // Mesa's and NVIDIA's forms.
+  // Mesa's form (it reports source string 0 for every file) and NVIDIA's.
+  EXPECT_EQ(annotate_shader_log("0:100003(7): error: x\n0(12) : error C1008: y\n", src),
+            "broken.frag:3(7): error: x\ncommon.glsl(12) : error C1008: y\n");
+  const std::string listing = numbered_shader_source(src);
+  EXPECT_NE(listing.find("broken.frag:   3 |   o = vec4(undefined_name);\n"), std::string::npos)
+      << listing;
+  EXPECT_NE(listing.find("common.glsl:   1 | "), std::string::npos) << listing;
+  EXPECT_EQ(listing.find("beamcast-source"), std::string::npos) << listing;
 }
 
 TEST(Shaders, AssembledSourceStartsWithVersion) {

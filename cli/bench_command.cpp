@@ -3,7 +3,7 @@
 
 #include "bench/accuracy.hpp"
 #include "bench/views.hpp"
-#include "client/cli/commands.hpp"
+#include "cli/commands.hpp"
 
 namespace beamcast::cli {
 

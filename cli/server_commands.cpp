@@ -13,7 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "client/cli/commands.hpp"
+#include "cli/commands.hpp"
 #include "client/client.hpp"
 
 namespace beamcast::cli {

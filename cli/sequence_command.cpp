@@ -12,8 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "client/cli/commands.hpp"
-#include "client/cli/progress.hpp"
+#include "cli/commands.hpp"
+#include "cli/progress.hpp"
 #include "client/client.hpp"
 #include "protocol/camera_path.hpp"
 #include "protocol/rigs.hpp"

@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "client/cli/commands.hpp"
+#include "cli/commands.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
 #include "render/pass_plan.hpp"

@@ -4,7 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "client/cli/commands.hpp"
+#include "cli/commands.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"beamcast: render energy-beam scenes headless (offline or through a server)"};

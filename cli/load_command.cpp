@@ -28,10 +28,11 @@
 #include <boost/asio.hpp>
 #include <nlohmann/json.hpp>
 
-#include "client/cli/commands.hpp"
+#include "cli/commands.hpp"
 #include "client/client.hpp"
 #include "client/latency_histogram.hpp"
 #include "protocol/bounded_json.hpp"
+#include "protocol/data_dir.hpp"
 #include "protocol/framing.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
@@ -53,7 +54,7 @@ struct LoadArgs {
   long long requests = 0;  // total; 0: until duration
   double rate = 0;         // requests/s over all connections; 0: closed loop
   int size = 256;
-  std::string scene_file = BEAMCAST_DEMO_SCENE;
+  std::string scene_file = (find_data_dir("examples") / "paper_10sets.json").string();
   std::string poses = "mix";  // fixed, orbit, random, mix
   int cameras = 0;            // cameras per request; 0: mix of 1 and 4
   double verify_fraction = 0.02;
@@ -145,10 +146,10 @@ struct VerifyJob {
 
 class Verifier {
  public:
-  Verifier(Results& r, const json& scene_json, int tolerance)
+  Verifier(Results& r, const json& scene_json, const std::string& scene_file, int tolerance)
       : results_(r), tolerance_(tolerance) {
     SceneLoadOptions opts;
-    opts.assets_dir = std::filesystem::path(BEAMCAST_DEMO_SCENE).parent_path();
+    opts.assets_dir = std::filesystem::path(scene_file).parent_path();
     scene_ = parse_scene(scene_json, opts);
     // Decoding every frame: two threads; reference renders: one (its own GL context).
     for (int i = 0; i < 2; ++i) threads_.emplace_back([this] { decode_loop(); });
@@ -296,7 +297,7 @@ class Load {
       : args(a),
         scene_id(std::move(scene_id)),
         poses(scene_json.at("cameras").at(0), a.size),
-        verifier(results, scene_json, a.tolerance) {}
+        verifier(results, scene_json, a.scene_file, a.tolerance) {}
 
   int run(const client::Endpoint& ep) {
     tcp::resolver resolver(io);
