@@ -142,23 +142,16 @@ GLuint FrameTargets::make_fbo(const PassDecl& pass, int layer) {
 
 namespace {
 
-// A program in its per-camera and its multi-view variant (the latter built on
-// first use; see shaders/multiview*.glsl).
+// A program of shaders/programs.txt in its per-camera and its multi-view
+// variant (the latter built on first use; see shaders/multiview.glsl).
 class ProgramPair {
  public:
-  ProgramPair(std::string name, std::vector<std::string_view> vert,
-              std::vector<std::string_view> frag)
-      : name_(std::move(name)), vert_(std::move(vert)), frag_(std::move(frag)) {
-    single_ = build_program(name_, assemble_shader(vert_), assemble_shader(frag_));
+  explicit ProgramPair(std::string name) : name_(std::move(name)) {
+    single_ = build(shader_program(name_));
   }
   GLuint get(bool multiview) {
     if (!multiview) return single_.get();
-    if (!multi_) {
-      std::vector<std::string_view> v = vert_, f = frag_;
-      v.insert(v.begin(), "multiview.glsl");
-      f.insert(f.begin(), "multiview.glsl");
-      multi_ = build_program(name_ + "_multiview", assemble_shader(v), assemble_shader(f));
-    }
+    if (!multi_) multi_ = build(shader_program(name_ + "_multiview"));
     return multi_.get();
   }
   GLint uniform(bool multiview, const char* name) {
@@ -166,8 +159,10 @@ class ProgramPair {
   }
 
  private:
+  static GlProgram build(const ShaderProgramSpec& spec) {
+    return build_program(spec.name, assemble_shader(spec.vertex), assemble_shader(spec.fragment));
+  }
   std::string name_;
-  std::vector<std::string_view> vert_, frag_;
   GlProgram single_, multi_;
 };
 
@@ -193,9 +188,7 @@ void for_each_view(FrameContext& ctx, const PassDecl& self, ProgramPair& program
 class SurfacePass final : public Pass {
  public:
   SurfacePass()
-      : raster_("surface", {"common.glsl", "surface.vert"}, {"common.glsl", "surface.frag"}),
-        analytic_("analytic_occluder", {"common.glsl", "fullscreen.vert"},
-                  {"common.glsl", "analytic_occluder.frag"}) {}
+      : raster_("surface"), analytic_("analytic_occluder") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
     glEnable(GL_DEPTH_TEST);
@@ -240,8 +233,7 @@ class SurfacePass final : public Pass {
 class BeamPass final : public Pass {
  public:
   BeamPass()
-      : program_("beam", {"common.glsl", "beam.vert"},
-                 {"common.glsl", "beam_math.glsl", "beam.frag"}) {}
+      : program_("beam") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
     glUseProgram(program_.get(multi));
@@ -297,7 +289,7 @@ class BeamPass final : public Pass {
 class TonemapPass final : public Pass {
  public:
   TonemapPass()
-      : program_("tonemap", {"common.glsl", "fullscreen.vert"}, {"common.glsl", "tonemap.frag"}) {}
+      : program_("tonemap") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
     glUseProgram(program_.get(multi));
