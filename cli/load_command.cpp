@@ -34,6 +34,7 @@
 #include "protocol/bounded_json.hpp"
 #include "protocol/data_dir.hpp"
 #include "protocol/framing.hpp"
+#include "protocol/render_response.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
 #include "render/renderer.hpp"
@@ -545,19 +546,26 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
     ++r.errors[code];
     if (busy) r.busy_latency.record_ms(ms);
   } else {
-    const json& res = msg["result"];
-    const json& frames = res["frames"];
+    std::optional<RenderResponse> res;
+    std::string why;
+    try {
+      res = render_response_from_json(msg.value("result", json()), "/result");
+    } catch (const ProtocolError& e) {
+      why = e.what();
+    }
     std::vector<VerifyJob> jobs;
-    bool shape_ok = frames.is_array() && frames.size() == p.cameras.size();
-    for (std::size_t i = 0; shape_ok && i < frames.size(); ++i) {
-      const json& att = frames[i]["attachment"];
-      const std::size_t off = att.value("offset", std::size_t{0}), len = att.value("length", std::size_t{0});
-      if (off + len > binary.size() || len == 0) {
+    bool shape_ok = res && res->frames.size() == p.cameras.size();
+    if (res && !shape_ok) why = "frames do not match the cameras";
+    for (std::size_t i = 0; shape_ok && i < res->frames.size(); ++i) {
+      const std::optional<Attachment>& att = res->frames[i].attachment;
+      if (!att || att->length == 0 || att->offset > binary.size() ||
+          att->length > binary.size() - att->offset) {
         shape_ok = false;
+        why = "frame " + std::to_string(i) + " has no attachment inside the binary section";
         break;
       }
       VerifyJob job;
-      job.png.assign(binary.begin() + off, binary.begin() + off + len);
+      job.png.assign(binary.begin() + att->offset, binary.begin() + att->offset + att->length);
       job.width = p.cameras[i]["width"];
       job.height = p.cameras[i]["height"];
       job.seq = p.seq;
@@ -570,17 +578,17 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
       std::lock_guard lock(r.mu);
       if (!shape_ok) {
         ++r.errors["bad_frames"];
-        note_failure(r, "request " + std::to_string(p.seq) + ": frames do not match the cameras");
+        note_failure(r, "request " + std::to_string(p.seq) + ": " + why);
       } else {
         ++r.ok;
-        r.frames += frames.size();
+        r.frames += res->frames.size();
         r.bytes += kFrameHeaderSize + body_.size();
         r.latency.record_ms(ms);
-        const json& t = res["timings"];
-        r.queue_ms.record_ms(t.value("queue_ms", 0.0));
-        r.render_ms.record_ms(t.value("render_ms", 0.0));
-        r.encode_ms.record_ms(t.value("encode_ms", 0.0));
-        r.server_ms.record_ms(t.value("server_ms", 0.0));
+        const RenderTimings& t = res->timings;
+        r.queue_ms.record_ms(t.queue_ms);
+        r.render_ms.record_ms(t.render_ms);
+        r.encode_ms.record_ms(t.encode_ms);
+        r.server_ms.record_ms(t.server_ms);
       }
     }
     for (auto& j : jobs) load_.verifier.push(std::move(j));

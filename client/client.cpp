@@ -225,61 +225,65 @@ RenderResult Client::render(const RenderRequest& request) {
     out.error = r.error;
     return out;
   }
-  out.frames = decode_frames(r);
-  const nlohmann::json& result = r.result();
-  out.passes = result.value("passes", nlohmann::json::array());
-  out.timings = result.value("timings", nlohmann::json::object());
-  const auto sm = out.timings.find("server_ms");
-  out.server_ms = sm != out.timings.end() && sm->is_number() ? sm->get<double>() : 0.0;
+  const RenderResponse response = read_render_response(r);
+  out.frames = decode_frames(r, response);
+  out.passes = response.passes;
+  out.timings = to_json(response)["timings"];
+  out.server_ms = response.timings.server_ms;
   out.network_ms = out.e2e_ms - out.server_ms;
   return out;
 }
 
-std::vector<RenderedFrame> decode_frames(const Response& response) {
-  std::vector<RenderedFrame> frames;
+RenderResponse read_render_response(const Response& response) {
   try {
-    for (const nlohmann::json& f : response.result().at("frames")) {
-      RenderedFrame fr;
-      fr.camera = f.at("camera").get<std::string>();
-      fr.index = f.value("index", static_cast<int>(frames.size()));
-      fr.width = f.at("width").get<int>();
-      fr.height = f.at("height").get<int>();
-      fr.bit_depth = f.value("bit_depth", 8);
-      if (const auto a = f.find("attachment"); a != f.end()) {
-        const auto offset = a->at("offset").get<std::uint64_t>();
-        const auto length = a->at("length").get<std::uint64_t>();
-        // Compare without adding, so a huge offset cannot wrap around.
-        if (offset > response.binary.size() || length > response.binary.size() - offset) {
-          throw std::runtime_error("frame '" + fr.camera + "': attachment [" +
-                                   std::to_string(offset) + ", +" + std::to_string(length) +
-                                   ") outside the " + std::to_string(response.binary.size()) +
-                                   "-byte binary section");
-        }
-        const auto* begin = response.binary.data() + offset;
-        fr.png.assign(begin, begin + length);
-      } else if (const auto b = f.find("data_base64"); b != f.end()) {
-        try {
-          fr.png = base64_decode(b->get<std::string>());
-        } catch (const std::invalid_argument& e) {
-          throw std::runtime_error("frame '" + fr.camera + "': " + e.what());
-        }
-      } else {
-        throw std::runtime_error("frame '" + fr.camera +
-                                 "' has neither attachment nor data_base64");
-      }
-      // Everything that is not identity or payload is a timing (gpu_ms, pass_ms, ...).
-      fr.timings = nlohmann::json::object();
-      for (const auto& [key, value] : f.items()) {
-        if (key.size() > 3 && key.ends_with("_ms")) fr.timings[key] = value;
-      }
-      frames.push_back(std::move(fr));
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(std::string("malformed render response: ") + e.what());
-  } catch (const std::runtime_error& e) {
+    return render_response_from_json(response.result(), "/result");
+  } catch (const ProtocolError& e) {
     throw std::runtime_error(std::string("malformed render response: ") + e.what());
   }
+}
+
+std::vector<RenderedFrame> decode_frames(const Response& response, const RenderResponse& parsed) {
+  std::vector<RenderedFrame> frames;
+  for (const RenderFrame& f : parsed.frames) {
+    RenderedFrame fr;
+    fr.camera = f.camera;
+    fr.index = static_cast<int>(f.index);
+    fr.width = f.width;
+    fr.height = f.height;
+    fr.bit_depth = f.bit_depth.value_or(8);
+    const std::string what = "malformed render response: frame '" + f.camera + "'";
+    if (f.attachment) {
+      const auto [offset, length] = *f.attachment;
+      // Compare without adding, so a huge offset cannot wrap around.
+      if (offset > response.binary.size() || length > response.binary.size() - offset) {
+        throw std::runtime_error(what + ": attachment [" + std::to_string(offset) + ", +" +
+                                 std::to_string(length) + ") outside the " +
+                                 std::to_string(response.binary.size()) + "-byte binary section");
+      }
+      const auto* begin = response.binary.data() + offset;
+      fr.png.assign(begin, begin + length);
+    } else if (f.data_base64) {
+      try {
+        fr.png = base64_decode(*f.data_base64);
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(what + ": " + e.what());
+      }
+    } else {
+      throw std::runtime_error(what + " has neither attachment nor data_base64");
+    }
+    // The timings as sent (gpu_ms, pass_ms, readback_ms, encode_ms).
+    fr.timings = nlohmann::json::object();
+    const nlohmann::json sent = to_json(f);  // named: items() refers to it
+    for (const auto& [key, value] : sent.items()) {
+      if (key.ends_with("_ms")) fr.timings[key] = value;
+    }
+    frames.push_back(std::move(fr));
+  }
   return frames;
+}
+
+std::vector<RenderedFrame> decode_frames(const Response& response) {
+  return decode_frames(response, read_render_response(response));
 }
 
 }  // namespace beamcast::client

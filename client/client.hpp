@@ -6,7 +6,7 @@
 // std::runtime_error. Requests may be pipelined with send(); responses that
 // arrive for other ids while call()/receive_for() waits are kept for later.
 //
-// Depends on protocol/ (framing, ErrorInfo) only: no GL, no render/.
+// Depends on protocol/ (framing, ErrorInfo, RenderResponse) only: no GL, no render/.
 #pragma once
 
 #include <chrono>
@@ -23,6 +23,7 @@
 
 #include "protocol/base64.hpp"
 #include "protocol/errors.hpp"
+#include "protocol/render_response.hpp"
 
 namespace beamcast::client {
 
@@ -140,7 +141,11 @@ class Client {
   std::deque<Response> kept_;  // received but not yet asked for, in arrival order
 };
 
+// The result of a successful render response, typed; a result that breaks the
+// protocol throws std::runtime_error naming the bad field's pointer.
+RenderResponse read_render_response(const Response& response);
 // Decodes the frames of a successful render response (exposed for tests).
 std::vector<RenderedFrame> decode_frames(const Response& response);
+std::vector<RenderedFrame> decode_frames(const Response& response, const RenderResponse& parsed);
 
 }  // namespace beamcast::client

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 
 #include "protocol/json_reader.hpp"
 
@@ -153,96 +152,88 @@ ErrorInfo with_path_prefix(ErrorInfo e, std::string_view prefix) {
 std::string parse_scene_id(const nlohmann::json& params, const std::string& path) {
   auto it = params.find("scene_id");
   if (it == params.end()) fail("missing_field", path, "scene_id is required");
-  if (!it->is_string()) fail("wrong_type", path, "scene_id must be a string");
-  const auto& id = it->get_ref<const std::string&>();
+  const std::string id = json_read::read_string(json_read::Node{&*it, path});
   bool ok = !id.empty() && id.size() <= 64;
   for (char c : id) ok = ok && valid_id_char(c);
   if (!ok) fail("invalid_value", path, "scene_id must match [A-Za-z0-9_.-]{1,64}");
   return id;
 }
 
-RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits& limits) {
-  RenderParams rp;
-  allow_params(params,
-               {"scene", "scene_id", "cameras", "output", "encoding", "atlas", "quality", "budget_ms",
-                "still_ms", "motion", "interactive_format"},
-               "render");
-  bool automatic = false;
-  if (auto q = params.find("quality"); q != params.end()) {
-    if (!q->is_string() || (*q != "auto" && *q != "full")) {
-      fail("invalid_value", "/params/quality", "quality must be \"auto\" or \"full\"");
-    }
-    automatic = *q == "auto";
+namespace {
+
+// One of `allowed`; anything else, a non-string included, is invalid_value
+// (what these params have always answered), listing the choices.
+std::string read_choice(const json_read::Node& n, std::initializer_list<std::string_view> allowed) {
+  std::string list;
+  std::size_t i = 0;
+  for (std::string_view a : allowed) {
+    if (n.json().is_string() && n.json().get_ref<const std::string&>() == a) return std::string(a);
+    list += (i == 0 ? "" : i + 1 == allowed.size() ? " or " : ", ") + ('"' + std::string(a) + '"');
+    ++i;
   }
+  fail("invalid_value", n.path, n.name() + " must be " + list);
+}
+
+// The value at `n`, which must be an object (wrong_type naming `what`).
+const nlohmann::json& object_at(const json_read::Node& n, std::string_view what) {
+  const json_read::ObjectReader is_object(n, what);
+  return n.json();
+}
+
+}  // namespace
+
+RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits& limits) {
+  using json_read::check_closed, json_read::Node, json_read::ObjectReader, json_read::read_array,
+      json_read::read_bool, json_read::read_number;
+  static constexpr std::string_view kKeys[] = {
+      "scene",   "scene_id",  "cameras",  "output", "encoding",          "atlas",
+      "quality", "budget_ms", "still_ms", "motion", "interactive_format"};
+  const ObjectReader r(Node{&params, "/params"}, "render params");
+  r.allow_only(kKeys);
+  RenderParams rp;
+  const auto quality = r.optional("quality");
+  const bool automatic = quality && read_choice(*quality, {"auto", "full"}) == "auto";
   for (const char* key : {"budget_ms", "still_ms", "motion", "interactive_format"}) {
-    if (params.contains(key) && !automatic) {
-      fail("invalid_value", std::string("/params/") + key,
+    if (r.optional(key) && !automatic) {
+      fail("invalid_value", r.path_of(key),
            std::string(key) + " applies only with \"quality\": \"auto\"");
     }
   }
   if (automatic) {
     QualityParams qp;
-    auto number = [&](const char* key, double lo, double hi, double* out) {
-      auto it = params.find(key);
-      if (it == params.end()) return;
-      const std::string path = std::string("/params/") + key;
-      if (!it->is_number()) fail("wrong_type", path, std::string(key) + " must be a number");
-      const double v = it->get<double>();
-      if (!(v >= lo && v <= hi)) {
-        char range[64];
-        std::snprintf(range, sizeof range, " must be in [%g, %g]", lo, hi);
-        fail("out_of_range", path, std::string(key) + range);
-      }
-      *out = v;
-    };
-    number("budget_ms", 1.0, 10000.0, &qp.budget_ms);
-    number("still_ms", 0.0, 60000.0, &qp.still_ms);
-    if (auto m = params.find("motion"); m != params.end()) {
-      if (!m->is_string() || (*m != "infer" && *m != "moving" && *m != "still")) {
-        fail("invalid_value", "/params/motion", "motion must be \"infer\", \"moving\" or \"still\"");
-      }
-      qp.motion = m->get<std::string>();
+    if (auto n = r.optional("budget_ms")) {
+      qp.budget_ms = check_closed(*n, read_number(*n), 1.0, 10000.0);
     }
-    if (auto f = params.find("interactive_format"); f != params.end()) {
-      if (!f->is_string() || (*f != "jpeg" && *f != "png")) {
-        fail("invalid_value", "/params/interactive_format",
-             "interactive_format must be \"jpeg\" or \"png\"");
-      }
-      qp.jpeg = *f == "jpeg";
+    if (auto n = r.optional("still_ms")) {
+      qp.still_ms = check_closed(*n, read_number(*n), 0.0, 60000.0);
+    }
+    if (auto n = r.optional("motion")) qp.motion = read_choice(*n, {"infer", "moving", "still"});
+    if (auto n = r.optional("interactive_format")) {
+      qp.jpeg = read_choice(*n, {"jpeg", "png"}) == "jpeg";
     }
     rp.quality = qp;
   }
-  const bool has_scene = params.contains("scene");
-  const bool has_id = params.contains("scene_id");
-  if (has_scene == has_id) {
-    fail(has_scene ? "conflicting_fields" : "missing_field", "/params",
+  const auto scene = r.optional("scene");
+  const auto scene_id = r.optional("scene_id");
+  if (scene.has_value() == scene_id.has_value()) {
+    fail(scene ? "conflicting_fields" : "missing_field", "/params",
          "render needs exactly one of \"scene\" (inline) and \"scene_id\" (stored)");
   }
-  if (has_scene) {
-    if (!params["scene"].is_object()) fail("wrong_type", "/params/scene", "scene must be an object");
-    rp.scene = params["scene"];
+  if (scene) {
+    rp.scene = object_at(*scene, "scene");  // parsed by the caller
   } else {
-    rp.scene_id = parse_scene_id(params, "/params/scene_id");
+    rp.scene_id = parse_scene_id(params, scene_id->path);
   }
-  if (auto c = params.find("cameras"); c != params.end()) {
-    if (!c->is_array()) fail("wrong_type", "/params/cameras", "cameras must be an array");
-    if (c->empty()) fail("invalid_value", "/params/cameras", "cameras must not be empty");
-    std::vector<Camera> cams = parse_camera_list(*c, "/params/cameras", limits);
-    rp.cameras = std::move(cams);
+  if (auto c = r.optional("cameras")) {
+    if (read_array(*c).empty()) fail("invalid_value", c->path, "cameras must not be empty");
+    rp.cameras = parse_camera_list(c->json(), c->path, limits);
   }
-  if (auto o = params.find("output"); o != params.end()) {
-    if (!o->is_object()) fail("wrong_type", "/params/output", "output must be an object");
-    rp.output = *o;
+  if (auto o = r.optional("output")) {
+    rp.output = object_at(*o, "output");  // merged over the scene's by the caller
   }
-  if (auto a = params.find("atlas"); a != params.end()) {
-    if (!a->is_boolean()) fail("wrong_type", "/params/atlas", "atlas must be true or false");
-    rp.atlas = a->get<bool>();
-  }
-  if (auto e = params.find("encoding"); e != params.end()) {
-    if (!e->is_string() || (*e != "binary" && *e != "base64")) {
-      fail("invalid_value", "/params/encoding", "encoding must be \"binary\" or \"base64\"");
-    }
-    rp.base64 = *e == "base64";
+  if (auto a = r.optional("atlas")) rp.atlas = read_bool(*a);
+  if (auto e = r.optional("encoding")) {
+    rp.base64 = read_choice(*e, {"binary", "base64"}) == "base64";
   }
   return rp;
 }

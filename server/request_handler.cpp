@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "protocol/base64.hpp"
 #include "protocol/request.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/pass_plan.hpp"
@@ -11,6 +10,7 @@
 #include "server/limits.hpp"
 #include "server/session.hpp"
 #include "server/accuracy_controller.hpp"
+#include "server/render_result.hpp"
 #include "server/connection.hpp"
 
 namespace beamcast {
@@ -113,10 +113,6 @@ json store_scene(ServerCore& core, const std::string& id, json scene_json, Scene
   return {{"scene_id", id}, {"bytes", bytes}, {"evicted", evicted}};
 }
 
-json frame_name(const Camera& cam, std::size_t i) {
-  return cam.name.empty() ? "camera_" + std::to_string(i) : cam.name;
-}
-
 void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session, const json& id,
                    const json& params, Clock::time_point arrived) {
   const RenderParams rp = parse_render_params(params, core.config.scene_limits);
@@ -208,10 +204,14 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   // Only an unmodified stored scene at full quality may share a render with
   // other requests (a batch renders with one set of options).
   if (stored && !rp.output && !decision) job.batch_key = stored.get();
-  job.done = [&core, session, id, cameras, arrived, base64 = rp.base64,
-              passes = plan_passes(*scene), bit_depth = scene->output.bit_depth, decision, level,
-              ladder_size, budget_ms, jpeg = job.jpeg, jpeg_quality = job.jpeg_quality](
-                 RenderOutcome&& out) {
+  RenderResultContext ctx;
+  ctx.cameras = cameras;
+  ctx.planned_passes = plan_passes(*scene);
+  ctx.bit_depth = scene->output.bit_depth;
+  ctx.base64 = rp.base64;
+  job.done = [&core, session, id, arrived, ctx = std::move(ctx), decision, level, ladder_size,
+              budget_ms, jpeg = job.jpeg, jpeg_quality = job.jpeg_quality](
+                 RenderOutcome&& out) mutable {
     session->end_render();
     if (out.dropped) return;
     if (out.error) {
@@ -220,7 +220,6 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
       session->send_error(id, *out.error);
       return;
     }
-    json quality;
     if (decision) {
       // What this frame cost the server: rendering (with read-back) and encoding.
       const double frame_ms = out.render_ms + out.encode_wall_ms;
@@ -231,101 +230,12 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
           st.controller->observe(decision->level, frame_ms, steady_ms(Clock::now()));
         }
       }
-      const RenderSettings& r = level.render;
-      quality = {{"mode", "auto"},
-                 {"level", decision->level},
-                 {"levels", ladder_size},
-                 {"label", level.label},
-                 {"reason", decision->reason},
-                 {"still", decision->still},
-                 {"moving", decision->moving},
-                 {"scale", decision->still ? 1.0 : level.scale},
-                 {"method", r.method == IntegrationMethod::kTable        ? "table"
-                            : r.method == IntegrationMethod::kClosedForm ? "closed_form"
-                                                                         : "march"},
-                 {"table", {r.table_d, r.table_s}},
-                 {"samples", r.samples},
-                 {"format", jpeg ? "jpeg" : "png"},
-                 {"budget_ms", budget_ms},
-                 {"estimate_ms", decision->estimate_ms},
-                 {"frame_ms", frame_ms}};
-      if (jpeg) quality["jpeg_quality"] = jpeg_quality;
+      ctx.quality =
+          quality_report(*decision, level, ladder_size, budget_ms, jpeg, jpeg_quality, frame_ms);
     }
-    json frames = json::array();
+    ctx.server_ms = ms_since(arrived);
     std::vector<std::uint8_t> binary;
-    double readback_ms = 0.0;
-    auto attach = [&](json& f, const std::vector<std::uint8_t>& png) {
-      if (base64) {
-        f["data_base64"] = base64_encode(png);
-      } else {
-        f["attachment"] = {{"offset", binary.size()}, {"length", png.size()}};
-        binary.insert(binary.end(), png.begin(), png.end());
-      }
-    };
-    for (std::size_t i = 0; i < out.frames.size(); ++i) {
-      const FrameResult& fr = out.frames[i];
-      json pass_ms = json::object();
-      for (const PassTiming& p : fr.passes) pass_ms[p.name] = p.gpu_ms;
-      json f = {{"camera", frame_name(cameras[i], i)},
-                {"index", i},
-                {"width", cameras[i].width},
-                {"height", cameras[i].height},
-                {"gpu_ms", fr.gpu_ms},
-                {"pass_ms", pass_ms},
-                {"readback_ms", fr.readback_ms},
-                {"gpu_batch",
-                 {{"index", fr.batch.index},
-                  {"views", fr.batch.views},
-                  {"gpu_ms", fr.batch.gpu_ms},
-                  {"readback_ms", fr.batch.readback_ms}}}};
-      readback_ms += fr.readback_ms;
-      if (out.atlas) {
-        const AtlasTile& t = out.atlas->tiles[i];
-        f["x"] = t.x;
-        f["y"] = t.y;
-      } else {
-        f["format"] = out.is_jpeg[i] ? "jpeg" : "png";
-        f["bit_depth"] = out.is_jpeg[i] ? 8 : bit_depth;  // JPEG has 8 bits per channel
-        f["encode_ms"] = out.encode_ms[i];
-        attach(f, out.pngs[i]);
-      }
-      frames.push_back(std::move(f));
-    }
-    std::vector<std::string> frame_passes = passes;
-    if (!out.frames.empty()) {
-      frame_passes.clear();
-      for (const PassTiming& p : out.frames[0].passes) frame_passes.push_back(p.name);
-    }
-    if (out.atlas) {
-      // One image; the frames become its tiles.
-      const Atlas& a = *out.atlas;
-      json f = {{"camera", "atlas"},
-                {"index", 0},
-                {"width", a.columns * a.cell_width},
-                {"height", a.rows * a.cell_height},
-                {"format", out.is_jpeg[0] ? "jpeg" : "png"},
-                {"bit_depth", out.is_jpeg[0] ? 8 : bit_depth},
-                {"encode_ms", out.encode_ms[0]},
-                {"atlas",
-                 {{"columns", a.columns},
-                  {"rows", a.rows},
-                  {"cell_width", a.cell_width},
-                  {"cell_height", a.cell_height},
-                  {"tiles", std::move(frames)}}}};
-      attach(f, out.pngs[0]);
-      frames = json::array({std::move(f)});
-    }
-    json result = {{"passes", frame_passes},
-                   {"batched", out.batched_requests > 1},
-                   {"batch", {{"requests", out.batched_requests}, {"views", out.batched_views}}},
-                   {"frames", std::move(frames)},
-                   {"timings",
-                    {{"queue_ms", out.queue_ms},
-                     {"render_ms", out.render_ms},
-                     {"readback_ms", readback_ms},
-                     {"encode_ms", out.encode_wall_ms},
-                     {"server_ms", ms_since(arrived)}}}};
-    if (decision) result["quality"] = std::move(quality);
+    json result = to_json(build_render_response(out, ctx, &binary));
     core.stats.count_frames(out.frames.size());
     core.metrics.count_request("render", true);
     core.metrics.observe(Metrics::kQueue, out.queue_ms);

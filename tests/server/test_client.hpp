@@ -11,10 +11,13 @@
 #include <boost/asio/write.hpp>
 #include <nlohmann/json.hpp>
 
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "protocol/framing.hpp"
+#include "protocol/render_response.hpp"
 
 namespace beamcast::test {
 
@@ -22,6 +25,24 @@ struct Reply {
   nlohmann::json json;
   std::vector<std::uint8_t> binary;
 };
+
+// The typed result of a successful render reply (throws ProtocolError naming
+// the bad field if the server broke the format).
+inline RenderResponse render_result(const Reply& r) {
+  return render_response_from_json(r.json.at("result"), "/result");
+}
+
+// The encoded image of frame `i` of a render reply with attachments.
+inline std::vector<std::uint8_t> frame_bytes(const Reply& r, std::size_t i = 0) {
+  const RenderResponse res = render_result(r);
+  const std::optional<Attachment> att = res.frames.at(i).attachment;
+  if (!att || att->offset > r.binary.size() || att->length > r.binary.size() - att->offset) {
+    throw std::runtime_error("frame " + std::to_string(i) +
+                             " has no attachment in the binary part");
+  }
+  const auto begin = r.binary.begin() + static_cast<std::ptrdiff_t>(att->offset);
+  return {begin, begin + static_cast<std::ptrdiff_t>(att->length)};
+}
 
 class Conn {
  public:

@@ -21,9 +21,7 @@ json render_req(int id) {
 // The frame's PNG decoded: the fake's flat grey.
 void expect_fake_frame(const test::Reply& r) {
   ASSERT_TRUE(r.json.value("ok", false)) << r.json;
-  const json& att = r.json.at("result").at("frames").at(0).at("attachment");
-  const std::size_t off = att.at("offset"), len = att.at("length");
-  const Image img = decode_png({r.binary.begin() + off, r.binary.begin() + off + len});
+  const Image img = decode_png(test::frame_bytes(r));
   ASSERT_EQ(img.width, 24);
   ASSERT_EQ(img.height, 24);
   for (std::uint16_t v : img.rgb) ASSERT_EQ(v, test::FakeRendererControl::kGrey8);

@@ -27,12 +27,7 @@ json render_req(const json& id) {
   return {{"id", id}, {"method", "render"}, {"params", {{"scene", occluder_scene()}}}};
 }
 
-// The PNG bytes of a render response's only frame.
-std::vector<std::uint8_t> frame_bytes(const test::Reply& r) {
-  const json& att = r.json.at("result").at("frames").at(0).at("attachment");
-  const std::size_t off = att.at("offset"), len = att.at("length");
-  return {r.binary.begin() + off, r.binary.begin() + off + len};
-}
+using test::frame_bytes;
 
 TEST(RendererRebuild, GlErrorAnswersInternalAndTheNextFramesMatchAFreshServer) {
   std::vector<std::uint8_t> reference;

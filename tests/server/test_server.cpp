@@ -9,6 +9,7 @@
 #include <set>
 #include <thread>
 
+#include "protocol/base64.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
 #include "render/pass_plan.hpp"
@@ -70,11 +71,7 @@ class TestServer {
   std::thread thread_;
 };
 
-Image frame_png(const Reply& r, std::size_t i) {
-  const json& att = r.json.at("result").at("frames").at(i).at("attachment");
-  const std::size_t off = att.at("offset"), len = att.at("length");
-  return decode_png(std::vector<std::uint8_t>(r.binary.begin() + off, r.binary.begin() + off + len));
-}
+Image frame_png(const Reply& r, std::size_t i) { return decode_png(test::frame_bytes(r, i)); }
 
 TEST(Server, HelloReportsProtocolCapabilitiesAndLimits) {
   TestServer s;
@@ -140,11 +137,11 @@ TEST(Server, MultiCameraRequestReturnsEveryFrame) {
   const json scene = read_example("multi_camera");
   const Reply r = c.call(render_req(7, scene));
   ASSERT_TRUE(r.json["ok"]) << r.json;
-  const json& frames = r.json["result"]["frames"];
+  const std::vector<RenderFrame> frames = test::render_result(r).frames;
   ASSERT_EQ(frames.size(), scene["cameras"].size());
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const Image img = frame_png(r, i);
-    EXPECT_EQ(frames[i]["camera"], scene["cameras"][i]["name"]);
+    EXPECT_EQ(frames[i].camera, scene["cameras"][i]["name"]);
     EXPECT_EQ(img.width, scene["cameras"][i]["width"]);
     EXPECT_EQ(img.height, scene["cameras"][i]["height"]);
     EXPECT_EQ(img.bit_depth, 16);
@@ -160,13 +157,13 @@ TEST(Server, Base64EncodingCarriesTheSamePng) {
   const Reply b64 = c.call(req);
   ASSERT_TRUE(b64.json["ok"]) << b64.json;
   EXPECT_TRUE(b64.binary.empty());
-  const std::string text = b64.json["result"]["frames"][0]["data_base64"];
-  const json& att = bin.json["result"]["frames"][0]["attachment"];
-  const std::vector<std::uint8_t> png(bin.binary.begin() + att["offset"].get<std::size_t>(),
-                                      bin.binary.begin() + att["offset"].get<std::size_t>() +
-                                          att["length"].get<std::size_t>());
-  EXPECT_EQ(text.size(), (png.size() + 2) / 3 * 4);
+  const RenderFrame f = test::render_result(b64).frames.at(0);
+  ASSERT_TRUE(f.data_base64);
+  EXPECT_FALSE(f.attachment);
+  const std::string& text = *f.data_base64;
   EXPECT_EQ(text.substr(0, 8), "iVBORw0K");  // base64 of the PNG signature
+  // The same scene, the same encoder: the same bytes either way.
+  EXPECT_EQ(base64_decode(text), test::frame_bytes(bin));
 }
 
 TEST(Server, StoredScenesPutUpdateRenderDeleteAndEvict) {
@@ -473,12 +470,13 @@ TEST(Server, BatchWindowMergesViewersOfOneStoredScene) {
     const Reply r = viewers[i]->recv();
     ASSERT_TRUE(r.json["ok"]) << r.json;
     EXPECT_EQ(r.json["id"], i);
-    const json& res = r.json["result"];
-    EXPECT_EQ(res["batched"], true);
-    EXPECT_EQ(res["batch"]["requests"], 3);
-    EXPECT_EQ(res["batch"]["views"], 3);
-    ASSERT_EQ(res["frames"].size(), 1u);
-    EXPECT_EQ(res["frames"][0]["gpu_batch"]["views"], 3);  // one multi-view pass
+    const RenderResponse res = test::render_result(r);
+    EXPECT_TRUE(res.batched);
+    EXPECT_EQ(res.batch_requests, 3);
+    EXPECT_EQ(res.batch_views, 3);
+    ASSERT_EQ(res.frames.size(), 1u);
+    ASSERT_TRUE(res.frames[0].gpu_batch);
+    EXPECT_EQ(res.frames[0].gpu_batch->views, 3);  // one multi-view pass
     scene.cameras = {parse_camera(poses[i], "", SceneLimits{})};
     const auto alone = offline.render(scene);
     EXPECT_EQ(compare_levels(frame_png(r, 0), alone[0].image).max_abs, 0) << "viewer " << i;

@@ -64,9 +64,7 @@ double settled_rss_mib() {
 }
 
 Image frame_image(const test::Reply& r, std::size_t i) {
-  const json& att = r.json.at("result").at("frames").at(i).at("attachment");
-  const std::size_t off = att.at("offset"), len = att.at("length");
-  return decode_png(std::vector<std::uint8_t>(r.binary.begin() + off, r.binary.begin() + off + len));
+  return decode_png(test::frame_bytes(r, i));
 }
 
 bool same_image(const Image& a, const Image& b) {

@@ -151,7 +151,14 @@ TEST(ClientLoopback, RenderDecodesAttachmentsAndBase64) {
            {"result",
             {{"passes", {"beams", "tonemap"}},
              {"frames", frames},
-             {"timings", {{"queue_ms", 0.1}, {"server_ms", 2.5}}}}}},
+             {"batched", false},
+             {"batch", {{"requests", 1}, {"views", 2}}},
+             {"timings",
+              {{"queue_ms", 0.1},
+               {"render_ms", 1.0},
+               {"readback_ms", 0.2},
+               {"encode_ms", 0.5},
+               {"server_ms", 2.5}}}}}},
           binary);
   });
   Client c;
@@ -203,20 +210,6 @@ TEST(ClientLoopback, NullIdErrorReachesTheWaitingCall) {
   EXPECT_EQ(r.error.code, "busy");
 }
 
-TEST(ClientLoopback, AttachmentOutsideTheBinaryPartThrows) {
-  FakePeer peer([](int fd) {
-    const json req = read_request(fd);
-    const json frame = {{"camera", "v"},
-                        {"width", 1},
-                        {"height", 1},
-                        {"attachment", {{"offset", 1}, {"length", 4}}}};
-    reply(fd, {{"id", req["id"]}, {"ok", true}, {"result", {{"frames", {frame}}}}}, {1, 2, 3, 4});
-  });
-  Client c;
-  c.connect("127.0.0.1", peer.port());
-  EXPECT_THROW(c.render(stored("demo")), std::runtime_error);
-}
-
 // Runs `fn`, expecting std::runtime_error whose message contains `needle`.
 void expect_transport_error(const std::function<void()>& fn, const std::string& needle) {
   try {
@@ -225,6 +218,42 @@ void expect_transport_error(const std::function<void()>& fn, const std::string& 
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
   }
+}
+
+TEST(ClientLoopback, AttachmentOutsideTheBinaryPartThrows) {
+  FakePeer peer([](int fd) {
+    const json req = read_request(fd);
+    const json frame = {{"camera", "v"},
+                        {"index", 0},
+                        {"width", 1},
+                        {"height", 1},
+                        {"attachment", {{"offset", 1}, {"length", 4}}}};
+    const json timings = {{"queue_ms", 0}, {"render_ms", 0}, {"readback_ms", 0},
+                          {"encode_ms", 0}, {"server_ms", 0}};
+    reply(fd,
+          {{"id", req["id"]},
+           {"ok", true},
+           {"result",
+            {{"passes", json::array()},
+             {"frames", {frame}},
+             {"batched", false},
+             {"batch", {{"requests", 1}, {"views", 1}}},
+             {"timings", timings}}}},
+          {1, 2, 3, 4});
+  });
+  Client c;
+  c.connect("127.0.0.1", peer.port());
+  expect_transport_error([&] { c.render(stored("demo")); }, "outside the 4-byte binary section");
+}
+
+TEST(ClientLoopback, MalformedRenderResultNamesTheField) {
+  FakePeer peer([](int fd) {
+    const json req = read_request(fd);
+    reply(fd, {{"id", req["id"]}, {"ok", true}, {"result", {{"frames", json::array()}}}});
+  });
+  Client c;
+  c.connect("127.0.0.1", peer.port());
+  expect_transport_error([&] { c.render(stored("demo")); }, "/result/passes: required field");
 }
 
 TEST(ClientLoopback, ReceiveTimesOut) {

@@ -66,5 +66,36 @@ TEST(RenderParams, BadQualityParamsNameTheirPath) {
   EXPECT_EQ(e.path, "/params/budget_ms");
 }
 
+// The other render params: code and pointer of each bad value (read with the
+// scene parser's ObjectReader).
+TEST(RenderParams, BadParamsNameTheirPath) {
+  const struct {
+    json params;
+    const char* code;
+    const char* path;
+  } cases[] = {
+      {{{"scene", 5}}, "wrong_type", "/params/scene"},
+      {{{"scene_id", 5}}, "wrong_type", "/params/scene_id"},
+      {{{"scene_id", "a b"}}, "invalid_value", "/params/scene_id"},
+      {json::object(), "missing_field", "/params"},
+      {{{"scene_id", "demo"}, {"scene", json::object()}}, "conflicting_fields", "/params"},
+      {{{"scene_id", "demo"}, {"cameras", json::array()}}, "invalid_value", "/params/cameras"},
+      {{{"scene_id", "demo"}, {"cameras", json::object()}}, "wrong_type", "/params/cameras"},
+      {{{"scene_id", "demo"}, {"output", "bright"}}, "wrong_type", "/params/output"},
+      {{{"scene_id", "demo"}, {"atlas", "yes"}}, "wrong_type", "/params/atlas"},
+      {{{"scene_id", "demo"}, {"encoding", 1}}, "invalid_value", "/params/encoding"},
+      {{{"scene_id", "demo"}, {"sceen", 1}}, "unknown_field", "/params/sceen"},
+  };
+  for (const auto& c : cases) {
+    const ErrorInfo e = error_of(c.params);
+    EXPECT_EQ(e.code, c.code) << c.params.dump() << ": " << e.message;
+    EXPECT_EQ(e.path, c.path) << c.params.dump() << ": " << e.message;
+  }
+  EXPECT_EQ(error_of({{"scene_id", "demo"}, {"encoding", "hex"}}).message,
+            "encoding must be \"binary\" or \"base64\"");
+  EXPECT_TRUE(parse_render_params({{"scene_id", "demo"}, {"encoding", "base64"}}, SceneLimits{})
+                  .base64);
+}
+
 }  // namespace
 }  // namespace beamcast
