@@ -1,6 +1,8 @@
 #include "protocol/render_response.hpp"
 
+#include <algorithm>
 #include <limits>
+#include <tuple>
 
 #include "protocol/json_reader.hpp"
 
@@ -9,7 +11,20 @@ namespace beamcast {
 using json = nlohmann::json;
 using namespace json_read;
 
-bool RenderAtlas::operator==(const RenderAtlas&) const = default;
+bool RenderAtlas::operator==(const RenderAtlas& o) const {
+  return std::tie(columns, rows, cell_width, cell_height) ==
+             std::tie(o.columns, o.rows, o.cell_width, o.cell_height) &&
+         tiles.size() == o.tiles.size() && std::equal(tiles.begin(), tiles.end(), o.tiles.begin());
+}
+
+bool RenderFrame::operator==(const RenderFrame& o) const {
+  return std::tie(camera, index, width, height, gpu_ms, pass_ms, readback_ms, gpu_batch, x, y,
+                  format, bit_depth, encode_ms, attachment, data_base64) ==
+             std::tie(o.camera, o.index, o.width, o.height, o.gpu_ms, o.pass_ms, o.readback_ms,
+                      o.gpu_batch, o.x, o.y, o.format, o.bit_depth, o.encode_ms, o.attachment,
+                      o.data_base64) &&
+         atlas.has_value() == o.atlas.has_value() && (!atlas || *atlas == *o.atlas);
+}
 
 // --- writing ---
 

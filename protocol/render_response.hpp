@@ -64,7 +64,9 @@ struct RenderFrame {
   std::optional<Attachment> attachment;    // "encoding": "binary"
   std::optional<std::string> data_base64;  // "encoding": "base64"
   std::optional<RenderAtlas> atlas;        // the atlas frame only
-  bool operator==(const RenderFrame&) const = default;
+  // Written out (render_response.cpp): clang 14 crashes defaulting the
+  // comparisons of these two mutually recursive types.
+  bool operator==(const RenderFrame&) const;
 };
 
 // "quality": "auto" only: the accuracy controller's choice for this frame.
