@@ -12,7 +12,6 @@ Vec3 read_point(const Node& n, const SceneLimits& limits) {
   return check_coordinates(n, read_vec3(n), limits.max_abs_coordinate);
 }
 
-// A length: > 0, finite, at most max_abs_coordinate.
 double read_size(const Node& n, const SceneLimits& limits) {
   const double v = check_positive(n, read_number(n));
   if (v > limits.max_abs_coordinate) {
@@ -23,13 +22,11 @@ double read_size(const Node& n, const SceneLimits& limits) {
   return v;
 }
 
-// True if normalize(v) is finite: nonzero, and not so tiny (denormal) that 1/|v| overflows.
 bool normalizable(const Vec3& v) {
   const double len = length(v);
   return len > 0.0 && std::isfinite(len) && std::isfinite(1.0 / len);
 }
 
-// A direction: finite, not the zero vector (need not be unit).
 Vec3 read_direction(const Node& n) {
   const Vec3 v = read_vec3(n);
   if (!normalizable(v)) {
@@ -54,7 +51,6 @@ Color read_albedo(const Node& n) {
   return c;
 }
 
-// [w, x, y, z] with finite nonzero norm, returned normalized.
 std::array<double, 4> read_quaternion(const Node& n) {
   auto q = read_numbers<4>(n);
   const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);

@@ -51,6 +51,7 @@ MeshOccluder MeshOccluder::parse(const OccluderParse& in) {
 }
 
 Aabb MeshOccluder::bounds() const {
+  if (!box.empty()) return box;  // set by parse
   Aabb b;
   for (const Vec3& v : vertices) b.grow(v);
   return b;
