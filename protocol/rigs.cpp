@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <limits>
+#include <variant>
 
 #include "protocol/camera.hpp"
 #include "protocol/errors.hpp"
@@ -99,24 +100,11 @@ namespace {
 // Centre of the beams' bounding box (spheres: centres; capsules: both ends).
 std::optional<Vec3> beams_centre(const Scene& scene) {
   if (scene.beams.empty()) return std::nullopt;
-  Vec3 lo{}, hi{};
-  bool first = true;
-  auto grow = [&](const Vec3& p) {
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = first ? p[k] : std::min(lo[k], p[k]);
-      hi[k] = first ? p[k] : std::max(hi[k], p[k]);
-    }
-    first = false;
-  };
+  Aabb box;
   for (const Beam& b : scene.beams) {
-    if (const auto* s = std::get_if<SphereBeam>(&b.shape)) {
-      grow(s->center);
-    } else {
-      grow(std::get<CapsuleBeam>(b.shape).p0);
-      grow(std::get<CapsuleBeam>(b.shape).p1);
-    }
+    box.grow(std::visit([](const auto& shape) { return shape.defining_bounds(); }, b.shape));
   }
-  return 0.5 * (lo + hi);
+  return box.centre();
 }
 
 // The integer after "name:" (or `fallback` without one).

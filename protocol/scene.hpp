@@ -1,8 +1,8 @@
 // Scene model: what a client describes. Pure data, no GL, no sockets.
 // Every later scene element (lights, media, SLIM surfaces, volumes) is a new
 // member here and a new pass in render/, never a change to the existing ones;
-// a new occluder kind is a module in protocol/occluders/ (docs/architecture.md,
-// "Adding a scene element").
+// a new occluder or beam kind is a module in protocol/occluders/ or
+// protocol/beams/ (docs/architecture.md, "Adding a scene element").
 #pragma once
 
 #include <array>
@@ -12,6 +12,7 @@
 #include <variant>
 #include <vector>
 
+#include "protocol/beams/beams.hpp"
 #include "protocol/density.hpp"
 #include "protocol/occluders/occluders.hpp"
 #include "protocol/vec.hpp"
@@ -19,19 +20,10 @@
 namespace beamcast {
 
 // A glowing body whose density depends on the normalized distance x = dist/radius
-// to its center (sphere) or to its axis segment (capsule).
-struct SphereBeam {
-  Vec3 center{};
-};
-struct CapsuleBeam {
-  Vec3 p0{};
-  Vec3 p1{};
-  bool cap0 = true;  // hemisphere beyond p0
-  bool cap1 = true;  // hemisphere beyond p1
-};
-
+// to its center (sphere) or to its axis segment (capsule). One module per kind
+// in protocol/beams/ (parsing, bounds, GPU form, CPU reference geometry).
 struct Beam {
-  std::variant<SphereBeam, CapsuleBeam> shape;
+  BeamShape shape;
   double radius = 1.0;
   Color color{1.0, 1.0, 1.0};
   double intensity = 1.0;

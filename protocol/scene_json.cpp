@@ -9,8 +9,10 @@
 #include <set>
 #include <sstream>
 
+#include "protocol/beams/beam_parse.hpp"
 #include "protocol/camera.hpp"
 #include "protocol/json_reader.hpp"
+#include "protocol/kinds.hpp"
 #include "protocol/occluders/occluder_parse.hpp"
 #include "protocol/rigs.hpp"
 
@@ -50,10 +52,7 @@ int read_int_limited(const Node& n, std::int64_t lo, std::int64_t hi, const char
 
 // ---- Beams --------------------------------------------------------------------------
 
-// The beam and rig types: read by the parser, listed in hello's capabilities.
-enum class BeamKind { kSphere, kCapsule };
-constexpr std::array<std::pair<std::string_view, BeamKind>, 2> kBeamKinds{
-    {{"sphere", BeamKind::kSphere}, {"capsule", BeamKind::kCapsule}}};
+// The rig types: read by the parser, listed in hello's capabilities.
 enum class RigKind { kOrbit, kCubemap, kStereo };
 constexpr std::array<std::pair<std::string_view, RigKind>, 3> kRigKinds{
     {{"orbit", RigKind::kOrbit}, {"cubemap", RigKind::kCubemap}, {"stereo", RigKind::kStereo}}};
@@ -125,46 +124,25 @@ Density parse_density(const Node& n, const SceneLimits& limits) {
   return d;
 }
 
+// The fields every beam has; the kind's own (protocol/beams/) come after
+// "type" in the allowed list and are read by its parse function.
+constexpr std::array<std::string_view, 4> kBeamFields{"radius", "color", "intensity", "density"};
+
 Beam parse_beam(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "a beam");
-  const Node type = o.required("type");
-  using Kind = BeamKind;
-  const Kind kind = read_enum<Kind>(type, std::span(kBeamKinds));
   Beam b;
-  if (kind == Kind::kSphere) {
-    o.allow_only({"type", "center", "radius", "color", "intensity", "density"});
-  } else {
-    o.allow_only({"type", "p0", "p1", "caps", "radius", "color", "intensity", "density"});
-  }
-  b.radius = read_size(o.required("radius"), limits);
-  if (auto c = o.optional("color")) b.color = read_color(*c);
-  if (auto i = o.optional("intensity")) b.intensity = check_non_negative(*i, read_number(*i));
-  if (auto d = o.optional("density")) b.density = parse_density(*d, limits);
-
-  if (kind == Kind::kSphere) {
-    b.shape = SphereBeam{read_point(o.required("center"), limits)};
-    return b;
-  }
-  CapsuleBeam c;
-  c.p0 = read_point(o.required("p0"), limits);
-  const Node p1 = o.required("p1");
-  c.p1 = read_point(p1, limits);
-  if (auto caps = o.optional("caps")) {
-    if (!caps->json().is_array() || caps->json().size() != 2) {
-      fail("wrong_type", caps->path,
-           "caps must be an array of 2 booleans, got " + describe(caps->json()));
-    }
-    c.cap0 = read_bool(Node{&caps->json()[0], child_path(caps->path, 0)});
-    c.cap1 = read_bool(Node{&caps->json()[1], child_path(caps->path, 1)});
-  }
-  const double len = length(c.p1 - c.p0);
-  if (len <= 1e-9 * std::max(1.0, b.radius)) {
-    fail("degenerate_capsule", p1.path,
-         "capsule axis length |p1 - p0| = " + format_number(len) +
-             " is zero or too small for radius " + format_number(b.radius) +
-             "; write a zero-length capsule as a sphere beam instead");
-  }
-  b.shape = c;
+  b.shape = parse_kind<BeamShape>(o.required("type"), [&](auto kind) {
+    using Kind = typename decltype(kind)::type;
+    std::vector<std::string_view> allowed{"type"};
+    allowed.insert(allowed.end(), Kind::kFields.begin(), Kind::kFields.end());
+    allowed.insert(allowed.end(), kBeamFields.begin(), kBeamFields.end());
+    o.allow_only(allowed);
+    b.radius = read_size(o.required("radius"), limits);
+    if (auto c = o.optional("color")) b.color = read_color(*c);
+    if (auto i = o.optional("intensity")) b.intensity = check_non_negative(*i, read_number(*i));
+    if (auto d = o.optional("density")) b.density = parse_density(*d, limits);
+    return Kind::parse(BeamParse{o, limits, b.radius});
+  });
   return b;
 }
 
@@ -176,8 +154,7 @@ Occluder parse_occluder(const Node& n, const SceneLoadOptions& opts, std::int64_
   ObjectReader o(n, "an occluder");
   const Node type = o.required("type");
   Occluder occ;
-  occ.shape = parse_occluder_shape(read_string(type), type.path,
-                                   OccluderParse{o, opts, mesh_triangles});
+  occ.shape = parse_occluder_shape(type, OccluderParse{o, opts, mesh_triangles});
   if (auto a = o.optional("albedo")) occ.albedo = read_albedo(*a);
   return occ;
 }
@@ -678,7 +655,7 @@ Scene load_scene_file(const std::filesystem::path& file, const SceneLoadOptions&
 nlohmann::json scene_capabilities() {
   json densities = density_names();
   densities.push_back("table");
-  return {{"beam_types", enum_names(kBeamKinds)},
+  return {{"beam_types", beam_types()},
           {"densities", densities},
           {"occluder_types", occluder_types()},
           {"camera_rigs", enum_names(kRigKinds)}};

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 
 namespace beamcast {
 
@@ -20,5 +21,25 @@ double length(const Vec3& a);
 Vec3 normalize(const Vec3& a);
 // Rotates v by the unit quaternion q = (w, x, y, z).
 Vec3 rotate(const std::array<double, 4>& q, const Vec3& v);
+
+// World-space axis-aligned bounds; empty until grown.
+struct Aabb {
+  Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+          std::numeric_limits<double>::infinity()};
+  Vec3 hi{-lo[0], -lo[1], -lo[2]};
+  bool empty() const { return !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]); }
+  void grow(const Vec3& p) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = p[k] < lo[k] ? p[k] : lo[k];
+      hi[k] = p[k] > hi[k] ? p[k] : hi[k];
+    }
+  }
+  void grow(const Aabb& b) {
+    if (b.empty()) return;
+    grow(b.lo);
+    grow(b.hi);
+  }
+  Vec3 centre() const { return 0.5 * (lo + hi); }
+};
 
 }  // namespace beamcast

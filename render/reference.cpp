@@ -31,11 +31,7 @@ struct PreparedBeam {
   double r = 1.0;
   double inv_r = 1.0;
   double bound2 = 1.0;    // squared bounding radius, in units of r
-  bool capsule = false;
-  Vec3 w{0.0, 0.0, 1.0};  // unit axis (capsule)
-  double half_len = 0.0;  // L / (2 r)
-  bool cap0 = true;
-  bool cap1 = true;
+  const BeamShape* shape = nullptr;  // the kind splits rays into regions (protocol/beams/)
   const Density* density = nullptr;
   std::vector<double> xb;  // density breakpoints strictly inside (0, 1)
   double fmax = 1.0;
@@ -50,21 +46,12 @@ PreparedBeam prepare_beam(const Beam& beam) {
     if (x > 0.0 && x < 1.0) pb.xb.push_back(x);
   }
   pb.fmax = std::max(1e-300, std::abs(beam.density.max_value()));
-  if (const auto* s = std::get_if<SphereBeam>(&beam.shape)) {
-    pb.c = s->center;
-    pb.bound2 = 1.0;
-  } else {
-    const auto& cap = std::get<CapsuleBeam>(beam.shape);
-    pb.capsule = true;
-    pb.cap0 = cap.cap0;
-    pb.cap1 = cap.cap1;
-    const Vec3 axis = cap.p1 - cap.p0;
-    const double len = length(axis);
-    pb.c = 0.5 * (cap.p0 + cap.p1);
-    if (len > 0.0) pb.w = (1.0 / len) * axis;  // else: degenerate, any axis will do
-    pb.half_len = 0.5 * len * pb.inv_r;
-    pb.bound2 = (pb.half_len + 1.0) * (pb.half_len + 1.0);
-  }
+  const ReferenceFrame frame =
+      std::visit([&](const auto& shape) { return shape.reference_frame(beam.radius); },
+                 beam.shape);
+  pb.c = frame.c;
+  pb.bound2 = frame.bound2;
+  pb.shape = &beam.shape;
   return pb;
 }
 
@@ -158,9 +145,8 @@ double integrate_point(const PreparedBeam& pb, const Vec3& q, const Vec3& v, con
 // Region where the distance is measured to the axis line through `a0` with unit
 // direction w, restricted to sigma in [lo, hi].
 double integrate_line(const PreparedBeam& pb, const Vec3& q, const Vec3& v, const Vec3& a0,
-                      double lo, double hi, double rel_tol) {
+                      const Vec3& w, double lo, double hi, double rel_tol) {
   if (!(hi > lo)) return 0.0;
-  const Vec3& w = pb.w;
   const Vec3 m = q - a0;
   const Vec3 mp = m - dot(m, w) * w;        // ray point at sigma = 0, radial part
   const Vec3 vp = v - dot(v, w) * w;        // direction, radial part; |vp| = sin(theta)
@@ -184,6 +170,26 @@ double integrate_line(const PreparedBeam& pb, const Vec3& q, const Vec3& v, cons
                           rel_tol);
 }
 
+// The point and line regions of one ray q + sigma v, for the kinds'
+// reference_energy (protocol/beams/beam_base.hpp).
+class RayIntegrals final : public RadialIntegrals {
+ public:
+  RayIntegrals(const PreparedBeam& pb, const Vec3& q, const Vec3& v, double rel_tol)
+      : pb_(pb), q_(q), v_(v), rel_tol_(rel_tol) {}
+  double point(const Vec3& a, double lo, double hi) const override {
+    return integrate_point(pb_, q_, v_, a, lo, hi, rel_tol_);
+  }
+  double line(const Vec3& a, const Vec3& w, double lo, double hi) const override {
+    return integrate_line(pb_, q_, v_, a, w, lo, hi, rel_tol_);
+  }
+
+ private:
+  const PreparedBeam& pb_;
+  const Vec3& q_;
+  const Vec3& v_;
+  double rel_tol_;
+};
+
 // (1/r) * integral of f along o + t v, t in [t0, t1], |v| = 1.
 double beam_energy_prepared(const PreparedBeam& pb, const Vec3& o, const Vec3& v, double t0,
                             double t1, double rel_tol) {
@@ -198,38 +204,10 @@ double beam_energy_prepared(const PreparedBeam& pb, const Vec3& o, const Vec3& v
   const double s1 = std::min((t1 - t_ref) * pb.inv_r, h);
   if (!(s1 > s0)) return 0.0;
 
-  if (!pb.capsule) return integrate_point(pb, q, v, Vec3{0.0, 0.0, 0.0}, s0, s1, rel_tol);
-
-  // Capsule: u(sigma) = (p - p0) . w = u_q + sigma * vw, slab 0 <= u <= L.
-  const Vec3 a0 = (-pb.half_len) * pb.w;
-  const Vec3 a1 = pb.half_len * pb.w;
-  const double len = 2.0 * pb.half_len;
-  const double uq = dot(q - a0, pb.w);
-  const double vw = dot(v, pb.w);
-  // Sigma intervals of the three regions (before cap0 / in the slab / beyond cap1).
-  double r0lo, r0hi, slo, shi, r1lo, r1hi;
-  if (vw > 0.0) {
-    const double su0 = -uq / vw;
-    const double suL = (len - uq) / vw;
-    r0lo = -kInf, r0hi = su0, slo = su0, shi = suL, r1lo = suL, r1hi = kInf;
-  } else if (vw < 0.0) {
-    const double su0 = -uq / vw;
-    const double suL = (len - uq) / vw;
-    r1lo = -kInf, r1hi = suL, slo = suL, shi = su0, r0lo = su0, r0hi = kInf;
-  } else {  // perpendicular to the axis: one region for the whole ray
-    r0lo = r0hi = slo = shi = r1lo = r1hi = 0.0;
-    if (uq < 0.0) {
-      r0lo = -kInf, r0hi = kInf;
-    } else if (uq > len) {
-      r1lo = -kInf, r1hi = kInf;
-    } else {
-      slo = -kInf, shi = kInf;
-    }
-  }
-  double e = integrate_line(pb, q, v, a0, std::max(s0, slo), std::min(s1, shi), rel_tol);
-  if (pb.cap0) e += integrate_point(pb, q, v, a0, std::max(s0, r0lo), std::min(s1, r0hi), rel_tol);
-  if (pb.cap1) e += integrate_point(pb, q, v, a1, std::max(s0, r1lo), std::min(s1, r1hi), rel_tol);
-  return e;
+  const RayIntegrals f(pb, q, v, rel_tol);
+  return std::visit(
+      [&](const auto& shape) { return shape.reference_energy(f, q, v, s0, s1, pb.r); },
+      *pb.shape);
 }
 
 // ---------------------------------------------------------------------------

@@ -290,18 +290,10 @@ void SceneResources::fill_beams(const Vec3& eye, void* beams) const {
     set3(d.color_layer, c, beam_layers_[i]);
     d.density[0] = static_cast<float>(static_cast<int>(beam.density.kind));
     d.density[1] = static_cast<float>(beam.density.sigma);
-    if (const auto* s = std::get_if<SphereBeam>(&beam.shape)) {
-      set3(d.p0_radius, s->center - eye, r);
-      set3(d.axis_length, {0.0, 0.0, 1.0}, 0.0f);
-      set3(d.caps_kind, {0.0, 0.0, 0.0}, 0.0f);
-    } else {
-      const auto& cap = std::get<CapsuleBeam>(beam.shape);
-      const Vec3 axis = cap.p1 - cap.p0;
-      const double len = length(axis);
-      set3(d.p0_radius, cap.p0 - eye, r);
-      set3(d.axis_length, (1.0 / len) * axis, static_cast<float>(len));
-      set3(d.caps_kind, {cap.cap0 ? 1.0 : 0.0, cap.cap1 ? 1.0 : 0.0, 1.0}, 0.0f);
-    }
+    const BeamGpu g = std::visit([&](const auto& shape) { return shape.gpu(eye); }, beam.shape);
+    set3(d.p0_radius, g.p0, r);
+    set3(d.axis_length, g.axis, static_cast<float>(g.length));
+    set3(d.caps_kind, g.caps_kind, 0.0f);
   }
 }
 

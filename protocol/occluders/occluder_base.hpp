@@ -23,26 +23,6 @@ namespace beamcast {
 
 struct OccluderParse;  // occluder_parse.hpp
 
-// World-space axis-aligned bounds; empty until grown.
-struct Aabb {
-  Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-          std::numeric_limits<double>::infinity()};
-  Vec3 hi{-lo[0], -lo[1], -lo[2]};
-  bool empty() const { return !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]); }
-  void grow(const Vec3& p) {
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = p[k] < lo[k] ? p[k] : lo[k];
-      hi[k] = p[k] > hi[k] ? p[k] : hi[k];
-    }
-  }
-  void grow(const Aabb& b) {
-    if (b.empty()) return;
-    grow(b.lo);
-    grow(b.hi);
-  }
-  Vec3 centre() const { return 0.5 * (lo + hi); }
-};
-
 // Slab test of the ray o + t v against `box`: the entry and exit parameters
 // and the axes that produced them (-1: none). False when the ray misses.
 bool ray_box(const Vec3& o, const Vec3& v, const Aabb& box, double* t_near, double* t_far,

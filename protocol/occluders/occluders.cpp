@@ -1,26 +1,12 @@
 #include "protocol/occluders/occluders.hpp"
 
 #include <limits>
-#include <optional>
 #include <utility>
 
+#include "protocol/kinds.hpp"
 #include "protocol/occluders/occluder_parse.hpp"
 
 namespace beamcast {
-
-namespace {
-
-// Calls f(std::type_identity<K>{}) for every kind K of OccluderShape, in order.
-template <class F, std::size_t... I>
-void each_kind(F&& f, std::index_sequence<I...>) {
-  (f(std::type_identity<std::variant_alternative_t<I, OccluderShape>>{}), ...);
-}
-template <class F>
-void each_kind(F&& f) {
-  each_kind(std::forward<F>(f), std::make_index_sequence<std::variant_size_v<OccluderShape>>{});
-}
-
-}  // namespace
 
 bool ray_box(const Vec3& o, const Vec3& v, const Aabb& box, double* t_near, double* t_far,
              int* axis_near, int* axis_far) {
@@ -49,29 +35,11 @@ void OccluderParse::allow(std::initializer_list<std::string_view> kind_fields) c
   fields.allow_only(all);
 }
 
-std::vector<std::string_view> occluder_types() {
-  std::vector<std::string_view> types;
-  each_kind([&](auto kind) { types.push_back(decltype(kind)::type::kType); });
-  return types;
-}
+std::vector<std::string_view> occluder_types() { return kind_types<OccluderShape>(); }
 
-OccluderShape parse_occluder_shape(const std::string& type, const std::string& type_path,
-                                   const OccluderParse& in) {
-  std::optional<OccluderShape> shape;
-  each_kind([&](auto kind) {
-    using Kind = typename decltype(kind)::type;
-    if (!shape && type == Kind::kType) shape.emplace(Kind::parse(in));
-  });
-  if (shape) return std::move(*shape);
-  std::string allowed;
-  for (std::string_view t : occluder_types()) {
-    allowed += allowed.empty() ? "\"" : ", \"";
-    allowed += t;
-    allowed += '"';
-  }
-  json_read::fail("invalid_value", type_path,
-                  "type must be one of " + allowed + ", got " +
-                      json_read::describe(nlohmann::json(type)));
+OccluderShape parse_occluder_shape(const json_read::Node& type, const OccluderParse& in) {
+  return parse_kind<OccluderShape>(type,
+                                   [&](auto kind) { return decltype(kind)::type::parse(in); });
 }
 
 }  // namespace beamcast

@@ -17,15 +17,18 @@
 
 namespace beamcast {
 
+namespace json_read {
+struct Node;
+}
+
 using OccluderShape =
     std::variant<PlaneOccluder, BoxOccluder, SphereOccluder, MeshOccluder, QuadOccluder>;
 
 // The "type" strings of every kind, in OccluderShape's order.
 std::vector<std::string_view> occluder_types();
 
-// The kind whose kType is `type`, parsed by its parse function; throws
-// invalid_value at `type_path` (listing the types) for an unknown type.
-OccluderShape parse_occluder_shape(const std::string& type, const std::string& type_path,
-                                   const OccluderParse& in);
+// The kind whose kType is the string at `type`, parsed by its parse function;
+// an unknown type throws invalid_value at type.path, listing the types.
+OccluderShape parse_occluder_shape(const json_read::Node& type, const OccluderParse& in);
 
 }  // namespace beamcast
