@@ -216,7 +216,7 @@ def markdown(res):
         md[-1] += (f"{b['frames_per_s']:.1f} | {b['latency_ms']['p99']:.0f} | " if b else "- | - | ")
         md[-1] += f"{m[name]['errors_by_code'] or 0} |"
     r = m["ratios"]
-    md += ["", f"Preview frames/s with batch load / alone: **{r['preview_fps_mix_over_alone']:.2f}** "
+    md += ["", f"Preview frames/s with batch load / alone: **{r['preview_fps_mix_over_alone']:.3f}** "
            f"(target ≥ 0.8); preview p99 with / alone: **{r['preview_p99_mix_over_alone']:.2f}** "
            f"(target ≤ 2); batch frames/s with preview / alone: **{r['batch_fps_mix_over_alone']:.2f}** "
            f"(target ≥ 0.7)."]
