@@ -91,7 +91,8 @@ class ServerProcess {
 struct Row {
   int k = 0;
   // one_request, k_requests, renderer_batched, renderer_batched_sync (batches
-  // read back synchronously: FrameOptions::pipelined_readback off),
+  // read back synchronously: Readback::kSynchronous; renderer_batched is
+  // Readback::kPipelined, whatever the device),
   // renderer_single
   std::string mode;
   int round = 0;
@@ -161,7 +162,10 @@ Row renderer_run(Renderer& renderer, const Scene& scene, const std::vector<Camer
   Row row{k, !batch ? "renderer_single" : pipelined ? "renderer_batched" : "renderer_batched_sync"};
   const auto t0 = Clock::now();
   const auto frames =
-      renderer.render(scene, cams, FrameOptions{.batch = batch, .pipelined_readback = pipelined});
+      renderer.render(scene, cams,
+                      FrameOptions{.batch = batch,
+                                   .readback = pipelined ? Readback::kPipelined
+                                                         : Readback::kSynchronous});
   row.e2e_ms = ms_since(t0);
   row.render_ms = row.e2e_ms;
   std::map<int, bool> seen;

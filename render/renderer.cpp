@@ -71,6 +71,7 @@ struct Renderer::Impl {
   std::array<GlBuffer, 2> pbos;
   std::array<std::size_t, 2> pbo_bytes{};
   int next_slot = 0;
+  bool software_rasterizer = false;  // Readback::kAuto reads synchronously there
   int max_layers = 0;
   bool fail_next = false;  // fail_next_render_for_test()
 
@@ -91,6 +92,10 @@ struct Renderer::Impl {
     // near to far.
     glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+    const auto* gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    const std::string name = gl_renderer ? gl_renderer : "";
+    software_rasterizer = name.find("llvmpipe") != std::string::npos ||
+                          name.find("softpipe") != std::string::npos;
     gl_check("renderer setup");
   }
 
@@ -206,7 +211,7 @@ struct Renderer::Impl {
   }
 
   // Renders cameras[idx[0..]] (all one size) in one multi-view pass set and
-  // reads every view back: with pipelined_readback, issues the read-back into
+  // reads every view back: pipelined, issues the read-back into
   // a pixel pack buffer with a fence (`out`), completed by finish_batch();
   // otherwise reads synchronously. With read_hdr the batch is finished at once
   // (the HDR read-back stays synchronous).
@@ -234,7 +239,9 @@ struct Renderer::Impl {
     run_passes(scene, ctx, query_sets[static_cast<std::size_t>(slot)]);
 
     const bool wide = scene.output.bit_depth == 16;
-    if (opts.pipelined_readback) {
+    const bool pipelined = opts.readback == Readback::kPipelined ||
+                           (opts.readback == Readback::kAuto && !software_rasterizer);
+    if (pipelined) {
       issue_batch(plan, idx, w, h, wide, slot, wall0, out);
     } else {
       read_batch_now(plan, frames, idx, w, h, wide, slot, ms_since(wall0));
@@ -268,7 +275,7 @@ struct Renderer::Impl {
     }
   }
 
-  // The synchronous read-back (pipelined_readback off): glGetTextureImage into
+  // The synchronous read-back (Readback::kSynchronous): glGetTextureImage into
   // client memory waits for the passes, then transfers every layer.
   void read_batch_now(const FramePlan& plan, std::vector<FrameResult>& frames,
                       const std::vector<std::size_t>& idx, int w, int h, bool wide, int slot,

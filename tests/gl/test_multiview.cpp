@@ -147,7 +147,7 @@ TEST(MultiView, BatchesSplitAtTheViewBound) {
 // Without the HDR read-back, batch k's read-back is finished only after batch
 // k+1's passes are submitted (pixel buffer objects, render/renderer.cpp): the
 // frames must still be those of single renders, bit for bit (as must those of
-// the synchronous read-back, FrameOptions::pipelined_readback off), at 8 and 16 bits,
+// the synchronous read-back, Readback::kSynchronous), at 8 and 16 bits,
 // also when the targets change size between two batches and when a one-view
 // batch (the per-camera path) comes between two; and each frame's timing split
 // must add up.
@@ -172,7 +172,9 @@ TEST(MultiView, PipelinedReadBackEqualsSingleRenders) {
     for (bool pipelined : {true, false}) {
       SCOPED_TRACE(pipelined ? "pipelined read-back" : "synchronous read-back");
       const auto batched = renderer().render(
-          scene, FrameOptions{.max_batch_views = 2, .pipelined_readback = pipelined});
+          scene, FrameOptions{.max_batch_views = 2,
+                              .readback = pipelined ? Readback::kPipelined
+                                                    : Readback::kSynchronous});
       ASSERT_EQ(batched.size(), 13u);
       std::set<int> batch_ids;
       for (std::size_t i = 0; i < batched.size(); ++i) {
