@@ -90,13 +90,20 @@ class ServerProcess {
 
 struct Row {
   int k = 0;
-  std::string mode;  // one_request, k_requests, renderer_batched, renderer_single
+  // one_request, k_requests, renderer_batched, renderer_batched_sync (batches
+  // read back synchronously: Readback::kSynchronous; renderer_batched is
+  // Readback::kPipelined, whatever the device),
+  // renderer_single
+  std::string mode;
   int round = 0;
   double e2e_ms = 0;     // client: first request written -> last response read
   double render_ms = 0;  // server render call(s), summed over requests
   double gpu_ms = 0;     // GL timestamps, summed over GPU batches
   double readback_ms = 0;
   double encode_ms = 0;  // server encode wall, summed over requests
+  // Renderer rows only (not on the wire): where the renderer's wall time went,
+  // summed over GPU batches (render/renderer.hpp, BatchTiming).
+  double submit_ms = 0, readback_wait_ms = 0, readback_copy_ms = 0;
 };
 
 // Sums a response's per-frame GPU figures, counting each GPU batch once.
@@ -151,10 +158,14 @@ Row k_requests(client::Client& c, const json& cameras, int k, int window) {
 }
 
 Row renderer_run(Renderer& renderer, const Scene& scene, const std::vector<Camera>& cams, int k,
-                 bool batch) {
-  Row row{k, batch ? "renderer_batched" : "renderer_single"};
+                 bool batch, bool pipelined = true) {
+  Row row{k, !batch ? "renderer_single" : pipelined ? "renderer_batched" : "renderer_batched_sync"};
   const auto t0 = Clock::now();
-  const auto frames = renderer.render(scene, cams, FrameOptions{.batch = batch});
+  const auto frames =
+      renderer.render(scene, cams,
+                      FrameOptions{.batch = batch,
+                                   .readback = pipelined ? Readback::kPipelined
+                                                         : Readback::kSynchronous});
   row.e2e_ms = ms_since(t0);
   row.render_ms = row.e2e_ms;
   std::map<int, bool> seen;
@@ -163,6 +174,9 @@ Row renderer_run(Renderer& renderer, const Scene& scene, const std::vector<Camer
     seen[f.batch.index] = true;
     row.gpu_ms += f.batch.gpu_ms;
     row.readback_ms += f.batch.readback_ms;
+    row.submit_ms += f.batch.submit_ms;
+    row.readback_wait_ms += f.batch.readback_wait_ms;
+    row.readback_copy_ms += f.batch.readback_copy_ms;
   }
   return row;
 }
@@ -234,6 +248,7 @@ int run_views(const ViewsOptions& opts) {
     k_requests(c, cj, 2, window);
     if (renderer) {
       renderer_run(*renderer, scene, cams, 2, true);
+      renderer_run(*renderer, scene, cams, 2, true, false);
       renderer_run(*renderer, scene, cams, 2, false);
     }
   }
@@ -255,7 +270,14 @@ int run_views(const ViewsOptions& opts) {
         got.push_back(one_request(c, cj, k));
       }
       if (renderer) {
-        got.push_back(renderer_run(*renderer, scene, cams, k, true));
+        // Pipelined and synchronous read-back alternate too.
+        if (round % 2 == 0) {
+          got.push_back(renderer_run(*renderer, scene, cams, k, true));
+          got.push_back(renderer_run(*renderer, scene, cams, k, true, false));
+        } else {
+          got.push_back(renderer_run(*renderer, scene, cams, k, true, false));
+          got.push_back(renderer_run(*renderer, scene, cams, k, true));
+        }
         got.push_back(renderer_run(*renderer, scene, cams, k, false));
       }
       for (Row& r : got) {
@@ -270,10 +292,12 @@ int run_views(const ViewsOptions& opts) {
   // CSV: every measurement.
   {
     std::ofstream csv(opts.out / "views.csv");
-    csv << "k,mode,round,e2e_ms,render_ms,gpu_ms,readback_ms,encode_ms\n";
+    csv << "k,mode,round,e2e_ms,render_ms,gpu_ms,readback_ms,encode_ms,submit_ms,"
+           "readback_wait_ms,readback_copy_ms\n";
     for (const Row& r : rows) {
       csv << r.k << ',' << r.mode << ',' << r.round << ',' << r.e2e_ms << ',' << r.render_ms << ','
-          << r.gpu_ms << ',' << r.readback_ms << ',' << r.encode_ms << '\n';
+          << r.gpu_ms << ',' << r.readback_ms << ',' << r.encode_ms << ',' << r.submit_ms << ','
+          << r.readback_wait_ms << ',' << r.readback_copy_ms << '\n';
     }
   }
   // Markdown: medians per K and mode, and the ratios that matter.
@@ -288,9 +312,12 @@ int run_views(const ViewsOptions& opts) {
      << " round(s), medians; pipelining window " << window << ".\n\n";
   md << "| K | one request e2e ms | K requests e2e ms | ratio | one: render / gpu / read-back / "
         "encode ms | K req: render / gpu / read-back / encode ms (sums) |";
-  if (renderer) md << " renderer batched / single ms (gpu) |";
+  if (renderer) {
+    md << " renderer batched / single ms (gpu) | renderer batched: submit / read-back wait / "
+          "copy ms | renderer batched, synchronous read-back: ms, submit / wait / copy ms |";
+  }
   md << "\n|---|---|---|---|---|---|";
-  if (renderer) md << "---|";
+  if (renderer) md << "---|---|---|";
   md << "\n";
   char buf[512];
   for (int k : ks) {
@@ -306,6 +333,17 @@ int run_views(const ViewsOptions& opts) {
       std::snprintf(buf, sizeof buf, " %.1f (%.1f) / %.1f (%.1f) |",
                     med(k, "renderer_batched", &Row::e2e_ms), med(k, "renderer_batched", &Row::gpu_ms),
                     med(k, "renderer_single", &Row::e2e_ms), med(k, "renderer_single", &Row::gpu_ms));
+      md << buf;
+      std::snprintf(buf, sizeof buf, " %.1f / %.1f / %.1f |",
+                    med(k, "renderer_batched", &Row::submit_ms),
+                    med(k, "renderer_batched", &Row::readback_wait_ms),
+                    med(k, "renderer_batched", &Row::readback_copy_ms));
+      md << buf;
+      std::snprintf(buf, sizeof buf, " %.1f, %.1f / %.1f / %.1f |",
+                    med(k, "renderer_batched_sync", &Row::e2e_ms),
+                    med(k, "renderer_batched_sync", &Row::submit_ms),
+                    med(k, "renderer_batched_sync", &Row::readback_wait_ms),
+                    med(k, "renderer_batched_sync", &Row::readback_copy_ms));
       md << buf;
     }
     md << "\n";

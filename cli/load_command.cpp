@@ -4,6 +4,14 @@
 // time so a slow server cannot hide queueing: no coordinated omission). Every
 // frame received is decoded and checked; a fraction is compared with a local
 // render of the same pose (the offline GL renderer, same code as the server).
+//
+// Traffic classes: by default one class ("load") made of the options above. With
+// --preview-connections and/or --batch-connections the run is a mix (issue 13):
+// a preview-like closed loop (one camera moving along an orbit every frame,
+// `"quality": "auto"`, as server/preview/preview.js sends) next to a batch-like
+// loop (multi-camera orbit renders, open loop at --batch-rate or closed loop),
+// each class with its own latency histogram, throughput and errors. Every class
+// reports each connection's throughput and the max/min ratio (fairness).
 #include <unistd.h>
 
 #include <algorithm>
@@ -37,6 +45,7 @@
 #include "protocol/render_response.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
+#include "render/jpeg.hpp"
 #include "render/renderer.hpp"
 
 namespace beamcast::cli {
@@ -61,6 +70,17 @@ struct LoadArgs {
   double verify_fraction = 0.02;
   int tolerance = 1;  // max |difference| per 8-bit channel against the local render
   int inflight_per_connection = 8;
+  int pipeline = 1;  // closed loop: requests each connection keeps in flight
+  // The mix: a preview-like class and a batch-like class (either may be 0).
+  int preview_connections = 0;
+  int preview_size = 256;
+  double preview_budget_ms = 33;
+  double preview_step_deg = 3;  // orbit step between a connection's frames
+  int batch_connections = 0;
+  int batch_cameras = 16;
+  int batch_size = 256;
+  double batch_rate = 0;  // requests/s over the batch connections; 0: closed loop
+  int batch_pipeline = 1;
   double busy_backoff_ms = 20;  // closed loop: pause after a "busy" answer, as a polite client does  // open loop: more than this is a client-side skip
   double timeout_s = 60;
   std::string token;
@@ -132,6 +152,32 @@ struct Results {
   std::vector<std::string> failures;  // first few, for the report
 };
 
+// One class of traffic: how its requests look and how they are sent, and what
+// came back (counters guarded by Results::mu).
+struct TrafficClass {
+  std::string name;
+  int connections = 1;
+  double rate = 0;   // open loop requests/s over the class; 0: closed loop
+  int pipeline = 1;  // closed loop: in flight per connection
+  int inflight_cap = 8;  // open loop: in flight per connection before a skip
+  int cameras = 0;       // 0: mix of 1 and 4
+  std::string poses = "mix";
+  bool preview = false;  // one moving camera per request, quality "auto"
+  double budget_ms = 33;
+  double step_rad = 0;
+  double verify_fraction = 0;
+  std::optional<PoseSource> pose_source;
+  // State (event-loop thread only).
+  std::uint64_t next_seq = 0;
+  std::size_t rr = 0;
+  // Results (under Results::mu).
+  LatencyHistogram latency;
+  std::map<std::string, std::uint64_t> errors;
+  std::uint64_t sent = 0, ok = 0, frames = 0, bytes = 0, skipped = 0;
+  std::uint64_t still_frames = 0, jpeg_frames = 0;  // preview: full-accuracy and interactive
+  std::map<int, std::uint64_t> levels;              // preview: frames per quality level
+};
+
 void note_failure(Results& r, std::string what) {
   if (r.failures.size() < 5) r.failures.push_back(std::move(what));
 }
@@ -139,7 +185,8 @@ void note_failure(Results& r, std::string what) {
 // ---- frame verification -----------------------------------------------------
 
 struct VerifyJob {
-  std::vector<std::uint8_t> png;
+  std::vector<std::uint8_t> png;  // or a JPEG (interactive preview frames)
+  bool jpeg = false;
   int width = 0, height = 0;
   json camera;     // set for a reference comparison
   std::uint64_t seq = 0;
@@ -181,7 +228,7 @@ class Verifier {
  private:
   std::optional<Image> decode(const VerifyJob& job) {
     try {
-      Image img = decode_png(job.png);
+      Image img = job.jpeg ? decode_jpeg(job.png) : decode_png(job.png);
       std::lock_guard lock(results_.mu);
       ++results_.decoded;
       if (img.width != job.width || img.height != job.height) {
@@ -258,11 +305,17 @@ class Load;
 
 class Conn : public std::enable_shared_from_this<Conn> {
  public:
-  Conn(Load& load, asio::io_context& io, int index) : load_(load), socket_(io), index_(index) {}
+  Conn(Load& load, asio::io_context& io, int index, TrafficClass& cls)
+      : load_(load), socket_(io), index_(index), cls_(cls) {}
   void start(const tcp::resolver::results_type& endpoints);
   // Sends request `seq`, timed from `intended` (its scheduled time).
   void send_render(std::uint64_t seq, Clock::time_point intended);
   std::size_t inflight() const { return pending_.size(); }
+  TrafficClass& traffic_class() const { return cls_; }
+  int index() const { return index_; }
+  // Answered requests and their frames (this connection's throughput).
+  std::uint64_t ok_requests() const { return ok_requests_; }
+  std::uint64_t ok_frames() const { return ok_frames_; }
   bool ready() const { return ready_ && !dead_; }
   void close() {
     boost::system::error_code ignored;
@@ -284,6 +337,9 @@ class Conn : public std::enable_shared_from_this<Conn> {
   Load& load_;
   tcp::socket socket_;
   int index_;
+  TrafficClass& cls_;
+  std::uint64_t frame_no_ = 0;  // preview: this connection's frames so far (its orbit position)
+  std::uint64_t ok_requests_ = 0, ok_frames_ = 0;
   bool ready_ = false, dead_ = false, writing_ = false;
   std::deque<std::vector<std::uint8_t>> writes_;
   std::array<std::uint8_t, kFrameHeaderSize> header_{};
@@ -294,19 +350,23 @@ class Conn : public std::enable_shared_from_this<Conn> {
 
 class Load {
  public:
-  Load(const LoadArgs& a, json scene_json, std::string scene_id)
+  Load(const LoadArgs& a, json scene_json, std::string scene_id,
+       std::vector<std::unique_ptr<TrafficClass>> cls)
       : args(a),
         scene_id(std::move(scene_id)),
-        poses(scene_json.at("cameras").at(0), a.size),
+        classes(std::move(cls)),
         verifier(results, scene_json, a.scene_file, a.tolerance) {}
 
   int run(const client::Endpoint& ep) {
     tcp::resolver resolver(io);
     const auto endpoints = resolver.resolve(ep.host, std::to_string(ep.port));
     start = Clock::now();
-    for (int i = 0; i < args.connections; ++i) {
-      conns.push_back(std::make_shared<Conn>(*this, io, i));
-      conns.back()->start(endpoints);
+    int index = 0;
+    for (auto& cls : classes) {
+      for (int i = 0; i < cls->connections; ++i) {
+        conns.push_back(std::make_shared<Conn>(*this, io, index++, *cls));
+        conns.back()->start(endpoints);
+      }
     }
     asio::steady_timer ticker(io);
     tick(ticker);
@@ -318,10 +378,12 @@ class Load {
   // Called by a connection when it is ready (closed loop: starts its loop) or
   // when an answer arrived (closed loop: sends the next).
   void on_ready(Conn& c) {
-    if (args.rate <= 0) maybe_send(c, Clock::now());
+    if (c.traffic_class().rate > 0) return;
+    for (int i = 0; i < c.traffic_class().pipeline; ++i) maybe_send(c, Clock::now());
   }
   void on_answer(Conn& c, bool busy) {
-    if (args.rate <= 0 && busy && args.busy_backoff_ms > 0) {
+    const bool closed = c.traffic_class().rate <= 0;
+    if (closed && busy && args.busy_backoff_ms > 0) {
       auto t = std::make_shared<asio::steady_timer>(io);
       t->expires_after(std::chrono::microseconds(static_cast<long long>(args.busy_backoff_ms * 1000)));
       t->async_wait([this, t, conn = c.shared_from_this()](const boost::system::error_code&) {
@@ -330,30 +392,31 @@ class Load {
       });
       return;
     }
-    if (args.rate <= 0) maybe_send(c, Clock::now());
+    if (closed) maybe_send(c, Clock::now());
     maybe_stop();
   }
   bool sending_over() const {
-    return stopping || (args.requests > 0 && next_seq >= static_cast<std::uint64_t>(args.requests));
+    return stopping || (args.requests > 0 && total_sent >= static_cast<std::uint64_t>(args.requests));
   }
   void on_dead() { maybe_stop(); }
 
   const LoadArgs& args;
   std::string scene_id;
-  PoseSource poses;
+  std::vector<std::unique_ptr<TrafficClass>> classes;
   Results results;
   Verifier verifier;
   asio::io_context io;
   std::vector<std::shared_ptr<Conn>> conns;
   Clock::time_point start;
-  std::uint64_t next_seq = 0;
+  std::uint64_t total_sent = 0;  // over all classes (--requests)
   bool stopping = false;
   Clock::time_point stop_at_deadline;
 
  private:
   void maybe_send(Conn& c, Clock::time_point intended) {
     if (sending_over() || !c.ready()) return;
-    c.send_render(next_seq++, intended);
+    ++total_sent;
+    c.send_render(c.traffic_class().next_seq++, intended);
   }
   void maybe_stop() {
     if (!sending_over()) return;
@@ -373,37 +436,49 @@ class Load {
     if (stopping && now > stop_at_deadline) {
       // Answers that never came count as errors.
       std::lock_guard lock(results.mu);
-      for (auto& c : conns) results.errors["no_answer"] += c->ready() ? c->inflight() : 0;
+      for (auto& c : conns) {
+        const std::size_t n = c->ready() ? c->inflight() : 0;
+        results.errors["no_answer"] += n;
+        if (n > 0) c->traffic_class().errors["no_answer"] += n;
+      }
       for (auto& c : conns) c->close();
       io.stop();
       return;
     }
-    if (args.rate > 0 && !sending_over()) {
-      // Open loop: every request due by now is sent, round robin over the
-      // connections, timed from its own scheduled instant.
-      const auto due = static_cast<std::uint64_t>(elapsed * args.rate);
-      while (next_seq < due && !sending_over()) {
+    bool open_loop = false;
+    for (auto& cls : classes) {
+      if (cls->rate <= 0) continue;
+      open_loop = true;
+      // Open loop: every request of the class due by now is sent, round robin
+      // over its connections, timed from its own scheduled instant.
+      const auto due = static_cast<std::uint64_t>(elapsed * cls->rate);
+      while (cls->next_seq < due && !sending_over()) {
         const auto intended = start + std::chrono::duration_cast<Clock::duration>(
-                                          std::chrono::duration<double>(next_seq / args.rate));
+                                          std::chrono::duration<double>(cls->next_seq / cls->rate));
         Conn* c = nullptr;
         for (std::size_t k = 0; k < conns.size() && !c; ++k) {
-          Conn& cand = *conns[(rr++) % conns.size()];
-          if (cand.ready() && cand.inflight() < static_cast<std::size_t>(args.inflight_per_connection)) c = &cand;
+          Conn& cand = *conns[(cls->rr++) % conns.size()];
+          if (&cand.traffic_class() == cls.get() && cand.ready() &&
+              cand.inflight() < static_cast<std::size_t>(cls->inflight_cap)) {
+            c = &cand;
+          }
         }
+        ++total_sent;
         if (!c) {
           // Every connection is at its in-flight cap: the request is not
           // sent (counted, not hidden).
-          ++next_seq;
+          ++cls->next_seq;
           std::lock_guard lock(results.mu);
           ++results.skipped;
+          ++cls->skipped;
           continue;
         }
-        c->send_render(next_seq++, intended);
+        c->send_render(cls->next_seq++, intended);
       }
     }
     progress(now, false);
     maybe_stop();
-    t.expires_after(std::chrono::milliseconds(args.rate > 0 ? 2 : 50));
+    t.expires_after(std::chrono::milliseconds(open_loop ? 2 : 50));
     t.async_wait([this, &t](const boost::system::error_code& ec) {
       if (!ec) tick(t);
     });
@@ -428,7 +503,6 @@ class Load {
                  isatty(2) && !final ? "   " : "\n");
   }
   Clock::time_point last_progress{};
-  std::size_t rr = 0;
 };
 
 void Conn::start(const tcp::resolver::results_type& endpoints) {
@@ -451,14 +525,26 @@ void Conn::start(const tcp::resolver::results_type& endpoints) {
 
 void Conn::send_render(std::uint64_t seq, Clock::time_point intended) {
   const std::int64_t id = next_id_++;
-  json cams = load_.poses.cameras_for(seq, load_.args.poses, load_.args.cameras);
-  json req = {{"id", id},
-              {"method", "render"},
-              {"params", {{"scene_id", load_.scene_id}, {"cameras", cams}}}};
+  const PoseSource& poses = *cls_.pose_source;
+  json params = {{"scene_id", load_.scene_id}};
+  json cams;
+  if (cls_.preview) {
+    // As the preview page sends while the camera is dragged: one camera, a
+    // new pose every frame (so the server infers motion), quality "auto".
+    const double az = poses.azimuth + 0.7 * index_ + cls_.step_rad * static_cast<double>(frame_no_++);
+    cams = json::array({poses.camera("view", az, poses.elevation, poses.radius)});
+    params["quality"] = "auto";
+    params["budget_ms"] = cls_.budget_ms;
+  } else {
+    cams = poses.cameras_for(seq, cls_.poses, cls_.cameras);
+  }
+  params["cameras"] = cams;
+  json req = {{"id", id}, {"method", "render"}, {"params", std::move(params)}};
   pending_[id] = Pending{seq, intended, std::move(cams)};
   {
     std::lock_guard lock(load_.results.mu);
     ++load_.results.sent;
+    ++cls_.sent;
   }
   write(encode_frame(req.dump()));
 }
@@ -519,7 +605,9 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
   if (!ready_) {  // the answer to hello
     if (!ok) {
       std::lock_guard lock(r.mu);
-      ++r.errors[msg["error"].value("code", "hello_failed")];
+      const std::string code = msg["error"].value("code", "hello_failed");
+      ++r.errors[code];
+      ++cls_.errors[code];
       dead_ = true;
       close();
       load_.on_dead();
@@ -544,6 +632,7 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
     busy = code == "busy";
     std::lock_guard lock(r.mu);
     ++r.errors[code];
+    ++cls_.errors[code];
     if (busy) r.busy_latency.record_ms(ms);
   } else {
     std::optional<RenderResponse> res;
@@ -569,21 +658,34 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
       job.width = p.cameras[i]["width"];
       job.height = p.cameras[i]["height"];
       job.seq = p.seq;
+      job.jpeg = res->frames[i].format.value_or("png") == "jpeg";
       // Deterministic sample of requests for the reference comparison.
       const double u = static_cast<double>((p.seq * 0x9E3779B97F4A7C15ull) >> 11) * 0x1.0p-53;
-      if (u < load_.args.verify_fraction) job.camera = p.cameras[i];
+      if (u < cls_.verify_fraction) job.camera = p.cameras[i];
       jobs.push_back(std::move(job));
     }
     {
       std::lock_guard lock(r.mu);
       if (!shape_ok) {
         ++r.errors["bad_frames"];
+        ++cls_.errors["bad_frames"];
         note_failure(r, "request " + std::to_string(p.seq) + ": " + why);
       } else {
         ++r.ok;
         r.frames += res->frames.size();
         r.bytes += kFrameHeaderSize + body_.size();
         r.latency.record_ms(ms);
+        ++cls_.ok;
+        cls_.frames += res->frames.size();
+        cls_.bytes += kFrameHeaderSize + body_.size();
+        cls_.latency.record_ms(ms);
+        ++ok_requests_;
+        ok_frames_ += res->frames.size();
+        if (res->quality) {
+          ++cls_.levels[static_cast<int>(res->quality->level)];
+          if (res->quality->still) ++cls_.still_frames;
+          if (res->quality->format == "jpeg") ++cls_.jpeg_frames;
+        }
         const RenderTimings& t = res->timings;
         r.queue_ms.record_ms(t.queue_ms);
         r.render_ms.record_ms(t.render_ms);
@@ -601,12 +703,61 @@ void Conn::fail(const std::string& why) {
   dead_ = true;
   {
     std::lock_guard lock(load_.results.mu);
-    if (!load_.stopping || !pending_.empty()) ++load_.results.errors[why];
+    if (!load_.stopping || !pending_.empty()) {
+      ++load_.results.errors[why];
+      ++cls_.errors[why];
+    }
     load_.results.errors["no_answer"] += pending_.size();
+    if (!pending_.empty()) cls_.errors["no_answer"] += pending_.size();
   }
   pending_.clear();
   close();
   load_.on_dead();
+}
+
+// The classes of a run: the mix's preview and batch classes, or one class
+// ("load") from --connections, --rate, --cameras and --poses.
+std::vector<std::unique_ptr<TrafficClass>> make_classes(const LoadArgs& a, const json& scene_json) {
+  std::vector<std::unique_ptr<TrafficClass>> out;
+  const json& cam = scene_json.at("cameras").at(0);
+  if (a.preview_connections > 0) {
+    auto c = std::make_unique<TrafficClass>();
+    c->name = "preview";
+    c->connections = a.preview_connections;
+    c->preview = true;
+    c->budget_ms = a.preview_budget_ms;
+    c->step_rad = a.preview_step_deg * std::numbers::pi / 180.0;
+    c->pose_source.emplace(cam, a.preview_size);
+    c->verify_fraction = 0;  // interactive frames are reduced-accuracy by design: decoded only
+    out.push_back(std::move(c));
+  }
+  if (a.batch_connections > 0) {
+    auto c = std::make_unique<TrafficClass>();
+    c->name = "batch";
+    c->connections = a.batch_connections;
+    c->rate = a.batch_rate;
+    c->pipeline = a.batch_pipeline;
+    c->inflight_cap = a.inflight_per_connection;
+    c->cameras = a.batch_cameras;
+    c->poses = "orbit";
+    c->pose_source.emplace(cam, a.batch_size);
+    c->verify_fraction = a.verify_fraction;
+    out.push_back(std::move(c));
+  }
+  if (out.empty()) {
+    auto c = std::make_unique<TrafficClass>();
+    c->name = "load";
+    c->connections = a.connections;
+    c->rate = a.rate;
+    c->pipeline = a.pipeline;
+    c->inflight_cap = a.inflight_per_connection;
+    c->cameras = a.cameras;
+    c->poses = a.poses;
+    c->pose_source.emplace(cam, a.size);
+    c->verify_fraction = a.verify_fraction;
+    out.push_back(std::move(c));
+  }
+  return out;
 }
 
 json histogram_json(const LatencyHistogram& h) {
@@ -646,7 +797,7 @@ int run_load(const LoadArgs& args) {
     if (!put.ok) throw std::runtime_error("scene.put refused: [" + put.error.code + "] " + put.error.message);
   }
 
-  Load load(args, scene_json, scene_id);
+  Load load(args, scene_json, scene_id, make_classes(args, scene_json));
   load.run(ep);
   const double wall = std::chrono::duration<double>(Clock::now() - load.start).count();
   load.progress(Clock::now(), true);
@@ -663,9 +814,60 @@ int run_load(const LoadArgs& args) {
   for (auto& [k, v] : r.errors) errors += v;
   const bool verified = r.decode_failed == 0 && r.size_mismatch == 0 && r.ref_failed == 0 &&
                         r.decoded == r.frames;
+  // Per class: throughput, latency, errors, and each connection's throughput
+  // with the max/min ratio (fairness; a connection that got nothing makes it
+  // infinite, reported as null).
+  json classes = json::array();
+  for (const auto& cls : load.classes) {
+    json per_conn = json::array();
+    double lo = 0, hi = 0;
+    bool first = true;
+    for (const auto& c : load.conns) {
+      if (&c->traffic_class() != cls.get()) continue;
+      const double fps = c->ok_frames() / wall;
+      per_conn.push_back({{"connection", c->index()},
+                          {"requests", c->ok_requests()},
+                          {"frames", c->ok_frames()},
+                          {"frames_per_s", fps}});
+      lo = first ? fps : std::min(lo, fps);
+      hi = first ? fps : std::max(hi, fps);
+      first = false;
+    }
+    std::uint64_t cls_errors = 0;
+    for (auto& [k, v] : cls->errors) cls_errors += v;
+    json c = {{"name", cls->name},
+              {"connections", cls->connections},
+              {"loop", cls->rate > 0 ? "open" : "closed"},
+              {"rate", cls->rate},
+              {"pipeline", cls->pipeline},
+              {"size", cls->pose_source->size},
+              {"cameras_per_request", cls->preview       ? json(1)
+                                      : cls->cameras > 0 ? json(cls->cameras)
+                                                         : json("mix 1/4")},
+              {"quality", cls->preview ? "auto" : "full"},
+              {"requests", {{"sent", cls->sent}, {"ok", cls->ok}, {"errors", cls_errors},
+                            {"not_sent", cls->skipped}}},
+              {"errors_by_code", cls->errors},
+              {"frames", cls->frames},
+              {"frames_per_s", cls->frames / wall},
+              {"requests_per_s", cls->ok / wall},
+              {"latency_ms", histogram_json(cls->latency)},
+              {"per_connection", per_conn},
+              {"fairness_max_over_min", lo > 0 ? json(hi / lo) : json(nullptr)}};
+    if (cls->preview) {
+      json levels = json::object();
+      for (auto& [lvl, n] : cls->levels) levels[std::to_string(lvl)] = n;
+      c["preview"] = {{"budget_ms", cls->budget_ms},
+                      {"still_frames", cls->still_frames},
+                      {"jpeg_frames", cls->jpeg_frames},
+                      {"frames_by_level", levels}};
+    }
+    classes.push_back(std::move(c));
+  }
+  const bool mix = args.preview_connections > 0 || args.batch_connections > 0;
   json out = {
       {"server", args.server},
-      {"mode", args.rate > 0 ? "open" : "closed"},
+      {"mode", mix ? "mix" : args.rate > 0 ? "open" : "closed"},
       {"connections", args.connections},
       {"rate", args.rate},
       {"size", args.size},
@@ -694,13 +896,18 @@ int run_load(const LoadArgs& args) {
         {"reference_max_diff", r.ref_max_diff},
         {"tolerance", args.tolerance},
         {"all_frames_correct", verified},
-        {"failures", r.failures}}}};
+        {"failures", r.failures}}},
+      {"classes", classes}};
   if (args.json_out) {
     std::printf("%s\n", out.dump(2).c_str());
   } else {
     const json& l = out["latency_ms"];
-    std::printf("beamcast load: %s loop, %d connections, %.1f s, %dx%d\n",
-                args.rate > 0 ? "open" : "closed", args.connections, wall, args.size, args.size);
+    if (mix) {
+      std::printf("beamcast load: mix, %.1f s\n", wall);
+    } else {
+      std::printf("beamcast load: %s loop, %d connections, %.1f s, %dx%d\n",
+                  args.rate > 0 ? "open" : "closed", args.connections, wall, args.size, args.size);
+    }
     std::printf("  requests  sent %llu  ok %llu  errors %llu  not sent %llu\n",
                 (unsigned long long)r.sent, (unsigned long long)r.ok,
                 (unsigned long long)errors, (unsigned long long)r.skipped);
@@ -719,6 +926,37 @@ int run_load(const LoadArgs& args) {
                 (unsigned long long)r.ref_checked, r.ref_max_diff, args.tolerance,
                 verified ? "all correct" : "FAILURES");
     for (auto& f : r.failures) std::printf("    %s\n", f.c_str());
+    for (const json& c : classes) {
+      const json& cl = c["latency_ms"];
+      std::printf("  class %s: %d connections, %s loop, %s cameras at %d px, quality %s\n",
+                  c["name"].get<std::string>().c_str(), c["connections"].get<int>(),
+                  c["loop"].get<std::string>().c_str(), c["cameras_per_request"].dump().c_str(),
+                  c["size"].get<int>(), c["quality"].get<std::string>().c_str());
+      std::printf("    %.1f frames/s  %.2f requests/s  ok %llu  errors %llu\n",
+                  c["frames_per_s"].get<double>(), c["requests_per_s"].get<double>(),
+                  (unsigned long long)c["requests"]["ok"].get<std::uint64_t>(),
+                  (unsigned long long)c["requests"]["errors"].get<std::uint64_t>());
+      for (auto& [k, v] : c["errors_by_code"].items()) {
+        std::printf("      error %-20s %llu\n", k.c_str(), (unsigned long long)v.get<std::uint64_t>());
+      }
+      std::printf("    latency ms  p50 %.1f  p90 %.1f  p99 %.1f  max %.1f\n",
+                  cl["p50"].get<double>(), cl["p90"].get<double>(), cl["p99"].get<double>(),
+                  cl["max"].get<double>());
+      if (c.contains("preview")) {
+        std::printf("    preview  %llu interactive (JPEG) and %llu still frames, by level %s\n",
+                    (unsigned long long)c["preview"]["jpeg_frames"].get<std::uint64_t>(),
+                    (unsigned long long)c["preview"]["still_frames"].get<std::uint64_t>(),
+                    c["preview"]["frames_by_level"].dump().c_str());
+      }
+      std::printf("    per connection frames/s");
+      for (const json& pc : c["per_connection"]) std::printf(" %.1f", pc["frames_per_s"].get<double>());
+      const json& f = c["fairness_max_over_min"];
+      if (f.is_null()) {
+        std::printf("  (max/min: a connection got no frame)\n");
+      } else {
+        std::printf("  (max/min %.3f)\n", f.get<double>());
+      }
+    }
   }
   return verified ? 0 : 3;
 }
@@ -756,6 +994,34 @@ void add_load_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--inflight", args->inflight_per_connection,
                   "Open loop: requests in flight per connection before one is skipped")
+      ->check(CLI::Range(1, 1024))->capture_default_str();
+  cmd->add_option("--pipeline", args->pipeline,
+                  "Closed loop: requests each connection keeps in flight (fairness: -c 4 "
+                  "--pipeline 16 --cameras 1)")
+      ->check(CLI::Range(1, 1024))->capture_default_str();
+  cmd->add_option("--preview-connections", args->preview_connections,
+                  "Mix: preview-like closed-loop connections (one camera moving along an "
+                  "orbit, quality auto)")
+      ->check(CLI::Range(0, 1000))->capture_default_str();
+  cmd->add_option("--preview-size", args->preview_size, "Mix: preview frame width and height")
+      ->check(CLI::Range(1, 4096))->capture_default_str();
+  cmd->add_option("--preview-budget", args->preview_budget_ms, "Mix: preview budget_ms")
+      ->check(CLI::Range(1.0, 10000.0))->capture_default_str();
+  cmd->add_option("--preview-step", args->preview_step_deg,
+                  "Mix: degrees the preview camera moves along its orbit per frame")
+      ->check(CLI::Range(0.001, 180.0))->capture_default_str();
+  cmd->add_option("--batch-connections", args->batch_connections,
+                  "Mix: batch-like connections (multi-camera orbit renders, quality full)")
+      ->check(CLI::Range(0, 1000))->capture_default_str();
+  cmd->add_option("--batch-cameras", args->batch_cameras, "Mix: cameras per batch request")
+      ->check(CLI::Range(1, 64))->capture_default_str();
+  cmd->add_option("--batch-size", args->batch_size, "Mix: batch frame width and height")
+      ->check(CLI::Range(1, 4096))->capture_default_str();
+  cmd->add_option("--batch-rate", args->batch_rate,
+                  "Mix: batch requests/s over the batch connections (0: closed loop)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  cmd->add_option("--batch-pipeline", args->batch_pipeline,
+                  "Mix, closed loop: batch requests each batch connection keeps in flight")
       ->check(CLI::Range(1, 1024))->capture_default_str();
   cmd->add_option("--busy-backoff", args->busy_backoff_ms,
                   "Closed loop: milliseconds a connection waits after a busy answer")

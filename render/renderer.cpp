@@ -26,17 +26,36 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 // Copies `views` images of w x h (GL rows bottom-up, RGB) from `src` into
 // top-down frames.
 template <class T, class Dst>
-void split_views(const std::vector<T>& src, int w, int h, std::size_t first, std::size_t views,
-                 Dst dst) {
+void split_views(const T* src, int w, int h, std::size_t first, std::size_t views, Dst dst) {
   const std::size_t row = 3 * static_cast<std::size_t>(w);
   for (std::size_t v = 0; v < views; ++v) {
     auto* out = dst(first + v);
-    const T* layer = src.data() + v * row * h;
+    const T* layer = src + v * row * h;
     for (int y = 0; y < h; ++y) {
       std::copy(layer + (h - 1 - y) * row, layer + (h - y) * row, out + y * row);
     }
   }
 }
+
+// A multi-view batch whose read-back was issued into a pixel buffer object
+// and fenced, but not yet mapped: it is finished (fence waited, PBO mapped,
+// views split into frames) after the next batch's passes are submitted, so
+// on a GPU that renders asynchronously the transfer of batch k overlaps the
+// draws of batch k+1. Lives only inside one Renderer::render call.
+struct PendingReadback {
+  std::vector<std::size_t> idx;  // frames of the batch
+  int w = 0, h = 0;
+  bool wide = false;  // 16-bit channels
+  int slot = 0;       // PBO and timestamp-query set
+  GLsync fence = nullptr;
+  double submit_ms = 0.0;  // CPU time issuing the passes and the read-back
+  PendingReadback() = default;
+  PendingReadback(const PendingReadback&) = delete;
+  PendingReadback& operator=(const PendingReadback&) = delete;
+  ~PendingReadback() {
+    if (fence) glDeleteSync(fence);
+  }
+};
 
 struct Renderer::Impl {
   std::unique_ptr<EglContext> context;
@@ -45,7 +64,14 @@ struct Renderer::Impl {
   FrameTargets targets;
   FrameTargets layered;  // multi-view batches
   GlVertexArray empty_vao;
-  std::vector<GlQuery> queries;  // timestamps: frame start, then one after each pass
+  // Timestamps (frame start, then one after each pass), one set per read-back
+  // slot: a batch's set is read after the next batch has written the other.
+  std::array<std::vector<GlQuery>, 2> query_sets;
+  // Double-buffered pixel pack buffers of multi-view batches, by slot.
+  std::array<GlBuffer, 2> pbos;
+  std::array<std::size_t, 2> pbo_bytes{};
+  int next_slot = 0;
+  bool software_rasterizer = false;  // Readback::kAuto reads synchronously there
   int max_layers = 0;
   bool fail_next = false;  // fail_next_render_for_test()
 
@@ -66,12 +92,16 @@ struct Renderer::Impl {
     // near to far.
     glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+    const auto* gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    const std::string name = gl_renderer ? gl_renderer : "";
+    software_rasterizer = name.find("llvmpipe") != std::string::npos ||
+                          name.find("softpipe") != std::string::npos;
     gl_check("renderer setup");
   }
 
   // Clears the plan's targets and runs its passes, with a timestamp before
   // the first and after each (plan.passes.size() + 1 queries).
-  void run_passes(const Scene& scene, FrameContext& ctx) {
+  void run_passes(const Scene& scene, FrameContext& ctx, std::vector<GlQuery>& queries) {
     const FramePlan& plan = ctx.plan;
     while (queries.size() < plan.passes.size() + 1) {
       GLuint id = 0;
@@ -90,7 +120,7 @@ struct Renderer::Impl {
   }
 
   // Pass times of the last run_passes (waits for the GPU).
-  BatchTiming read_timings(const FramePlan& plan) {
+  BatchTiming read_timings(const FramePlan& plan, const std::vector<GlQuery>& queries) {
     std::vector<GLuint64> stamps(plan.passes.size() + 1);
     for (std::size_t i = 0; i < stamps.size(); ++i) {
       glGetQueryObjectui64v(queries[i].get(), GL_QUERY_RESULT, &stamps[i]);
@@ -123,7 +153,8 @@ struct Renderer::Impl {
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.camera_buffer());
     FrameContext ctx{scene,           plan, cam, basis, res, targets, empty_vao.get(), 0,
                      full_cam.width, full_cam.height};
-    run_passes(scene, ctx);
+    run_passes(scene, ctx, query_sets[0]);
+    const double submit_ms = ms_since(wall0);
 
     // Read-back (synchronous: it waits for the GPU to finish the frame).
     const auto rb0 = std::chrono::steady_clock::now();
@@ -168,21 +199,26 @@ struct Renderer::Impl {
       }
     }
 
-    result.batch = read_timings(plan);
+    result.batch = read_timings(plan, query_sets[0]);
+    result.batch.submit_ms = submit_ms;
     result.passes = result.batch.passes;
     result.gpu_ms = result.batch.gpu_ms;
     result.wall_ms = ms_since(wall0);
     result.batch.readback_ms = result.readback_ms;
+    result.batch.readback_wait_ms = result.readback_ms;  // not split on this path
     result.batch.wall_ms = result.wall_ms;
     return result;
   }
 
-  // Renders cameras[idx[0..]] (all one size) in one multi-view pass set into
-  // frames[idx[...]]; one read-back transfers every view.
+  // Renders cameras[idx[0..]] (all one size) in one multi-view pass set and
+  // reads every view back: pipelined, issues the read-back into
+  // a pixel pack buffer with a fence (`out`), completed by finish_batch();
+  // otherwise reads synchronously. With read_hdr the batch is finished at once
+  // (the HDR read-back stays synchronous).
   void render_batch(const Scene& scene, const std::vector<Camera>& cameras,
                     const std::vector<std::size_t>& idx, SceneResources& res,
                     const FramePlan& plan, const FrameOptions& opts,
-                    std::vector<FrameResult>& frames) {
+                    std::vector<FrameResult>& frames, PendingReadback& out) {
     const auto wall0 = std::chrono::steady_clock::now();
     const std::size_t k = idx.size();
     std::vector<Camera> cams;
@@ -192,41 +228,27 @@ struct Renderer::Impl {
       bases.push_back(camera_basis(cameras[i]));
     }
     const int w = cams[0].width, h = cams[0].height;
+    const int slot = next_slot;
+    next_slot ^= 1;
     res.bind_views(cams, bases, kMaxBatchViews);
     layered.ensure(plan, w, h, w, h, scene.output.bit_depth, static_cast<int>(k));
     glViewport(0, 0, w, h);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.views_camera_buffer());
     FrameContext ctx{scene, plan, cams[0], bases[0], res, layered, empty_vao.get(),
                      static_cast<int>(k), w, h};
-    run_passes(scene, ctx);
+    run_passes(scene, ctx, query_sets[static_cast<std::size_t>(slot)]);
 
-    // One read-back of every layer (synchronous: waits for the passes).
-    const auto rb0 = std::chrono::steady_clock::now();
-    const std::size_t per_view = 3 * static_cast<std::size_t>(w) * h;
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    for (std::size_t v = 0; v < k; ++v) {
-      FrameResult& f = frames[idx[v]];
-      f.image.width = w;
-      f.image.height = h;
-      f.image.bit_depth = scene.output.bit_depth;
-      f.image.rgb.resize(per_view);
-    }
-    auto image_of = [&](std::size_t v) { return frames[idx[v]].image.rgb.data(); };
-    if (scene.output.bit_depth == 16) {
-      std::vector<std::uint16_t> all(per_view * k);
-      glGetTextureImage(layered.texture(plan.final_target), 0, GL_RGB, GL_UNSIGNED_SHORT,
-                        static_cast<GLsizei>(all.size() * 2), all.data());
-      split_views(all, w, h, 0, k, image_of);
+    const bool wide = scene.output.bit_depth == 16;
+    const bool pipelined = opts.readback == Readback::kPipelined ||
+                           (opts.readback == Readback::kAuto && !software_rasterizer);
+    if (pipelined) {
+      issue_batch(plan, idx, w, h, wide, slot, wall0, out);
     } else {
-      std::vector<std::uint8_t> all(per_view * k);
-      glGetTextureImage(layered.texture(plan.final_target), 0, GL_RGB, GL_UNSIGNED_BYTE,
-                        static_cast<GLsizei>(all.size()), all.data());
-      split_views(all, w, h, 0, k, image_of);
+      read_batch_now(plan, frames, idx, w, h, wide, slot, ms_since(wall0));
     }
-    gl_check("glGetTextureImage(output layers)");
-    const double readback_ms = ms_since(rb0);
     if (opts.read_hdr) {
-      std::vector<float> all(per_view * k);
+      finish_batch(plan, frames, out);
+      std::vector<float> all(3 * static_cast<std::size_t>(w) * h * k);
       glGetTextureImage(layered.texture("hdr"), 0, GL_RGB, GL_FLOAT,
                         static_cast<GLsizei>(all.size() * sizeof(float)), all.data());
       gl_check("glGetTextureImage(hdr layers)");
@@ -234,15 +256,150 @@ struct Renderer::Impl {
         HdrImage& hdr = frames[idx[v]].hdr;
         hdr.width = w;
         hdr.height = h;
-        hdr.rgb.resize(per_view);
+        hdr.rgb.resize(3 * static_cast<std::size_t>(w) * h);
       }
-      split_views(all, w, h, 0, k, [&](std::size_t v) { return frames[idx[v]].hdr.rgb.data(); });
+      split_views(all.data(), w, h, 0, k,
+                  [&](std::size_t v) { return frames[idx[v]].hdr.rgb.data(); });
     }
+  }
 
-    BatchTiming batch = read_timings(plan);
+  // Gives the frames of a batch their images' size and depth.
+  static void size_frames(std::vector<FrameResult>& frames, const std::vector<std::size_t>& idx,
+                          int w, int h, bool wide) {
+    for (std::size_t i : idx) {
+      FrameResult& f = frames[i];
+      f.image.width = w;
+      f.image.height = h;
+      f.image.bit_depth = wide ? 16 : 8;
+      f.image.rgb.resize(3 * static_cast<std::size_t>(w) * h);
+    }
+  }
+
+  // The synchronous read-back (Readback::kSynchronous): glGetTextureImage into
+  // client memory waits for the passes, then transfers every layer.
+  void read_batch_now(const FramePlan& plan, std::vector<FrameResult>& frames,
+                      const std::vector<std::size_t>& idx, int w, int h, bool wide, int slot,
+                      double submit_ms) {
+    const std::size_t k = idx.size();
+    const std::size_t n = 3 * static_cast<std::size_t>(w) * h * k;
+    const auto rb0 = std::chrono::steady_clock::now();
+    size_frames(frames, idx, w, h, wide);
+    auto image_of = [&](std::size_t v) { return frames[idx[v]].image.rgb.data(); };
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    double wait_ms = 0.0;
+    if (wide) {
+      std::vector<std::uint16_t> all(n);
+      glGetTextureImage(layered.texture(plan.final_target), 0, GL_RGB, GL_UNSIGNED_SHORT,
+                        static_cast<GLsizei>(all.size() * 2), all.data());
+      wait_ms = ms_since(rb0);
+      split_views(all.data(), w, h, 0, k, image_of);
+    } else {
+      std::vector<std::uint8_t> all(n);
+      glGetTextureImage(layered.texture(plan.final_target), 0, GL_RGB, GL_UNSIGNED_BYTE,
+                        static_cast<GLsizei>(all.size()), all.data());
+      wait_ms = ms_since(rb0);
+      split_views(all.data(), w, h, 0, k, image_of);
+    }
+    gl_check("glGetTextureImage(output layers)");
+    const double readback_ms = ms_since(rb0);
+    set_batch_timing(plan, frames, idx, slot, submit_ms, wait_ms, readback_ms - wait_ms);
+  }
+
+  // The pipelined read-back: every layer into this slot's PBO (queued after
+  // the passes, so no wait here; the next batch's draws into the same layered
+  // targets are ordered after it by GL's command order), then a fence.
+  void issue_batch(const FramePlan& plan, const std::vector<std::size_t>& idx, int w, int h,
+                   bool wide, int slot, std::chrono::steady_clock::time_point wall0,
+                   PendingReadback& out) {
+    const std::size_t k = idx.size();
+    const std::size_t bytes = 3 * static_cast<std::size_t>(w) * h * k * (wide ? 2 : 1);
+    GlBuffer& pbo = pbos[static_cast<std::size_t>(slot)];
+    if (!pbo.get() || pbo_bytes[static_cast<std::size_t>(slot)] < bytes) {
+      GLuint id = 0;
+      glCreateBuffers(1, &id);
+      pbo = GlBuffer(id);
+      glNamedBufferData(id, static_cast<GLsizeiptr>(bytes), nullptr, GL_STREAM_READ);
+      pbo_bytes[static_cast<std::size_t>(slot)] = bytes;
+    }
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, pbo.get());
+    // With a pack buffer bound, the pointer argument is an offset into it.
+    glGetTextureImage(layered.texture(plan.final_target), 0, GL_RGB,
+                      wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE, static_cast<GLsizei>(bytes),
+                      nullptr);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    gl_check("glGetTextureImage(output layers into PBO)");
+    out.fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    // Starts the queued work now (a fence waited on with
+    // GL_SYNC_FLUSH_COMMANDS_BIT would flush only at the wait).
+    glFlush();
+    gl_check("glFenceSync(output layers)");
+    out.idx = idx;
+    out.w = w;
+    out.h = h;
+    out.wide = wide;
+    out.slot = slot;
+    out.submit_ms = ms_since(wall0);
+  }
+
+  // Completes a batch issued by issue_batch: waits for its fence (the passes
+  // and the transfer), maps its PBO, splits the views into their frames and
+  // reads the batch's timestamps. A no-op for an empty (already finished) one.
+  void finish_batch(const FramePlan& plan, std::vector<FrameResult>& frames,
+                    PendingReadback& p) {
+    if (!p.fence) return;
+    const auto wait0 = std::chrono::steady_clock::now();
+    for (;;) {
+      const GLenum r = glClientWaitSync(p.fence, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000ull);
+      if (r == GL_ALREADY_SIGNALED || r == GL_CONDITION_SATISFIED) break;
+      if (r == GL_WAIT_FAILED) {
+        gl_check("glClientWaitSync(output layers)");
+        throw GlError("glClientWaitSync(output layers) failed");
+      }
+      // GL_TIMEOUT_EXPIRED: keep waiting (a large batch on a slow device).
+    }
+    glDeleteSync(p.fence);
+    p.fence = nullptr;
+    const double wait_ms = ms_since(wait0);
+
+    const auto copy0 = std::chrono::steady_clock::now();
+    const std::size_t k = p.idx.size();
+    const std::size_t bytes = 3 * static_cast<std::size_t>(p.w) * p.h * k * (p.wide ? 2 : 1);
+    const GLuint pbo = pbos[static_cast<std::size_t>(p.slot)].get();
+    const void* mapped =
+        glMapNamedBufferRange(pbo, 0, static_cast<GLsizeiptr>(bytes), GL_MAP_READ_BIT);
+    if (!mapped) {
+      gl_check("glMapNamedBufferRange(output layers)");
+      throw GlError("glMapNamedBufferRange(output layers) returned null");
+    }
+    size_frames(frames, p.idx, p.w, p.h, p.wide);
+    auto image_of = [&](std::size_t v) { return frames[p.idx[v]].image.rgb.data(); };
+    if (p.wide) {
+      split_views(static_cast<const std::uint16_t*>(mapped), p.w, p.h, 0, k, image_of);
+    } else {
+      split_views(static_cast<const std::uint8_t*>(mapped), p.w, p.h, 0, k, image_of);
+    }
+    glUnmapNamedBuffer(pbo);
+    gl_check("glUnmapNamedBuffer(output layers)");
+    set_batch_timing(plan, frames, p.idx, p.slot, p.submit_ms, wait_ms, ms_since(copy0));
+  }
+
+  // The batch's timing (GPU timestamps from its query set, the CPU split),
+  // shared out to its frames.
+  void set_batch_timing(const FramePlan& plan, std::vector<FrameResult>& frames,
+                        const std::vector<std::size_t>& idx, int slot, double submit_ms,
+                        double wait_ms, double copy_ms) {
+    const std::size_t k = idx.size();
+    BatchTiming batch = read_timings(plan, query_sets[static_cast<std::size_t>(slot)]);
     batch.views = static_cast<int>(k);
-    batch.readback_ms = readback_ms;
-    batch.wall_ms = ms_since(wall0);
+    batch.submit_ms = submit_ms;
+    batch.readback_wait_ms = wait_ms;
+    batch.readback_copy_ms = copy_ms;
+    batch.readback_ms = wait_ms + copy_ms;
+    // The batch's own CPU time: its submission and its completion (with
+    // pipelining, not the next batch's submission in between, which that
+    // batch accounts for).
+    batch.wall_ms = submit_ms + batch.readback_ms;
     const double share = 1.0 / static_cast<double>(k);
     for (std::size_t v = 0; v < k; ++v) {
       FrameResult& f = frames[idx[v]];
@@ -251,7 +408,7 @@ struct Renderer::Impl {
       f.readback_ms = batch.readback_ms * share;
       f.wall_ms = batch.wall_ms * share;
       f.passes = batch.passes;
-      for (PassTiming& p : f.passes) p.gpu_ms *= share;
+      for (PassTiming& pt : f.passes) pt.gpu_ms *= share;
     }
   }
 };
@@ -309,14 +466,24 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
   } else {
     for (std::size_t i = 0; i < cameras.size(); ++i) batches.push_back({i});
   }
+  // Multi-view batches are pipelined: batch b's read-back is finished after
+  // batch b+1's passes are submitted (render_batch, finish_batch).
+  std::array<PendingReadback, 2> pending;
+  std::size_t cur = 0;
   for (std::size_t b = 0; b < batches.size(); ++b) {
     const auto& idx = batches[b];
     if (idx.size() == 1) {
+      impl_->finish_batch(plan, frames, pending[cur ^ 1]);
       frames[idx[0]] = impl_->render_camera(scene, cameras[idx[0]], res, plan, opts);
     } else {
-      impl_->render_batch(scene, cameras, idx, res, plan, opts, frames);
+      impl_->render_batch(scene, cameras, idx, res, plan, opts, frames, pending[cur]);
+      impl_->finish_batch(plan, frames, pending[cur ^ 1]);
+      cur ^= 1;
     }
-    for (std::size_t i : idx) frames[i].batch.index = static_cast<int>(b);
+  }
+  impl_->finish_batch(plan, frames, pending[cur ^ 1]);
+  for (std::size_t b = 0; b < batches.size(); ++b) {
+    for (std::size_t i : batches[b]) frames[i].batch.index = static_cast<int>(b);
   }
   return frames;
 }

@@ -24,6 +24,22 @@ struct PassTiming {
   double gpu_ms = 0.0;  // GL timestamp queries around the pass
 };
 
+// How multi-view batches are read back.
+enum class Readback {
+  // Pipelined, except on a software rasterizer (llvmpipe, softpipe), where
+  // the passes run during submission and there is nothing asynchronous to
+  // overlap: measured neutral to 4% slower there (docs/performance.md,
+  // "Mixed load (issue 13)"), so the synchronous read is kept.
+  kAuto,
+  // Each batch into one of two pixel buffer objects with a fence, mapped only
+  // after the next batch's passes are submitted: on a GPU that renders
+  // asynchronously, batch k's transfer overlaps batch k+1's draws.
+  kPipelined,
+  // glGetTextureImage into client memory right after the batch's passes
+  // (waits for them).
+  kSynchronous,
+};
+
 struct FrameOptions {
   bool read_hdr = false;  // also read back the linear HDR buffer
   // Multi-view batching: cameras of one size are rendered together, K views
@@ -37,6 +53,9 @@ struct FrameOptions {
   // Memory bound of a batch: views * width * height (the targets take about
   // 28 bytes a pixel; 16 Mpx is 448 MB, 64 views of 512x512).
   std::int64_t max_batch_pixels = 16LL << 20;
+  // Read-back of multi-view batches (above). Same frames either way
+  // (tests/gl/test_multiview.cpp).
+  Readback readback = Readback::kAuto;
   // Render at this fraction of the camera's width and height, then upscale to
   // the camera's size with a bilinear blit on the GPU ("upscale" pass); 1 =
   // native (no extra pass). The HDR buffer, if read, stays at the render size.
@@ -51,9 +70,22 @@ struct BatchTiming {
   int index = 0;  // batches in render order
   int views = 1;
   double gpu_ms = 0.0;
-  double readback_ms = 0.0;
+  double readback_ms = 0.0;  // readback_wait_ms + readback_copy_ms
+  // submit_ms + readback_ms: a multi-view batch's completion runs after the
+  // next batch's submission (Readback::kPipelined), which is not
+  // counted here.
   double wall_ms = 0.0;
   std::vector<PassTiming> passes;
+  // Where the batch's CPU (wall) time went: submit_ms issuing its passes (and,
+  // pipelined, its read-back into a pixel buffer object); readback_wait_ms
+  // waiting for the GPU to finish the passes and the transfer;
+  // readback_copy_ms mapping the buffer and splitting the views into frames.
+  // The single-camera path reads synchronously and counts its whole
+  // read-back as wait. (After `passes`, so that positional initializers of
+  // the fields above keep their meaning.)
+  double submit_ms = 0.0;
+  double readback_wait_ms = 0.0;
+  double readback_copy_ms = 0.0;
 };
 
 struct FrameResult {

@@ -13,8 +13,10 @@ import subprocess
 import sys
 import tempfile
 
-HEADER = "k,mode,round,e2e_ms,render_ms,gpu_ms,readback_ms,encode_ms"
-MODES = {"one_request", "k_requests", "renderer_batched", "renderer_single"}
+HEADER = ("k,mode,round,e2e_ms,render_ms,gpu_ms,readback_ms,encode_ms,submit_ms,"
+          "readback_wait_ms,readback_copy_ms")
+MODES = {"one_request", "k_requests", "renderer_batched", "renderer_batched_sync",
+         "renderer_single"}
 
 passed = 0
 failed = 0
@@ -56,6 +58,19 @@ def main():
         for mode in ("one_request", "k_requests"):
             check(f"{mode}: GPU time grows with K", gpu[(4, mode)] > 1.5 * gpu[(1, mode)],
                   f"{gpu[(1, mode)]} -> {gpu[(4, mode)]}")
+        # The renderer's split of its wall time (BatchTiming): the read-back is
+        # its wait for the GPU plus the copy out of the pixel buffer (CSV
+        # values have 6 significant digits, hence the 1e-3 relative slack),
+        # and submitting the passes takes time.
+        for r in rows:
+            if r["mode"] not in ("renderer_batched", "renderer_batched_sync"):
+                continue
+            rb, wait, copy = (float(r[k]) for k in ("readback_ms", "readback_wait_ms",
+                                                    "readback_copy_ms"))
+            check(f"{r['mode']} K={r['k']}: read-back = wait + copy",
+                  abs(rb - (wait + copy)) <= 1e-3 * max(rb, 1e-3), f"{rb} vs {wait} + {copy}")
+            check(f"{r['mode']} K={r['k']}: submit time recorded",
+                  float(r["submit_ms"]) > 0, r["submit_ms"])
         md = os.path.join(out, "views.md")
         check("views.md has a row per K",
               os.path.exists(md) and sum(1 for line in open(md) if line.startswith("| ")) == 4)
