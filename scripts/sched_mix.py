@@ -41,11 +41,17 @@ def pct(values, p):
     return v[min(len(v) - 1, int(math.ceil(p / 100.0 * len(v))) - 1)]
 
 
-def preview_loop(port, stop, out):
+def preview_loop(port, stop, out, fps=0.0):
+    """fps > 0: paced like a display (a frame every 1/fps s, or at once when
+    late); 0: closed loop, the next request as soon as the last answer came."""
     c = BeamcastClient("127.0.0.1", port)
     lat, frames, k = [], 0, 0
     t0 = time.perf_counter()
     while not stop.is_set():
+        if fps > 0:
+            due = t0 + k / fps
+            if due > time.perf_counter():
+                time.sleep(due - time.perf_counter())
         k += 1
         params = {"scene_id": "demo", "cameras": [orbit_camera(0.02 * k, 512)],
                   "quality": "auto", "motion": "moving", "budget_ms": 33}
@@ -84,11 +90,11 @@ def pipelined_loop(port, stop, out, cameras, depth, size):
     c.close()
 
 
-def run_phase(port, seconds, preview, batch):
+def run_phase(port, seconds, preview, batch, fps=0.0):
     stop = threading.Event()
     res_p, res_b, threads = {}, {}, []
     if preview:
-        threads.append(threading.Thread(target=preview_loop, args=(port, stop, res_p)))
+        threads.append(threading.Thread(target=preview_loop, args=(port, stop, res_p, fps)))
     if batch:
         threads.append(threading.Thread(target=pipelined_loop,
                                         args=(port, stop, res_b, 16, 2, 256)))
@@ -145,6 +151,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--server-binary", required=True)
     ap.add_argument("--seconds", type=float, default=10.0)
+    ap.add_argument("--preview-fps", type=float, default=0.0,
+                    help="pace the preview loop at this many frames/s (0: closed loop)")
     ap.add_argument("--skip", nargs="*", default=[], help="phases to skip: fairness cancel")
     a = ap.parse_args()
     srv = subprocess.Popen([a.server_binary, "--port", "0", "--http-port", "0", "--quiet-requests"],
@@ -153,13 +161,12 @@ def main():
         line = srv.stdout.readline()
         port = int(line.rsplit(":", 1)[1])
         # Warm-up: tables, programs, the accuracy controller's first levels.
-        warm = {}
         run_phase(port, 2.0, True, True)
-        warm = {}
         res = {"load_avg_start": os.getloadavg()[0]}
-        res["preview_alone"] = run_phase(port, a.seconds, True, False)
+        res["preview_fps_paced"] = a.preview_fps
+        res["preview_alone"] = run_phase(port, a.seconds, True, False, a.preview_fps)
         res["batch_alone"] = run_phase(port, a.seconds, False, True)
-        res["both"] = run_phase(port, a.seconds, True, True)
+        res["both"] = run_phase(port, a.seconds, True, True, a.preview_fps)
         pa, ba, bo = res["preview_alone"], res["batch_alone"], res["both"]
         res["ratios"] = {
             "preview_fps_both_over_alone": bo["preview_fps"] / pa["preview_fps"],
@@ -170,11 +177,11 @@ def main():
             res["fairness"] = fairness(port, a.seconds)
         if "cancel" not in a.skip:
             try:
+                time.sleep(1.5)  # past the server's interactive window: full slices
                 res["cancel"] = cancel(port)
             except Exception as e:  # an old server has no "stream"
                 res["cancel"] = {"error": str(e)}
         res["load_avg_end"] = os.getloadavg()[0]
-        del warm
         print(json.dumps(res, indent=1))
     finally:
         srv.terminate()

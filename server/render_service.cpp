@@ -200,6 +200,17 @@ bool RenderService::submit(RenderJob job) {
   do {
     if (current >= max_inflight_) return false;
   } while (!inflight_.compare_exchange_weak(current, current + 1));
+  // Batch work submitted while a preview is active renders one camera per
+  // slice: on llvmpipe a batch of 4 costs what 4 single frames cost
+  // (docs/performance.md), and the preview then waits for one frame, not 4.
+  const std::int64_t now_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                                  Clock::now().time_since_epoch())
+                                  .count();
+  if (job.work_class == WorkClass::kInteractive) {
+    last_interactive_ms_.store(now_ms);
+  } else if (now_ms - last_interactive_ms_.load() < interactive_window_ms_.load()) {
+    job.options.max_batch_views = 1;
+  }
   auto task = std::make_shared<Task>();
   task->cls = job.work_class;
   task->client = job.client;
@@ -633,6 +644,10 @@ void RenderService::gather_batch(Task& first, std::unique_lock<std::mutex>& lock
     }
   }
   first.slices = make_slices(first.cameras, first.options);
+}
+
+void RenderService::set_interactive_window(std::chrono::milliseconds window) {
+  interactive_window_ms_.store(window.count());
 }
 
 void RenderService::set_batch_window(std::chrono::milliseconds window, int max_views) {

@@ -15,6 +15,7 @@
 #include <condition_variable>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -138,6 +139,11 @@ class RenderService {
   // job renders as soon as a worker is free.
   void set_batch_window(std::chrono::milliseconds window, int max_views);
 
+  // While interactive work is about (an interactive job was submitted within
+  // `window`), batch jobs submitted are sliced one camera at a time, so a
+  // preview frame waits for at most one batch frame; 0: always full slices.
+  void set_interactive_window(std::chrono::milliseconds window);
+
   // False if `max_inflight` jobs are already accepted and unanswered (busy).
   bool submit(RenderJob job);
   int inflight() const { return inflight_.load(); }
@@ -197,6 +203,8 @@ class RenderService {
   int png_filters_;
   int max_inflight_;
   std::chrono::milliseconds batch_window_{0};
+  std::atomic<std::int64_t> interactive_window_ms_{1000};
+  std::atomic<std::int64_t> last_interactive_ms_{std::numeric_limits<std::int64_t>::min() / 2};
   int batch_max_views_ = 64;
   std::atomic<int> inflight_{0};
   std::atomic<std::uint64_t> dropped_{0};

@@ -94,6 +94,24 @@ TEST(Scheduling, AJobRendersInSlicesAndInteractiveFramesGoBetweenThem) {
   EXPECT_FALSE(r.stream);
 }
 
+TEST(Scheduling, BatchWorkSubmittedWhileAPreviewIsActiveRendersOneCameraPerSlice) {
+  auto control = std::make_shared<test::FakeRendererControl>();
+  test::LocalServer s({}, test::fake_renderer_factory(control));
+  // A window far longer than the test: "active" cannot lapse on a slow machine.
+  s.core().renders->set_interactive_window(std::chrono::hours(1));
+  test::Conn c(s.port(), 30);
+  ASSERT_TRUE(c.call(render_req(1, "b", 3)).json.value("ok", false));  // no preview yet
+  ASSERT_TRUE(c.call(render_req(2, "i", 1, {{"quality", "auto"}})).json.value("ok", false));
+  ASSERT_TRUE(c.call(render_req(3, "c", 3)).json.value("ok", false));
+  const auto log = control->call_log();
+  ASSERT_EQ(log.size(), 5u);
+  EXPECT_EQ(log[0], names({"b0", "b1", "b2"}));
+  EXPECT_EQ(log[1], names({"i0"}));
+  EXPECT_EQ(log[2], names({"c0"}));
+  EXPECT_EQ(log[3], names({"c1"}));
+  EXPECT_EQ(log[4], names({"c2"}));
+}
+
 TEST(Scheduling, FourPipelinedConnectionsTakeTurns) {
   auto control = std::make_shared<test::FakeRendererControl>();
   ServerConfig cfg;  // defaults: 16 in flight per connection, 64 in all
