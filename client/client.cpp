@@ -2,6 +2,7 @@
 
 #include "protocol/bounded_json.hpp"
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 #include <stdexcept>
@@ -215,23 +216,61 @@ RenderResult Client::render(const RenderRequest& request) {
   if (!request.output.is_null()) params["output"] = request.output;
   params["encoding"] = request.encoding;
 
+  if (request.stream) params["stream"] = true;
+
   const auto t0 = Clock::now();
+  const auto since_t0 = [&] {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  };
   const nlohmann::json id = send({{"id", next_id_++}, {"method", "render"}, {"params", params}});
-  Response r = receive_for(id);
   RenderResult out;
-  out.e2e_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-  out.ok = r.ok;
-  if (!r.ok) {
-    out.error = r.error;
-    return out;
+  out.parts = 0;
+  std::vector<char> seen;  // streamed: which camera indices have arrived
+  for (;;) {
+    Response r = receive_for(id);
+    if (out.parts == 0) out.first_part_ms = since_t0();
+    ++out.parts;
+    out.ok = r.ok;
+    if (!r.ok) {  // also ends a stream: frames of earlier parts are dropped with it
+      out.error = r.error;
+      out.frames.clear();
+      out.e2e_ms = since_t0();
+      return out;
+    }
+    const RenderResponse response = read_render_response(r);
+    std::vector<RenderedFrame> frames = decode_frames(r, response);
+    if (request.stream && !response.stream) {
+      throw std::runtime_error("render response: asked to stream, got no \"stream\" part");
+    }
+    if (request.on_part) request.on_part(response.stream ? response.stream->part : 0, frames);
+    const bool last = !response.stream || response.stream->last;
+    if (response.stream) {
+      // Parts name their frames' camera indices; each index once, all by the last part.
+      seen.resize(response.stream->frames, 0);
+      for (const RenderedFrame& f : frames) {
+        const auto i = static_cast<std::size_t>(f.index);
+        if (i >= seen.size() || seen[i]) {
+          throw std::runtime_error("render response: streamed frame index " +
+                                   std::to_string(f.index) + " out of range or repeated");
+        }
+        seen[i] = 1;
+      }
+    }
+    for (RenderedFrame& f : frames) out.frames.push_back(std::move(f));
+    if (last) {
+      if (std::find(seen.begin(), seen.end(), 0) != seen.end()) {
+        throw std::runtime_error("render response: the stream ended with frames missing");
+      }
+      std::sort(out.frames.begin(), out.frames.end(),
+                [](const RenderedFrame& a, const RenderedFrame& b) { return a.index < b.index; });
+      out.e2e_ms = since_t0();
+      out.passes = response.passes;
+      out.timings = to_json(response)["timings"];
+      out.server_ms = response.timings.server_ms;
+      out.network_ms = out.e2e_ms - out.server_ms;
+      return out;
+    }
   }
-  const RenderResponse response = read_render_response(r);
-  out.frames = decode_frames(r, response);
-  out.passes = response.passes;
-  out.timings = to_json(response)["timings"];
-  out.server_ms = response.timings.server_ms;
-  out.network_ms = out.e2e_ms - out.server_ms;
-  return out;
 }
 
 RenderResponse read_render_response(const Response& response) {

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -52,12 +53,20 @@ struct Response {
   const nlohmann::json& result() const;
 };
 
+struct RenderedFrame;
+
 struct RenderRequest {
   nlohmann::json scene;             // inline scene object; or
   std::string scene_id;             // a stored scene (exactly one of the two)
   nlohmann::json cameras;           // optional camera overrides (array), null for none
   nlohmann::json output;            // optional output overrides (object), null for none
   std::string encoding = "binary";  // "binary" (attachments) or "base64"
+  // Streaming (PROTOCOL.md, "Streaming"; the server lists "stream" in hello's
+  // capabilities): the server sends each GPU batch's frames as they finish.
+  // render() still returns every frame, in camera order; `on_part`, if set,
+  // sees each part's frames as it arrives (part number, frames).
+  bool stream = false;
+  std::function<void(int part, const std::vector<RenderedFrame>& frames)> on_part;
 };
 
 struct RenderedFrame {
@@ -79,6 +88,8 @@ struct RenderResult {
   double e2e_ms = 0;       // client wall time: request written -> response read
   double server_ms = 0;    // timings.server_ms
   double network_ms = 0;   // e2e_ms - server_ms: wire, kernel and client decode time
+  int parts = 1;           // response messages (streamed: one per part)
+  double first_part_ms = 0;  // client wall time until the first message (all of it unstreamed)
 };
 
 // --- the client ---

@@ -96,6 +96,9 @@ json to_json(const RenderResponse& r) {
               {"encode_ms", r.timings.encode_ms},
               {"server_ms", r.timings.server_ms}}}};
   if (r.quality) j["quality"] = to_json(*r.quality);
+  if (r.stream) {
+    j["stream"] = {{"part", r.stream->part}, {"last", r.stream->last}, {"frames", r.stream->frames}};
+  }
   return j;
 }
 
@@ -213,6 +216,11 @@ RenderResponse render_response_from_json(const json& result, const std::string& 
                     read_number(t.required("readback_ms")), read_number(t.required("encode_ms")),
                     read_number(t.required("server_ms"))};
   if (auto q = r.optional("quality")) out.quality = read_quality(*q);
+  if (auto st = r.optional("stream")) {
+    const ObjectReader sr(*st, "stream");
+    out.stream = StreamPart{read_int(sr.required("part")), read_bool(sr.required("last")),
+                            read_size(sr.required("frames"))};
+  }
   return out;
 }
 

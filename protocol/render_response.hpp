@@ -90,6 +90,16 @@ struct RenderTimings {
   bool operator==(const RenderTimings&) const = default;
 };
 
+// A streamed render ("stream": true, PROTOCOL.md "Streaming"): this message
+// is part `part` of the response; `last` on the final one; `frames` is the
+// request's total frame count.
+struct StreamPart {
+  int part = 0;
+  bool last = true;
+  std::size_t frames = 0;
+  bool operator==(const StreamPart&) const = default;
+};
+
 struct RenderResponse {
   std::vector<std::string> passes;
   std::vector<RenderFrame> frames;
@@ -97,6 +107,7 @@ struct RenderResponse {
   int batch_requests = 1, batch_views = 0;  // "batch": {"requests", "views"}
   RenderTimings timings;
   std::optional<QualityReport> quality;
+  std::optional<StreamPart> stream;  // streamed renders only
   bool operator==(const RenderResponse&) const = default;
 };
 

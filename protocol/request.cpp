@@ -187,7 +187,7 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
       json_read::read_bool, json_read::read_number;
   static constexpr std::string_view kKeys[] = {
       "scene",   "scene_id",  "cameras",  "output", "encoding",          "atlas",
-      "quality", "budget_ms", "still_ms", "motion", "interactive_format"};
+      "quality", "budget_ms", "still_ms", "motion", "interactive_format", "stream"};
   const ObjectReader r(Node{&params, "/params"}, "render params");
   r.allow_only(kKeys);
   RenderParams rp;
@@ -232,6 +232,13 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
     rp.output = object_at(*o, "output");  // merged over the scene's by the caller
   }
   if (auto a = r.optional("atlas")) rp.atlas = read_bool(*a);
+  if (auto st = r.optional("stream")) {
+    rp.stream = read_bool(*st);
+    // An atlas is one image of every frame: nothing to send before the end.
+    if (rp.stream && rp.atlas) {
+      fail("conflicting_fields", st->path, "\"stream\": true cannot be combined with \"atlas\": true");
+    }
+  }
   if (auto e = r.optional("encoding")) {
     rp.base64 = read_choice(*e, {"binary", "base64"}) == "base64";
   }

@@ -79,6 +79,7 @@ struct RenderParams {
   std::optional<nlohmann::json> output;  // merged over the scene's "output"
   bool base64 = false;
   bool atlas = false;  // one atlas image of all frames instead of one image each
+  bool stream = false;  // frames sent as their GPU batches finish (PROTOCOL.md, "Streaming")
 };
 RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits& limits);
 

@@ -93,6 +93,10 @@ class Connection {
 
   InteractiveState& interactive() { return interactive_; }
 
+  // This connection's identity for the render scheduler's turns (unique in
+  // the process, never reused).
+  std::uint64_t id() const { return id_; }
+
   // Whether this connection passed hello's token check (server/auth.hpp);
   // TCP sessions and WebSockets go through the same gate.
   bool authenticated() const { return authenticated_.load(); }
@@ -104,7 +108,12 @@ class Connection {
   void mark_gone() { alive_->store(false); }
 
  private:
+  static std::uint64_t next_id() {
+    static std::atomic<std::uint64_t> next{1};
+    return next.fetch_add(1);
+  }
   const int max_inflight_;
+  const std::uint64_t id_ = next_id();
   std::atomic<int> inflight_{0};
   std::shared_ptr<std::atomic<bool>> alive_ = std::make_shared<std::atomic<bool>>(true);
   InteractiveState interactive_;

@@ -249,6 +249,7 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
     if (closed_) return;
     closed_ = true;
     mark_gone();
+    core_.stats.connection_gone();
     writes_.clear();
     message_timer_.cancel();
     beast::error_code ignored;

@@ -49,20 +49,51 @@ const char* Metrics::stage_name(Stage s) {
   }
 }
 
+const char* Metrics::class_name(int c) { return c == 0 ? "interactive" : "batch"; }
+
+namespace {
+
+void add_to(Metrics::Histogram& h, double ms) {
+  const double s = ms / 1000.0;
+  std::size_t i = 0;
+  while (i < Metrics::kBuckets.size() && s > Metrics::kBuckets[i]) ++i;
+  ++h.counts[i];
+  ++h.count;
+  h.sum_s += s;
+}
+
+// The bucket, sum and count lines of one histogram; `labels` without braces.
+void write_histogram(std::string& o, const char* name, const std::string& labels,
+                     const Metrics::Histogram& h) {
+  std::uint64_t cum = 0;
+  for (std::size_t i = 0; i < Metrics::kBuckets.size(); ++i) {
+    cum += h.counts[i];
+    char le[32];
+    std::snprintf(le, sizeof le, "%g", Metrics::kBuckets[i]);  // bucket bounds as written: "0.05"
+    o += std::string(name) + "_bucket{" + labels + ",le=\"" + le + "\"} " + std::to_string(cum) + "\n";
+  }
+  cum += h.counts.back();
+  o += std::string(name) + "_bucket{" + labels + ",le=\"+Inf\"} " + std::to_string(cum) + "\n";
+  o += std::string(name) + "_sum{" + labels + "} " + num(h.sum_s) + "\n";
+  o += std::string(name) + "_count{" + labels + "} " + std::to_string(h.count) + "\n";
+}
+
+}  // namespace
+
+void Metrics::observe_class_wait(int work_class, double ms) {
+  if (work_class < 0 || work_class >= kClasses) return;
+  std::lock_guard lock(mu_);
+  add_to(class_waits_[static_cast<std::size_t>(work_class)], ms);
+}
+
 void Metrics::count_request(const std::string& method, bool ok) {
   std::lock_guard lock(mu_);
   ++requests_[{method, ok}];
 }
 
 void Metrics::observe(Stage stage, double ms) {
-  const double s = ms / 1000.0;
   std::lock_guard lock(mu_);
-  Histogram& h = stages_[stage];
-  std::size_t i = 0;
-  while (i < kBuckets.size() && s > kBuckets[i]) ++i;
-  ++h.counts[i];
-  ++h.count;
-  h.sum_s += s;
+  add_to(stages_[stage], ms);
 }
 
 void Metrics::add_gpu_ms(double ms) {
@@ -86,21 +117,28 @@ std::string Metrics::prometheus(const Gauges& g) const {
          "Render request latency by stage: queue wait, render (GPU + readback), PNG encode, "
          "and total time in the server.");
   for (int s = 0; s < kStageCount; ++s) {
-    const Histogram& h = stages_[s];
-    const std::string st = stage_name(static_cast<Stage>(s));
-    std::uint64_t cum = 0;
-    for (std::size_t i = 0; i < kBuckets.size(); ++i) {
-      cum += h.counts[i];
-      char le[32];
-      std::snprintf(le, sizeof le, "%g", kBuckets[i]);  // bucket bounds as written: "0.05"
-      o += "beamcast_stage_seconds_bucket{stage=\"" + st + "\",le=\"" + le + "\"} " +
-           std::to_string(cum) + "\n";
-    }
-    cum += h.counts.back();
-    o += "beamcast_stage_seconds_bucket{stage=\"" + st + "\",le=\"+Inf\"} " + std::to_string(cum) + "\n";
-    o += "beamcast_stage_seconds_sum{stage=\"" + st + "\"} " + num(h.sum_s) + "\n";
-    o += "beamcast_stage_seconds_count{stage=\"" + st + "\"} " + std::to_string(h.count) + "\n";
+    write_histogram(o, "beamcast_stage_seconds",
+                    std::string("stage=\"") + stage_name(static_cast<Stage>(s)) + "\"", stages_[s]);
   }
+  header(o, "beamcast_class_wait_seconds", "histogram",
+         "Render queue wait by scheduling class (interactive: quality auto; batch: the rest), "
+         "from arrival until the first slice reached a render worker.");
+  for (int c = 0; c < kClasses; ++c) {
+    write_histogram(o, "beamcast_class_wait_seconds",
+                    std::string("class=\"") + class_name(c) + "\"", class_waits_[c]);
+  }
+  header(o, "beamcast_class_queue_depth", "gauge",
+         "Render jobs with slices waiting for a GL worker, by scheduling class.");
+  for (int c = 0; c < kClasses; ++c) {
+    o += std::string("beamcast_class_queue_depth{class=\"") + class_name(c) + "\"} " +
+         std::to_string(g.class_queue_depth[c]) + "\n";
+  }
+  header(o, "beamcast_renders_cancelled_total", "counter",
+         "Renders stopped between slices because their client left.");
+  o += "beamcast_renders_cancelled_total " + std::to_string(g.renders_cancelled) + "\n";
+  header(o, "beamcast_slices_dropped_total", "counter",
+         "Render slices (GPU batches) not rendered because their client left.");
+  o += "beamcast_slices_dropped_total " + std::to_string(g.slices_dropped) + "\n";
   header(o, "beamcast_gpu_seconds_total", "counter", "GPU time of rendered frames (timer queries).");
   o += "beamcast_gpu_seconds_total " + num(gpu_s_) + "\n";
   header(o, "beamcast_frames_total", "counter", "Frames sent.");

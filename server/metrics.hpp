@@ -26,6 +26,11 @@ class Metrics {
   void count_request(const std::string& method, bool ok);
   void observe(Stage stage, double ms);
   void add_gpu_ms(double ms);
+  // Queue wait of a render by scheduling class (WorkClass: 0 interactive,
+  // 1 batch): from its arrival until its first slice reached a render worker.
+  static constexpr int kClasses = 2;
+  static const char* class_name(int c);
+  void observe_class_wait(int work_class, double ms);
 
   struct Gauges {
     int queue_depth = 0;
@@ -36,6 +41,9 @@ class Metrics {
     std::uint64_t bytes_out = 0;
     std::uint64_t renders_dropped = 0;
     std::uint64_t renderer_rebuilds = 0;
+    std::array<int, kClasses> class_queue_depth{};  // jobs with slices not yet taken
+    std::uint64_t renders_cancelled = 0;  // stopped between slices: the client left
+    std::uint64_t slices_dropped = 0;     // GPU batches not rendered for that reason
     std::map<std::string, std::uint64_t> errors;  // by code
     double uptime_s = 0;
   };
@@ -44,15 +52,17 @@ class Metrics {
 
   static const char* stage_name(Stage s);
 
- private:
   struct Histogram {
     std::array<std::uint64_t, kBuckets.size() + 1> counts{};  // last: +Inf
     std::uint64_t count = 0;
     double sum_s = 0;
   };
+
+ private:
   mutable std::mutex mu_;
   std::map<std::pair<std::string, bool>, std::uint64_t> requests_;
   std::array<Histogram, kStageCount> stages_{};
+  std::array<Histogram, kClasses> class_waits_{};
   double gpu_s_ = 0;
 };
 

@@ -23,6 +23,10 @@ Metrics::Gauges sample_gauges(const ServerCore& core) {
     g.inflight = core.renders->inflight();
     g.renders_dropped = core.renders->dropped();
     g.renderer_rebuilds = core.renders->renderer_rebuilds();
+    g.class_queue_depth = {core.renders->queued(WorkClass::kInteractive),
+                           core.renders->queued(WorkClass::kBatch)};
+    g.renders_cancelled = core.renders->cancelled();
+    g.slices_dropped = core.renders->slices_dropped();
   }
   return g;
 }

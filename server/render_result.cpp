@@ -3,6 +3,8 @@
 #include "protocol/base64.hpp"
 #include "protocol/check.hpp"
 
+#include <algorithm>
+
 namespace beamcast {
 
 QualityReport quality_report(const ControllerDecision& decision, const AccuracyLevel& level,
@@ -42,6 +44,8 @@ RenderResponse build_render_response(const RenderOutcome& out, const RenderResul
                                      std::vector<std::uint8_t>* binary) {
   // The service answers with one result per camera; one image each, or one atlas.
   BEAMCAST_CHECK(out.frames.size() <= ctx.cameras.size(), "a frame result without a camera");
+  BEAMCAST_CHECK(out.frame_index.empty() || out.frame_index.size() == out.frames.size(),
+                 "a camera index for every frame of a part");
   BEAMCAST_CHECK(out.pngs.size() == (out.atlas ? 1 : out.frames.size()),
                  "one image per frame, or one atlas");
   auto image = [&](RenderFrame& f, std::size_t i) {
@@ -61,11 +65,14 @@ RenderResponse build_render_response(const RenderOutcome& out, const RenderResul
   double readback_ms = 0.0;
   for (std::size_t i = 0; i < out.frames.size(); ++i) {
     const FrameResult& fr = out.frames[i];
+    // A streamed part carries some of the frames: each names its camera index.
+    const std::size_t cam = out.frame_index.empty() ? i : out.frame_index[i];
+    BEAMCAST_CHECK(cam < ctx.cameras.size(), "a frame's camera index within the request");
     RenderFrame f;
-    f.camera = frame_name(ctx.cameras[i], i);
-    f.index = i;
-    f.width = ctx.cameras[i].width;
-    f.height = ctx.cameras[i].height;
+    f.camera = frame_name(ctx.cameras[cam], cam);
+    f.index = cam;
+    f.width = ctx.cameras[cam].width;
+    f.height = ctx.cameras[cam].height;
     f.gpu_ms = fr.gpu_ms;
     f.pass_ms.emplace();
     for (const PassTiming& p : fr.passes) f.pass_ms->push_back({p.name, p.gpu_ms});
@@ -103,6 +110,7 @@ RenderResponse build_render_response(const RenderOutcome& out, const RenderResul
   r.timings =
       RenderTimings{out.queue_ms, out.render_ms, readback_ms, out.encode_wall_ms, ctx.server_ms};
   r.quality = ctx.quality;
+  if (ctx.stream) r.stream = StreamPart{std::max(0, out.part), out.last_part, ctx.cameras.size()};
   return r;
 }
 

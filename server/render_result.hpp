@@ -21,6 +21,7 @@ struct RenderResultContext {
   std::vector<std::string> planned_passes;  // reported when no frame ran
   int bit_depth = 8;                        // of PNG frames (JPEG frames are 8)
   bool base64 = false;                      // data_base64 instead of attachments
+  bool stream = false;                      // "stream": true: each part carries "stream"
   std::optional<QualityReport> quality;     // "quality": "auto" only
   double server_ms = 0.0;                   // arrival to response, measured by the caller
 };

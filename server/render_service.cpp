@@ -3,9 +3,14 @@
 #include <boost/asio/post.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <cstdio>
 #include <iterator>
 #include <optional>
+#include <tuple>
+#include <utility>
+
+#include "protocol/check.hpp"
 
 #include "render/gl_util.hpp"
 #include "render/image.hpp"
@@ -37,11 +42,135 @@ class GlFrameRenderer final : public FrameRenderer {
   Renderer renderer_;
 };
 
+// A job's cameras in slices of camera indices, as the renderer batches them:
+// cameras of one size in order of first appearance, at most max_batch_views
+// (and max_batch_pixels) per slice; one camera per slice where the renderer
+// does not batch (scaled frames, batching off). Never empty.
+std::vector<std::vector<std::size_t>> make_slices(const std::vector<Camera>& cameras,
+                                                  const FrameOptions& o) {
+  std::vector<std::vector<std::size_t>> slices;
+  // Scaled frames render one camera at a time (PlanInput::scaled).
+  const bool single = !o.batch || (o.resolution_scale > 0.0 && o.resolution_scale < 1.0);
+  std::vector<std::pair<int, int>> sizes;
+  std::vector<std::vector<std::size_t>> groups;
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const std::pair<int, int> size{cameras[i].width, cameras[i].height};
+    auto it = std::find(sizes.begin(), sizes.end(), size);
+    if (it == sizes.end()) {
+      sizes.push_back(size);
+      groups.emplace_back();
+      it = sizes.end() - 1;
+    }
+    groups[static_cast<std::size_t>(it - sizes.begin())].push_back(i);
+  }
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const std::int64_t pixels =
+        std::max<std::int64_t>(1, static_cast<std::int64_t>(sizes[g].first) * sizes[g].second);
+    const std::size_t cap =
+        single ? 1
+               : static_cast<std::size_t>(std::max<std::int64_t>(
+                     1, std::min<std::int64_t>(o.max_batch_views, o.max_batch_pixels / pixels)));
+    for (std::size_t at = 0; at < groups[g].size(); at += cap) {
+      const std::size_t end = std::min(groups[g].size(), at + cap);
+      slices.emplace_back(groups[g].begin() + static_cast<std::ptrdiff_t>(at),
+                          groups[g].begin() + static_cast<std::ptrdiff_t>(end));
+    }
+  }
+  if (slices.empty()) slices.emplace_back();  // no cameras: one empty render
+  return slices;
+}
+
 }  // namespace
+
+const char* work_class_name(WorkClass c) {
+  return c == WorkClass::kInteractive ? "interactive" : "batch";
+}
+
+// One unit of scheduling: a job (or jobs merged by the batch window) and how
+// far its slices have come.
+struct RenderService::Task {
+  std::vector<RenderJob> members;         // one, or several merged jobs
+  std::vector<Camera> cameras;            // every member's cameras, in order
+  std::vector<std::size_t> member_of;     // per camera: its member
+  std::vector<std::size_t> first_camera;  // per member: its first camera
+  std::vector<std::vector<std::size_t>> slices;
+  WorkClass cls = WorkClass::kBatch;
+  std::uint64_t client = 0;
+  const void* batch_key = nullptr;
+  FrameOptions options;  // the first member's: merged jobs share options by their key
+
+  // Guarded by the service's mu_.
+  std::size_t next_slice = 0;  // slices before it have been taken by a worker
+  bool started = false;
+  Clock::time_point start;
+
+  // Guarded by mu (frames, images: each element is written by one thread at
+  // a time, handed over through the queues).
+  std::mutex mu;
+  std::mutex emit_mu;  // parts and the completion go out in order, one at a time
+  std::vector<FrameResult> frames;
+  std::vector<std::vector<std::uint8_t>> images;
+  std::vector<char> is_jpeg;
+  std::vector<double> encode_ms;
+  std::vector<std::size_t> slice_left;  // frames of a slice still encoding
+  std::vector<Clock::time_point> slice_encode_start;
+  std::vector<char> slice_done;
+  std::size_t finished = 0;   // slices encoded or dropped
+  std::size_t next_part = 0;  // streaming: the next slice to send
+  int batches = 0;            // GPU batches rendered so far (frames' batch index)
+  double render_ms = 0.0;
+  double encode_wall_ms = 0.0;
+  std::optional<ErrorInfo> error;
+  bool cancelled = false;  // the clients had gone: the rest was not rendered
+
+  void add(RenderJob job) {
+    first_camera.push_back(cameras.size());
+    for (const Camera& c : job.cameras) {
+      cameras.push_back(c);
+      member_of.push_back(members.size());
+    }
+    members.push_back(std::move(job));
+  }
+  void prepare() {
+    const std::size_t n = cameras.size();
+    frames.resize(n);
+    images.resize(n);
+    is_jpeg.assign(n, 0);
+    encode_ms.assign(n, 0.0);
+    slice_left.assign(slices.size(), 0);
+    slice_encode_start.resize(slices.size());
+    slice_done.assign(slices.size(), 0);
+  }
+  bool any_alive() const {
+    return std::any_of(members.begin(), members.end(),
+                       [](const RenderJob& j) { return j.client_alive->load(); });
+  }
+  bool streamed() const { return members.size() == 1 && members[0].on_part != nullptr; }
+  // The frames of slice `s` as a part of the (single-job) streamed response.
+  RenderOutcome part(std::size_t s) {
+    RenderOutcome o;
+    o.part = static_cast<int>(s);
+    o.last_part = s + 1 == slices.size();
+    for (std::size_t i : slices[s]) {
+      o.frames.push_back(std::move(frames[i]));
+      o.pngs.push_back(std::move(images[i]));
+      o.is_jpeg.push_back(is_jpeg[i]);
+      o.encode_ms.push_back(encode_ms[i]);
+      o.frame_index.push_back(i);
+    }
+    o.queue_ms = ms_between(members[0].arrived, start);
+    o.render_ms = render_ms;
+    o.encode_wall_ms = encode_wall_ms;
+    o.slices = static_cast<int>(slices.size());
+    o.batched_views = static_cast<int>(cameras.size());
+    return o;
+  }
+};
 
 RendererFactory gl_renderer_factory(const RendererOptions& opts) {
   return [opts] { return std::make_unique<GlFrameRenderer>(opts); };
 }
+
 
 RenderService::RenderService(RendererFactory factory, int workers, int encode_threads,
                              int png_level, int png_filters, int max_inflight)
@@ -71,13 +200,31 @@ bool RenderService::submit(RenderJob job) {
   do {
     if (current >= max_inflight_) return false;
   } while (!inflight_.compare_exchange_weak(current, current + 1));
+  // Batch work submitted while a preview is active renders one camera per
+  // slice: on llvmpipe a batch of 4 costs what 4 single frames cost
+  // (docs/performance.md), and the preview then waits for one frame, not 4.
+  const std::int64_t now_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                                  Clock::now().time_since_epoch())
+                                  .count();
+  if (job.work_class == WorkClass::kInteractive) {
+    last_interactive_ms_.store(now_ms);
+  } else if (now_ms - last_interactive_ms_.load() < interactive_window_ms_.load()) {
+    job.options.max_batch_views = 1;
+  }
+  auto task = std::make_shared<Task>();
+  task->cls = job.work_class;
+  task->client = job.client;
+  task->batch_key = job.on_part ? nullptr : job.batch_key;  // a streamed job renders alone
+  task->options = job.options;
+  task->add(std::move(job));
+  task->slices = make_slices(task->cameras, task->options);
   {
     std::lock_guard lock(mu_);
     if (stopping_) {
       inflight_.fetch_sub(1);
       return false;
     }
-    queue_.push_back(std::move(job));
+    enqueue_locked(task, false);
   }
   cv_.notify_one();
   return true;
@@ -85,7 +232,14 @@ bool RenderService::submit(RenderJob job) {
 
 int RenderService::queued() const {
   std::lock_guard lock(mu_);
-  return static_cast<int>(queue_.size());
+  int n = 0;
+  for (const ClassQueue& q : queues_) n += q.tasks;
+  return n;
+}
+
+int RenderService::queued(WorkClass c) const {
+  std::lock_guard lock(mu_);
+  return queues_[static_cast<int>(c)].tasks;
 }
 
 void RenderService::finish(RenderJob& job, RenderOutcome&& outcome) {
@@ -108,6 +262,111 @@ std::unique_ptr<FrameRenderer> RenderService::make_renderer(int index) {
   }
 }
 
+void RenderService::enqueue_locked(const TaskPtr& task, bool front) {
+  ClassQueue& q = queues_[static_cast<int>(task->cls)];
+  std::deque<TaskPtr>& mine = q.by_client[task->client];
+  const bool was_empty = mine.empty();
+  if (front) {
+    mine.push_front(task);
+  } else {
+    mine.push_back(task);
+  }
+  ++q.tasks;
+  if (was_empty) {
+    if (front) {
+      q.turns.push_front(task->client);
+    } else {
+      q.turns.push_back(task->client);
+    }
+  }
+}
+
+bool RenderService::has_work_locked() const {
+  return std::any_of(queues_.begin(), queues_.end(),
+                     [](const ClassQueue& q) { return !q.turns.empty(); });
+}
+
+// The next slice: the first class with queued work (interactive before
+// batch); in it, the connection whose turn it is; of that connection's tasks,
+// the oldest. The connection then goes to the back of the turns, so a
+// connection with a deep pipeline gets one slice per round like any other.
+std::pair<RenderService::TaskPtr, std::size_t> RenderService::pick_locked(
+    std::unique_lock<std::mutex>& lock) {
+  for (;;) {
+    ClassQueue* q = nullptr;
+    for (ClassQueue& c : queues_) {
+      if (!c.turns.empty()) {
+        q = &c;
+        break;
+      }
+    }
+    if (q == nullptr) return {nullptr, 0};
+    const std::uint64_t client = q->turns.front();
+    q->turns.pop_front();
+    auto it = q->by_client.find(client);
+    BEAMCAST_CHECK(it != q->by_client.end() && !it->second.empty(),
+                   "a connection in the turns has queued work");
+    TaskPtr task = it->second.front();
+    if (!task->started) {
+      task->started = true;
+      if (task->batch_key != nullptr && batch_window_.count() > 0) {
+        // Out of the queue while its window runs (no other worker takes a
+        // slice of it meanwhile); back at the head of its turn after merging.
+        it->second.pop_front();
+        --q->tasks;
+        if (it->second.empty()) {
+          q->by_client.erase(it);
+        } else {
+          q->turns.push_front(client);
+        }
+        gather_batch(*task, lock);
+        task->start = Clock::now();
+        if (stopping_) {  // stop() drops it with the rest of the queue
+          enqueue_locked(task, true);
+          return {nullptr, 0};
+        }
+        task->prepare();
+        enqueue_locked(task, true);
+        continue;  // an interactive job may have come meanwhile
+      }
+      task->start = Clock::now();
+      task->prepare();
+    }
+    const std::size_t slice = task->next_slice++;
+    if (task->next_slice == task->slices.size()) {
+      it->second.pop_front();
+      --q->tasks;
+    }
+    if (it->second.empty()) {
+      q->by_client.erase(it);
+    } else {
+      q->turns.push_back(client);
+    }
+    return {task, slice};
+  }
+}
+
+// Takes the task's untaken slices out of the queue; returns how many.
+std::size_t RenderService::withdraw_locked(Task& task) {
+  const std::size_t left = task.slices.size() - task.next_slice;
+  if (left == 0) return 0;  // not queued any more
+  task.next_slice = task.slices.size();
+  ClassQueue& q = queues_[static_cast<int>(task.cls)];
+  auto it = q.by_client.find(task.client);
+  if (it == q.by_client.end()) return left;  // in a batch window, out of the queue
+  std::deque<TaskPtr>& mine = it->second;
+  const auto at = std::find_if(mine.begin(), mine.end(),
+                               [&](const TaskPtr& t) { return t.get() == &task; });
+  if (at == mine.end()) return left;
+  mine.erase(at);
+  --q.tasks;
+  if (mine.empty()) {
+    q.by_client.erase(it);
+    q.turns.erase(std::find(q.turns.begin(), q.turns.end(), task.client));
+  }
+  return left;
+}
+
 void RenderService::worker_main(int index) {
   std::unique_ptr<FrameRenderer> renderer = make_renderer(index);
   bool rebuild_pending = false;  // a GL error discarded the renderer, no new one yet
@@ -118,78 +377,45 @@ void RenderService::worker_main(int index) {
   ready_cv_.notify_all();
 
   for (;;) {
-    std::vector<RenderJob> jobs;
+    TaskPtr task;
+    std::size_t slice = 0;
     {
       std::unique_lock lock(mu_);
-      cv_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
-      if (queue_.empty()) return;  // stopping
-      RenderJob first = std::move(queue_.front());
-      queue_.pop_front();
-      jobs = gather_batch(std::move(first), lock);
+      cv_.wait(lock, [&] { return stopping_ || has_work_locked(); });
+      if (stopping_) return;  // stop() drops what is still queued
+      std::tie(task, slice) = pick_locked(lock);
     }
-    const auto start = Clock::now();
-    // Jobs whose client went away cost no GPU time.
-    std::vector<RenderJob> live;
-    for (RenderJob& job : jobs) {
-      if (!job.client_alive->load()) {
-        RenderOutcome out;
-        out.queue_ms = ms_between(job.arrived, start);
-        out.dropped = true;
-        dropped_.fetch_add(1);
-        finish(job, std::move(out));
-      } else {
-        live.push_back(std::move(job));
+    if (!task) continue;
+    // Between slices: a job whose clients have all gone costs no more GPU
+    // time. Its remaining slices leave the queue; nothing is answered.
+    if (!task->any_alive()) {
+      std::size_t withdrawn = 0;
+      {
+        std::lock_guard lock(mu_);
+        withdrawn = withdraw_locked(*task);
       }
-    }
-    if (live.empty()) continue;
-    std::vector<Camera> cameras;
-    for (const RenderJob& job : live) cameras.insert(cameras.end(), job.cameras.begin(), job.cameras.end());
-    std::optional<ErrorInfo> error;
-    std::vector<FrameResult> frames;
-    bool gl_failed = false;
-    if (!renderer) {
-      error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
-    } else {
-      try {
-        int inject = inject_failures_.load();
-        while (inject > 0 && !inject_failures_.compare_exchange_weak(inject, inject - 1)) {
+      bool first_cancel = false;
+      {
+        std::lock_guard lock(task->mu);
+        first_cancel = !task->cancelled;
+        task->cancelled = true;
+      }
+      if (first_cancel) {
+        if (slice == 0) {
+          dropped_.fetch_add(task->members.size());  // never reached the GPU
+        } else {
+          cancelled_.fetch_add(1);
         }
-        if (inject > 0) renderer->fail_next_render_for_test();
-        // Jobs share a render only with the same stored scene and default
-        // options (RenderJob::batch_key), so the first job's options hold for all.
-        frames = renderer->render(*live.front().scene, cameras, live.front().options);
-      } catch (const GlError& e) {
-        std::fprintf(stderr, "beamcast-server: render worker %d: GL error, rebuilding its context: %s\n",
-                     index, e.what());
-        error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
-        gl_failed = true;
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "beamcast-server: render failed: %s\n", e.what());
-        error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
       }
+      slices_dropped_.fetch_add(1 + withdrawn);
+      slices_finished(task, std::numeric_limits<std::size_t>::max(), 1 + withdrawn);
+      continue;
     }
-    const double render_ms = ms_between(start, Clock::now());
-    std::size_t at = 0;
-    for (RenderJob& job : live) {
-      RenderOutcome out;
-      out.queue_ms = ms_between(job.arrived, start);
-      out.batched_requests = static_cast<int>(live.size());
-      out.batched_views = static_cast<int>(cameras.size());
-      if (error) {
-        out.error = error;
-        finish(job, std::move(out));
-        continue;
-      }
-      out.render_ms = render_ms;
-      const std::size_t n = job.cameras.size();
-      out.frames.assign(std::make_move_iterator(frames.begin() + static_cast<std::ptrdiff_t>(at)),
-                        std::make_move_iterator(frames.begin() + static_cast<std::ptrdiff_t>(at + n)));
-      at += n;
-      encode_and_finish(std::move(job), std::move(out));
-    }
-    // After the failed jobs are answered: the old context goes before the
-    // new one is made current on this thread. A worker whose rebuild fails
-    // tries again before its next job (and answers `internal` meanwhile).
+    bool gl_failed = false;
+    run_slice(task, slice, renderer.get(), index, &gl_failed);
+    // After the failed job is answered: the old context goes before the new
+    // one is made current on this thread. A worker whose rebuild fails tries
+    // again before its next slice (and answers `internal` meanwhile).
     rebuild_pending = rebuild_pending || gl_failed;
     if (gl_failed || !renderer) {
       renderer.reset();
@@ -202,28 +428,226 @@ void RenderService::worker_main(int index) {
   }
 }
 
-std::vector<RenderJob> RenderService::gather_batch(RenderJob first,
-                                                   std::unique_lock<std::mutex>& lock) {
-  std::vector<RenderJob> jobs;
-  const void* key = first.batch_key;
-  const auto deadline = first.arrived + batch_window_;
-  int views = static_cast<int>(first.cameras.size());
-  jobs.push_back(std::move(first));
-  if (key == nullptr || batch_window_.count() <= 0) return jobs;
-  // Wait out the window on a condition of its own (so this worker swallows no
-  // wake-up meant for an idle one), then take the matching jobs.
-  window_cv_.wait_until(lock, deadline, [&] { return stopping_; });
-  for (auto it = queue_.begin(); it != queue_.end();) {
-    const int n = static_cast<int>(it->cameras.size());
-    if (it->batch_key == key && views + n <= batch_max_views_) {
-      views += n;
-      jobs.push_back(std::move(*it));
-      it = queue_.erase(it);
-    } else {
-      ++it;
+void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer* renderer,
+                              int index, bool* gl_failed) {
+  Task& task = *t;
+  const std::vector<std::size_t>& idx = task.slices[slice];
+  std::vector<Camera> cameras;
+  cameras.reserve(idx.size());
+  for (std::size_t i : idx) cameras.push_back(task.cameras[i]);
+  std::optional<ErrorInfo> error;
+  std::vector<FrameResult> frames;
+  const auto start = Clock::now();
+  if (!renderer) {
+    error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
+  } else {
+    try {
+      int inject = inject_failures_.load();
+      while (inject > 0 && !inject_failures_.compare_exchange_weak(inject, inject - 1)) {
+      }
+      if (inject > 0) renderer->fail_next_render_for_test();
+      // Merged jobs share a render only with the same stored scene and default
+      // options (RenderJob::batch_key), so the first job's options hold for all.
+      frames = renderer->render(*task.members.front().scene, cameras, task.options);
+      BEAMCAST_CHECK(frames.size() == cameras.size(), "one frame per camera of a slice");
+    } catch (const GlError& e) {
+      std::fprintf(stderr, "beamcast-server: render worker %d: GL error, rebuilding its context: %s\n",
+                   index, e.what());
+      error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
+      *gl_failed = true;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "beamcast-server: render failed: %s\n", e.what());
+      error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
     }
   }
-  return jobs;
+  const double render_ms = ms_between(start, Clock::now());
+  if (error) {
+    // The job is answered with the error: its other slices are not rendered.
+    std::size_t withdrawn = 0;
+    {
+      std::lock_guard lock(mu_);
+      withdrawn = withdraw_locked(task);
+    }
+    {
+      std::lock_guard lock(task.mu);
+      task.render_ms += render_ms;
+      if (!task.error) task.error = error;
+    }
+    slices_finished(t, std::numeric_limits<std::size_t>::max(), 1 + withdrawn);
+    return;
+  }
+  std::vector<std::size_t> encode;  // frames that get their own image (not atlas tiles)
+  {
+    std::lock_guard lock(task.mu);
+    task.render_ms += render_ms;
+    int batches = 0;
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      batches = std::max(batches, frames[k].batch.index + 1);
+      frames[k].batch.index += task.batches;  // batches counted over the whole job
+      task.frames[idx[k]] = std::move(frames[k]);
+      if (!task.members[task.member_of[idx[k]]].atlas) encode.push_back(idx[k]);
+    }
+    task.batches += batches;
+    task.slice_left[slice] = encode.size();
+    task.slice_encode_start[slice] = Clock::now();
+  }
+  if (encode.empty()) {
+    slices_finished(t, slice, 0);
+    return;
+  }
+  // Each frame on the encoder pool; this worker goes on to the next slice.
+  for (std::size_t i : encode) {
+    post_encode(task.cls, [this, t, slice, i] {
+      Task& task = *t;
+      const RenderJob& job = task.members[task.member_of[i]];
+      const auto t0 = Clock::now();
+      Image& img = task.frames[i].image;
+      bool png = !job.jpeg || img.rgb.empty();
+      std::vector<std::uint8_t> bytes;
+      if (!png) {
+        try {
+          bytes = encode_jpeg(img, job.jpeg_quality);
+        } catch (const std::exception& e) {
+          // Never expected of a valid image; the frame still goes out, as PNG.
+          std::fprintf(stderr, "beamcast-server: %s; sending PNG\n", e.what());
+          png = true;
+        }
+      }
+      if (png) bytes = encode_png(img, png_level_, png_filters_);
+      const auto t1 = Clock::now();
+      bool slice_complete = false;
+      {
+        std::lock_guard lock(task.mu);
+        task.images[i] = std::move(bytes);
+        task.is_jpeg[i] = png ? 0 : 1;
+        task.encode_ms[i] = ms_between(t0, t1);
+        img.rgb = {};  // the encoded image is what travels; free the pixels now
+        slice_complete = --task.slice_left[slice] == 0;
+        if (slice_complete) task.encode_wall_ms += ms_between(task.slice_encode_start[slice], t1);
+      }
+      if (slice_complete) slices_finished(t, slice, 0);
+    });
+  }
+}
+
+// Marks `slice` done (none: max) and `dropped` more slices finished; sends the
+// streamed parts that are ready, in slice order, and completes the task once
+// every slice is finished. Parts and completion are serialized by emit_mu,
+// so they leave in order whichever thread finishes which slice.
+void RenderService::slices_finished(const TaskPtr& t, std::size_t slice, std::size_t dropped) {
+  Task& task = *t;
+  std::lock_guard emit(task.emit_mu);
+  std::vector<RenderOutcome> parts;
+  bool all = false;
+  {
+    std::lock_guard lock(task.mu);
+    if (slice != std::numeric_limits<std::size_t>::max()) {
+      task.slice_done[slice] = 1;
+      ++task.finished;
+    }
+    task.finished += dropped;
+    all = task.finished == task.slices.size();
+    // The last slice goes with the completion (done), not as a part.
+    if (task.streamed() && !task.error && !task.cancelled) {
+      while (task.next_part + 1 < task.slices.size() && task.slice_done[task.next_part]) {
+        parts.push_back(task.part(task.next_part++));
+      }
+    }
+  }
+  for (RenderOutcome& p : parts) {
+    if (task.members[0].client_alive->load()) task.members[0].on_part(std::move(p));
+  }
+  if (all) complete(task);
+}
+
+// Every slice is finished: each member job gets its outcome.
+void RenderService::complete(Task& task) {
+  const auto now = Clock::now();
+  for (std::size_t m = 0; m < task.members.size(); ++m) {
+    RenderJob& job = task.members[m];
+    RenderOutcome out;
+    out.queue_ms = ms_between(job.arrived, task.started ? task.start : now);
+    out.batched_requests = static_cast<int>(task.members.size());
+    out.batched_views = static_cast<int>(task.cameras.size());
+    out.render_ms = task.render_ms;
+    out.encode_wall_ms = task.encode_wall_ms;
+    out.slices = static_cast<int>(task.slices.size());
+    if (task.cancelled || !job.client_alive->load()) {
+      out.dropped = true;
+      finish(job, std::move(out));
+      continue;
+    }
+    if (task.error) {
+      out.error = task.error;
+      finish(job, std::move(out));
+      continue;
+    }
+    if (task.streamed()) {
+      out = task.part(task.slices.size() - 1);
+      out.queue_ms = ms_between(job.arrived, task.start);
+      finish(job, std::move(out));
+      continue;
+    }
+    const std::size_t first = task.first_camera[m];
+    const std::size_t n = job.cameras.size();
+    for (std::size_t i = first; i < first + n; ++i) out.frames.push_back(std::move(task.frames[i]));
+    if (job.atlas && !out.frames.empty()) {
+      // One image of all the job's frames: composed and encoded here, once
+      // every slice is in.
+      const auto t0 = Clock::now();
+      std::vector<const Image*> images;
+      for (const FrameResult& f : out.frames) images.push_back(&f.image);
+      out.atlas = make_atlas(images);
+      for (FrameResult& f : out.frames) f.image.rgb = {};
+      out.pngs.push_back(encode_png(out.atlas->image, png_level_, png_filters_));
+      out.atlas->image.rgb = {};
+      out.is_jpeg.push_back(0);
+      out.encode_ms.push_back(ms_between(t0, Clock::now()));
+      out.encode_wall_ms += out.encode_ms.back();
+    } else {
+      for (std::size_t i = first; i < first + n; ++i) {
+        out.pngs.push_back(std::move(task.images[i]));
+        out.is_jpeg.push_back(task.is_jpeg[i]);
+        out.encode_ms.push_back(task.encode_ms[i]);
+      }
+    }
+    finish(job, std::move(out));
+  }
+}
+
+void RenderService::gather_batch(Task& first, std::unique_lock<std::mutex>& lock) {
+  // Wait out the window on a condition of its own (so this worker swallows no
+  // wake-up meant for an idle one), then take the matching queued jobs.
+  const auto deadline = first.members.front().arrived + batch_window_;
+  window_cv_.wait_until(lock, deadline, [&] { return stopping_; });
+  int views = static_cast<int>(first.cameras.size());
+  ClassQueue& q = queues_[static_cast<int>(first.cls)];
+  for (auto c = q.by_client.begin(); c != q.by_client.end();) {
+    std::deque<TaskPtr>& mine = c->second;
+    for (auto it = mine.begin(); it != mine.end();) {
+      Task& other = **it;
+      const int n = static_cast<int>(other.cameras.size());
+      if (!other.started && other.batch_key == first.batch_key && views + n <= batch_max_views_) {
+        views += n;
+        for (RenderJob& job : other.members) first.add(std::move(job));
+        it = mine.erase(it);
+        --q.tasks;
+      } else {
+        ++it;
+      }
+    }
+    if (mine.empty()) {
+      q.turns.erase(std::find(q.turns.begin(), q.turns.end(), c->first));
+      c = q.by_client.erase(c);
+    } else {
+      ++c;
+    }
+  }
+  first.slices = make_slices(first.cameras, first.options);
+}
+
+void RenderService::set_interactive_window(std::chrono::milliseconds window) {
+  interactive_window_ms_.store(window.count());
 }
 
 void RenderService::set_batch_window(std::chrono::milliseconds window, int max_views) {
@@ -232,76 +656,59 @@ void RenderService::set_batch_window(std::chrono::milliseconds window, int max_v
   batch_max_views_ = std::max(1, max_views);
 }
 
-// Encodes every frame in parallel on the CPU pool; the last one to finish
-// completes the job, while the worker moves on to the next render.
-void RenderService::encode_and_finish(RenderJob job, RenderOutcome out) {
-  struct EncodeState {
-    RenderJob job;
-    RenderOutcome out;
-    std::atomic<std::size_t> remaining;
-    Clock::time_point start;
-  };
-  if (job.atlas && !out.frames.empty()) {
-    std::vector<const Image*> images;
-    for (const FrameResult& f : out.frames) images.push_back(&f.image);
-    out.atlas = make_atlas(images);
-    for (FrameResult& f : out.frames) f.image.rgb = {};
+// One pool task per queued encode; each runs the most urgent queued encode,
+// so an interactive frame is encoded before the batch frames queued ahead of it.
+void RenderService::post_encode(WorkClass c, std::function<void()> fn) {
+  {
+    std::lock_guard lock(encode_mu_);
+    encode_queue_[static_cast<int>(c)].push_back(std::move(fn));
   }
-  // One PNG per frame, or the atlas alone.
-  const std::size_t n = out.atlas ? 1 : out.frames.size();
-  auto st = std::make_shared<EncodeState>();
-  st->out = std::move(out);
-  st->out.pngs.resize(n);
-  st->out.encode_ms.resize(n);
-  st->out.is_jpeg.assign(n, 0);
-  st->remaining = n;
-  st->start = Clock::now();
-  st->job = std::move(job);
-  for (std::size_t i = 0; i < n; ++i) {
-    boost::asio::post(encoders_, [this, st, i] {
-      const auto t0 = Clock::now();
-      Image& img = st->out.atlas ? st->out.atlas->image : st->out.frames[i].image;
-      bool png = !st->job.jpeg || img.rgb.empty();
-      if (!png) {
-        try {
-          st->out.pngs[i] = encode_jpeg(img, st->job.jpeg_quality);
-        } catch (const std::exception& e) {
-          // Never expected of a valid image; the frame still goes out, as PNG.
-          std::fprintf(stderr, "beamcast-server: %s; sending PNG\n", e.what());
-          png = true;
+  boost::asio::post(encoders_, [this] {
+    std::function<void()> next;
+    {
+      std::lock_guard lock(encode_mu_);
+      for (auto& q : encode_queue_) {
+        if (!q.empty()) {
+          next = std::move(q.front());
+          q.pop_front();
+          break;
         }
       }
-      if (png) st->out.pngs[i] = encode_png(img, png_level_, png_filters_);
-      st->out.is_jpeg[i] = png ? 0 : 1;
-      st->out.encode_ms[i] = ms_between(t0, Clock::now());
-      img.rgb = {};  // the PNG is what travels; free the pixels now
-      if (st->remaining.fetch_sub(1) == 1) {
-        st->out.encode_wall_ms = ms_between(st->start, Clock::now());
-        finish(st->job, std::move(st->out));
-      }
-    });
-  }
-  if (n == 0) finish(st->job, std::move(st->out));
+    }
+    if (next) next();
+  });
 }
 
 void RenderService::stop() {
-  std::deque<RenderJob> left;
   {
     std::lock_guard lock(mu_);
     if (stopping_ && workers_.empty()) return;
     stopping_ = true;
-    left.swap(queue_);
   }
   cv_.notify_all();
   window_cv_.notify_all();
   for (auto& t : workers_) t.join();
   workers_.clear();
-  encoders_.join();
-  for (auto& job : left) {
-    RenderOutcome out;
-    out.dropped = true;
-    finish(job, std::move(out));
+  // What is still queued is dropped (slices of a job being encoded included:
+  // that job completes as dropped when its encodes are done).
+  std::vector<std::pair<TaskPtr, std::size_t>> left;
+  {
+    std::lock_guard lock(mu_);
+    for (ClassQueue& q : queues_) {
+      std::vector<TaskPtr> tasks;
+      for (auto& [client, mine] : q.by_client) tasks.insert(tasks.end(), mine.begin(), mine.end());
+      for (const TaskPtr& t : tasks) left.emplace_back(t, withdraw_locked(*t));
+    }
   }
+  for (auto& [t, n] : left) {
+    {
+      std::lock_guard lock(t->mu);
+      t->cancelled = true;
+      if (t->frames.size() != t->cameras.size()) t->prepare();  // never started
+    }
+    slices_finished(t, std::numeric_limits<std::size_t>::max(), n);
+  }
+  encoders_.join();
 }
 
 }  // namespace beamcast

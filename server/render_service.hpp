@@ -1,13 +1,22 @@
-// Render work: a bounded queue, worker threads that each own a renderer (and
-// so a GL context), and a CPU pool that encodes frames to PNG in parallel.
+// Render work: a bounded set of admitted jobs, worker threads that each own a
+// renderer (and so a GL context), and a CPU pool that encodes frames to PNG in
+// parallel. A job is rendered in slices of at most FrameOptions::max_batch_views
+// cameras (one GPU batch each); each slice's frames are encoded while the next
+// slice renders, and between slices the scheduler picks what runs next:
+// interactive work before batch work, connections of one class in turn, and a
+// job whose client has gone stops (PROTOCOL.md, "Scheduling").
 // Sockets never reach here; GL never leaves the renderer behind FrameRenderer.
 #pragma once
 
+#include <array>
 #include <atomic>
+#include <cstdint>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <functional>
+#include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -49,6 +58,13 @@ using RendererFactory = std::function<std::unique_ptr<FrameRenderer>()>;
 // The GPU renderer (render/) behind the interface.
 RendererFactory gl_renderer_factory(const RendererOptions& opts);
 
+// The scheduling class of a job (PROTOCOL.md, "Scheduling"): interactive
+// frames (`quality: "auto"`, the preview) are served before batch work, slice
+// by slice; within a class connections take turns.
+enum class WorkClass { kInteractive = 0, kBatch = 1 };
+inline constexpr int kWorkClasses = 2;
+const char* work_class_name(WorkClass c);
+
 struct RenderOutcome {
   bool dropped = false;  // the client went away before the job reached the GPU
   std::optional<ErrorInfo> error;
@@ -56,9 +72,21 @@ struct RenderOutcome {
   std::vector<std::vector<std::uint8_t>> pngs;  // encoded frames (JPEG when RenderJob::jpeg)
   std::vector<char> is_jpeg;      // per frame: 1 if encoded as JPEG
   std::vector<double> encode_ms;  // per frame
+  // The request's camera index of each frame (empty: frame i is camera i).
+  // Set for the parts of a streamed job, which carry a slice's frames each.
+  std::vector<std::size_t> frame_index;
+  // Streamed jobs (RenderJob::on_part): this outcome's part number, and
+  // whether it is the last one (the one passed to `done`).
+  int part = -1;
+  bool last_part = true;
   double queue_ms = 0.0;
+  // The renderer's wall time for this job: the sum over its slices.
   double render_ms = 0.0;
+  // Encoding wall time: per slice, from its first frame's encode start to its
+  // last one's end, summed (slices encode while later slices render).
   double encode_wall_ms = 0.0;
+  // Slices (GPU batches) the job was rendered in.
+  int slices = 0;
   // Cross-request batching (RenderService::set_batch_window): how many
   // requests and views shared this job's render call (1 and its own cameras'
   // count when it rendered alone).
@@ -72,7 +100,9 @@ struct RenderOutcome {
 struct RenderJob {
   std::shared_ptr<const Scene> scene;
   std::vector<Camera> cameras;
-  FrameOptions options;    // resolution scale of `quality: "auto"` frames
+  // Resolution scale of `quality: "auto"` frames; max_batch_views is also the
+  // size of the slices the service renders the job in.
+  FrameOptions options;
   bool jpeg = false;       // encode as JPEG (interactive frames) instead of PNG
   int jpeg_quality = 90;
   std::shared_ptr<const std::atomic<bool>> client_alive;
@@ -81,6 +111,14 @@ struct RenderJob {
   // within the batch window are rendered in one call; null: never merged.
   const void* batch_key = nullptr;
   bool atlas = false;  // encode the frames as one atlas image (render/atlas.hpp)
+  WorkClass work_class = WorkClass::kBatch;
+  // The connection it came from: connections of one class take turns.
+  std::uint64_t client = 0;
+  // Streaming (render param "stream"): if set, called for every slice but the
+  // last, in slice order, with that slice's frames (RenderOutcome::part,
+  // frame_index); the last slice's frames then come to `done`. Never merged
+  // with other jobs (batch_key must be null).
+  std::function<void(RenderOutcome&&)> on_part;
   // Called exactly once, on a worker or encoder thread.
   std::function<void(RenderOutcome&&)> done;
 };
@@ -101,12 +139,23 @@ class RenderService {
   // job renders as soon as a worker is free.
   void set_batch_window(std::chrono::milliseconds window, int max_views);
 
+  // While interactive work is about (an interactive job was submitted within
+  // `window`), batch jobs submitted are sliced one camera at a time, so a
+  // preview frame waits for at most one batch frame; 0: always full slices.
+  void set_interactive_window(std::chrono::milliseconds window);
+
   // False if `max_inflight` jobs are already accepted and unanswered (busy).
   bool submit(RenderJob job);
   int inflight() const { return inflight_.load(); }
+  // Jobs with slices not yet taken by a worker (all classes, or one).
   int queued() const;
+  int queued(WorkClass c) const;
   // Jobs dropped because their client had gone (never rendered).
   std::uint64_t dropped() const { return dropped_.load(); }
+  // Jobs stopped between slices because their client had gone, and the
+  // slices (GPU batches) that were therefore never rendered.
+  std::uint64_t cancelled() const { return cancelled_.load(); }
+  std::uint64_t slices_dropped() const { return slices_dropped_.load(); }
   // Renderers discarded and recreated after a render threw GlError: a GL
   // error leaves the context in an unknown state, so the worker answers the
   // failed jobs `internal` and builds a new renderer (a new EGL context)
@@ -121,36 +170,68 @@ class RenderService {
   void stop();
 
  private:
+  struct Task;
+  using TaskPtr = std::shared_ptr<Task>;
   void worker_main(int index);
   // Creates a renderer on the calling (worker) thread; null, with the reason
   // in failure_, if it cannot.
   std::unique_ptr<FrameRenderer> make_renderer(int index);
   void finish(RenderJob& job, RenderOutcome&& outcome);
-  // Takes the queued jobs that may join `first` (same batch key) once its
+  // Scheduling, with mu_ held: queue a task at its connection's turn; take the
+  // next slice (interactive class first, connections in turn); take a task's
+  // remaining slices out of the queue.
+  void enqueue_locked(const TaskPtr& task, bool front);
+  bool has_work_locked() const;
+  std::pair<TaskPtr, std::size_t> pick_locked(std::unique_lock<std::mutex>& lock);
+  std::size_t withdraw_locked(Task& task);
+  // Merges the queued tasks that may join `first` (same batch key) once its
   // window has passed; called with `lock` held, may wait on it.
-  std::vector<RenderJob> gather_batch(RenderJob first, std::unique_lock<std::mutex>& lock);
-  void encode_and_finish(RenderJob job, RenderOutcome out);
+  void gather_batch(Task& first, std::unique_lock<std::mutex>& lock);
+  // One slice: render it and hand its frames to the encoders.
+  void run_slice(const TaskPtr& task, std::size_t slice, FrameRenderer* renderer, int index,
+                 bool* gl_failed);
+  // `slice` of `task` is finished (encoded; none: SIZE_MAX) and `dropped`
+  // more (never rendered); streamed parts go out in order, and the last
+  // finished slice completes the task's jobs.
+  void slices_finished(const TaskPtr& task, std::size_t slice, std::size_t dropped);
+  void complete(Task& task);
+  // The encoder pool runs interactive frames' encodes before batch ones.
+  void post_encode(WorkClass c, std::function<void()> fn);
 
   RendererFactory factory_;
   int png_level_;
   int png_filters_;
   int max_inflight_;
   std::chrono::milliseconds batch_window_{0};
+  std::atomic<std::int64_t> interactive_window_ms_{1000};
+  std::atomic<std::int64_t> last_interactive_ms_{std::numeric_limits<std::int64_t>::min() / 2};
   int batch_max_views_ = 64;
   std::atomic<int> inflight_{0};
   std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<std::uint64_t> cancelled_{0};
+  std::atomic<std::uint64_t> slices_dropped_{0};
   std::atomic<std::uint64_t> rebuilds_{0};
   std::atomic<int> inject_failures_{0};
   mutable std::mutex mu_;
   std::condition_variable cv_;
   std::condition_variable window_cv_;  // batch windows wait here (stop() wakes them)
-  std::deque<RenderJob> queue_;
+  // Per class: each connection's queued tasks (in arrival order), and the
+  // connections with queued tasks in turn order (a connection is in `turns`
+  // exactly when its deque is non-empty).
+  struct ClassQueue {
+    std::map<std::uint64_t, std::deque<TaskPtr>> by_client;
+    std::deque<std::uint64_t> turns;
+    int tasks = 0;
+  };
+  std::array<ClassQueue, kWorkClasses> queues_;
   bool stopping_ = false;
   int ready_ = 0;
   std::string description_;
   std::string failure_;
   std::condition_variable ready_cv_;
   std::vector<SizedThread> workers_;  // each owns a GL context
+  std::mutex encode_mu_;
+  std::array<std::deque<std::function<void()>>, kWorkClasses> encode_queue_;
   boost::asio::thread_pool encoders_;
 };
 

@@ -72,6 +72,8 @@ json hello_result(const ServerCore& core, const json& params) {
                        {"quality", {"full", "auto"}},
                        {"encodings", {"binary", "base64"}},
                        {"batch_window_ms", core.config.batch_window_ms},
+                       {"stream", true},
+                       {"scheduling", {{"classes", {"interactive", "batch"}}, {"slice_views", FrameOptions{}.max_batch_views}}},
                        {"passes", passes}};
   capabilities.update(scene_capabilities());
   return {{"protocol", kProtocolVersion},
@@ -196,22 +198,43 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   job.client_alive = session->alive_flag();
   job.atlas = rp.atlas;
   job.arrived = arrived;
+  // Scheduling (PROTOCOL.md, "Scheduling"): the preview's frames before batch
+  // work; connections of one class in turn.
+  job.work_class = decision ? WorkClass::kInteractive : WorkClass::kBatch;
+  job.client = session->id();
   if (decision) {
     job.options.resolution_scale = decision->still ? 1.0 : level.scale;
     job.jpeg = !decision->still && rp.quality->jpeg;
     job.jpeg_quality = level.jpeg_quality;
   }
   // Only an unmodified stored scene at full quality may share a render with
-  // other requests (a batch renders with one set of options).
-  if (stored && !rp.output && !decision) job.batch_key = stored.get();
-  RenderResultContext ctx;
-  ctx.cameras = cameras;
-  ctx.planned_passes = plan_passes(*scene);
-  ctx.bit_depth = scene->output.bit_depth;
-  ctx.base64 = rp.base64;
-  job.done = [&core, session, id, arrived, ctx = std::move(ctx), decision, level, ladder_size,
-              budget_ms, jpeg = job.jpeg, jpeg_quality = job.jpeg_quality](
-                 RenderOutcome&& out) mutable {
+  // other requests (a batch renders with one set of options); a streamed
+  // render never does.
+  if (stored && !rp.output && !decision && !rp.stream) job.batch_key = stored.get();
+  auto ctx = std::make_shared<RenderResultContext>();
+  ctx->cameras = cameras;
+  ctx->planned_passes = plan_passes(*scene);
+  ctx->bit_depth = scene->output.bit_depth;
+  ctx->base64 = rp.base64;
+  ctx->stream = rp.stream;
+  // One response message: the whole result, or one part of a streamed one.
+  // Parts and the final message never run concurrently (RenderService).
+  auto send_result = [&core, session, id, arrived, ctx](const RenderOutcome& out) {
+    ctx->server_ms = ms_since(arrived);
+    std::vector<std::uint8_t> binary;
+    json result = to_json(build_render_response(out, *ctx, &binary));
+    core.stats.count_frames(out.frames.size());
+    for (const FrameResult& fr : out.frames) core.metrics.add_gpu_ms(fr.gpu_ms);
+    json timings = result["timings"];
+    session->send(ok_response(id, std::move(result)), std::move(binary));
+    return timings;
+  };
+  if (rp.stream) {
+    job.on_part = [send_result](RenderOutcome&& part) { send_result(part); };
+  }
+  job.done = [&core, session, id, arrived, ctx, send_result, decision, level, ladder_size,
+              budget_ms, jpeg = job.jpeg, jpeg_quality = job.jpeg_quality,
+              work_class = job.work_class](RenderOutcome&& out) mutable {
     session->end_render();
     if (out.dropped) return;
     if (out.error) {
@@ -230,21 +253,17 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
           st.controller->observe(decision->level, frame_ms, steady_ms(Clock::now()));
         }
       }
-      ctx.quality =
+      ctx->quality =
           quality_report(*decision, level, ladder_size, budget_ms, jpeg, jpeg_quality, frame_ms);
     }
-    ctx.server_ms = ms_since(arrived);
-    std::vector<std::uint8_t> binary;
-    json result = to_json(build_render_response(out, ctx, &binary));
-    core.stats.count_frames(out.frames.size());
     core.metrics.count_request("render", true);
     core.metrics.observe(Metrics::kQueue, out.queue_ms);
+    core.metrics.observe_class_wait(static_cast<int>(work_class), out.queue_ms);
     core.metrics.observe(Metrics::kRender, out.render_ms);
     core.metrics.observe(Metrics::kEncode, out.encode_wall_ms);
     core.metrics.observe(Metrics::kTotal, ms_since(arrived));
-    for (const FrameResult& fr : out.frames) core.metrics.add_gpu_ms(fr.gpu_ms);
-    log_request(core, id, "render", "ok", result["timings"]);
-    session->send(ok_response(id, std::move(result)), std::move(binary));
+    const json timings = send_result(out);
+    log_request(core, id, "render", "ok", timings);
   };
   if (!core.renders->submit(std::move(job))) {
     session->end_render();
@@ -310,6 +329,11 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
       s["inflight"] = core.renders->inflight();
       s["queue_depth"] = core.renders->queued();
       s["renders_dropped"] = core.renders->dropped();
+      s["renders_cancelled"] = core.renders->cancelled();
+      s["slices_dropped"] = core.renders->slices_dropped();
+      s["queue_depth_by_class"] = {
+          {"interactive", core.renders->queued(WorkClass::kInteractive)},
+          {"batch", core.renders->queued(WorkClass::kBatch)}};
       s["renderer_rebuilds"] = core.renders->renderer_rebuilds();
       s["scenes"] = {{"count", core.scenes.count()}, {"bytes", core.scenes.bytes()}};
       session->send(ok_response(id, std::move(s)));

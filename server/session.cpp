@@ -266,6 +266,7 @@ void Session::close_now() {
   if (closed_) return;
   closed_ = true;
   mark_gone();  // queued renders of this client are dropped
+  core_.stats.connection_gone();
   state_ = ReadState::kStopped;
   read_timer_.cancel();
   write_timer_.cancel();

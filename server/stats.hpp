@@ -23,6 +23,10 @@ class ServerStats {
     ++connections_total_;
   }
   void connection_closed() { --connections_open_; }
+  // A connection was closed on the network side (its renders are dropped from
+  // then on; the object lives until its last render completes).
+  void connection_gone() { ++connections_gone_; }
+  std::uint64_t connections_gone() const { return connections_gone_.load(); }
   int connections_open() const { return connections_open_.load(); }
   std::uint64_t errors(const std::string& code) const;
 
@@ -37,6 +41,7 @@ class ServerStats {
   std::atomic<std::uint64_t> bytes_out_{0};
   std::atomic<int> connections_open_{0};
   std::atomic<std::uint64_t> connections_total_{0};
+  std::atomic<std::uint64_t> connections_gone_{0};
 };
 
 }  // namespace beamcast

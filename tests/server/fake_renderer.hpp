@@ -1,11 +1,19 @@
 // A FrameRenderer without GL for the server's logic tests: each frame is one
 // flat grey at the scene's bit depth, and the next render can be made to fail
-// with a GL error or with another exception. The GL integration tests
+// with a GL error or with another exception. It records the cameras of every
+// render call in order, and can hold renders (hold_after) so that a test
+// queues work behind a render in progress and then sees what the scheduler
+// runs next, without timing anything. The GL integration tests
 // (test_server.cpp, test_renderer_rebuild.cpp) keep the real renderer.
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
+#include <limits>
 #include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
 #include <stdexcept>
 #include <utility>
 
@@ -18,6 +26,43 @@ struct FakeRendererControl {
   std::atomic<int> created{0};          // renderers the factory has made
   std::atomic<bool> fail_other{false};  // next render throws std::runtime_error
   static constexpr std::uint16_t kGrey8 = 100;
+
+  // Render calls beyond the first `n` wait (recorded, not returning) until
+  // release().
+  void hold_after(std::size_t n) {
+    std::lock_guard lock(mu);
+    allowed = n;
+  }
+  void release() {
+    {
+      std::lock_guard lock(mu);
+      allowed = std::numeric_limits<std::size_t>::max();
+    }
+    cv.notify_all();
+  }
+  std::size_t call_count() {
+    std::lock_guard lock(mu);
+    return calls.size();
+  }
+  // The camera names of each render call so far, in call order.
+  std::vector<std::vector<std::string>> call_log() {
+    std::lock_guard lock(mu);
+    return calls;
+  }
+  // Called by the renderer: records the call and waits while it is held.
+  void enter(const std::vector<Camera>& cameras) {
+    std::unique_lock lock(mu);
+    std::vector<std::string> names;
+    for (const Camera& c : cameras) names.push_back(c.name);
+    calls.push_back(std::move(names));
+    const std::size_t me = calls.size();
+    cv.wait(lock, [&] { return me <= allowed; });
+  }
+
+  std::mutex mu;
+  std::condition_variable cv;
+  std::vector<std::vector<std::string>> calls;
+  std::size_t allowed = std::numeric_limits<std::size_t>::max();
 };
 
 class FakeFrameRenderer final : public FrameRenderer {
@@ -30,6 +75,7 @@ class FakeFrameRenderer final : public FrameRenderer {
   std::vector<FrameResult> render(const Scene& scene, const std::vector<Camera>& cameras) override {
     if (std::exchange(fail_gl_next_, false)) throw GlError("fake: injected GL error");
     if (control_->fail_other.exchange(false)) throw std::runtime_error("fake: not a GL error");
+    control_->enter(cameras);
     std::vector<FrameResult> frames(cameras.size());
     for (std::size_t i = 0; i < cameras.size(); ++i) {
       Image& img = frames[i].image;

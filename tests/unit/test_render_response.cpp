@@ -70,6 +70,24 @@ TEST(RenderResponse, ReadsTheExampleFields) {
   EXPECT_FALSE(a.frames[0].atlas->tiles[0].format);
 }
 
+// A streamed part (PROTOCOL.md, "Streaming"): "stream" round-trips, and a bad
+// field in it names its pointer.
+TEST(RenderResponse, StreamPartRoundTrips) {
+  json j = protocol_example();
+  j["stream"] = {{"part", 2}, {"last", false}, {"frames", 16}};
+  const RenderResponse r = render_response_from_json(j);
+  EXPECT_EQ(r.stream, (StreamPart{2, false, 16}));
+  EXPECT_EQ(to_json(r), j);
+  EXPECT_FALSE(render_response_from_json(protocol_example()).stream);
+  j["stream"]["last"] = "no";
+  try {
+    render_response_from_json(j, "/result");
+    FAIL() << "a non-boolean stream.last was accepted";
+  } catch (const ProtocolError& e) {
+    EXPECT_EQ(e.info().path, "/result/stream/last");
+  }
+}
+
 TEST(RenderResponse, UnknownKeysAreIgnored) {
   json j = protocol_example();
   j["added_later"] = {1, 2};
