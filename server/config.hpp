@@ -34,6 +34,17 @@ struct ServerConfig {
   // Cross-connection batching: renders of one stored scene arriving within this
   // many ms are rendered as one multi-view pass. 0: off (lowest latency).
   int batch_window_ms = 0;
+  // Cameras per slice: a render is run in slices of at most this many cameras
+  // (one GPU batch each), encoded while the next renders; the scheduler picks
+  // the next slice between them (PROTOCOL.md, "Scheduling"). 4: the
+  // renderer's batch size (FrameOptions::max_batch_views).
+  int slice_views = 4;
+  // ... and at most this many pixels (cameras x width x height; at least one
+  // camera). 2^18 = one 512x512 frame: on llvmpipe a 16-camera request ran
+  // 0.81-0.93x the time of 16 single requests at 256x256 with 4-camera slices,
+  // but 1.11-1.20x at 512x512, where one-camera slices gave 0.96-1.03x
+  // (docs/performance.md, "Slice size").
+  std::int64_t slice_pixels = 1 << 18;
   // PNG zlib level and libpng filter mask (PNG_FILTER_SUB = 0x10), chosen by
   // measurement: docs/performance.md, "PNG encoding".
   int png_level = 2;

@@ -54,6 +54,13 @@ int main(int argc, char** argv) {
                  "Batch renders of one stored scene arriving within this window into one "
                  "multi-view pass (0: off)")
       ->check(CLI::Range(0, 10000))->capture_default_str();
+  app.add_option("--slice-views", c.slice_views,
+                 "Cameras per slice of a render (one GPU batch; the scheduler runs other work "
+                 "between slices)")
+      ->check(CLI::Range(1, 64))->capture_default_str();
+  app.add_option("--slice-pixels", c.slice_pixels,
+                 "Pixels per slice at most (cameras x width x height; at least one camera)")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 30))->capture_default_str();
   app.add_option("--network-threads", c.network_threads, "Threads running connections")
       ->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--png-level", c.png_level, "zlib level of PNG frames (docs/performance.md)")

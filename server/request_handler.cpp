@@ -73,7 +73,7 @@ json hello_result(const ServerCore& core, const json& params) {
                        {"encodings", {"binary", "base64"}},
                        {"batch_window_ms", core.config.batch_window_ms},
                        {"stream", true},
-                       {"scheduling", {{"classes", {"interactive", "batch"}}, {"slice_views", FrameOptions{}.max_batch_views}}},
+                       {"scheduling", {{"classes", {"interactive", "batch"}}, {"slice_views", core.config.slice_views}, {"slice_pixels", core.config.slice_pixels}}},
                        {"passes", passes}};
   capabilities.update(scene_capabilities());
   return {{"protocol", kProtocolVersion},
@@ -202,6 +202,8 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   // work; connections of one class in turn.
   job.work_class = decision ? WorkClass::kInteractive : WorkClass::kBatch;
   job.client = session->id();
+  job.options.max_batch_views = core.config.slice_views;
+  job.options.max_batch_pixels = core.config.slice_pixels;
   if (decision) {
     job.options.resolution_scale = decision->still ? 1.0 : level.scale;
     job.jpeg = !decision->still && rp.quality->jpeg;
