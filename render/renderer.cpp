@@ -424,6 +424,43 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const FrameOptions
   return render(scene, scene.cameras, opts);
 }
 
+static_assert(kMaxBatchViews == 64, "camera_batches' default in renderer.hpp");
+
+std::vector<std::vector<std::size_t>> camera_batches(const std::vector<Camera>& cameras,
+                                                    const FrameOptions& opts,
+                                                    int device_max_views) {
+  std::vector<std::vector<std::size_t>> batches;
+  const bool scaled = opts.resolution_scale > 0.0 && opts.resolution_scale < 1.0;
+  if (!opts.batch || scaled) {
+    for (std::size_t i = 0; i < cameras.size(); ++i) batches.push_back({i});
+    return batches;
+  }
+  std::vector<std::pair<int, int>> sizes;
+  std::vector<std::vector<std::size_t>> groups;
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const std::pair<int, int> size{cameras[i].width, cameras[i].height};
+    auto it = std::find(sizes.begin(), sizes.end(), size);
+    if (it == sizes.end()) {
+      sizes.push_back(size);
+      groups.emplace_back();
+      it = sizes.end() - 1;
+    }
+    groups[static_cast<std::size_t>(it - sizes.begin())].push_back(i);
+  }
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const std::int64_t pixels = static_cast<std::int64_t>(sizes[g].first) * sizes[g].second;
+    const std::size_t cap = static_cast<std::size_t>(std::max<std::int64_t>(
+        1, std::min<std::int64_t>({opts.max_batch_views, device_max_views,
+                                   opts.max_batch_pixels / std::max<std::int64_t>(1, pixels)})));
+    for (std::size_t at = 0; at < groups[g].size(); at += cap) {
+      const std::size_t end = std::min(groups[g].size(), at + cap);
+      batches.emplace_back(groups[g].begin() + static_cast<std::ptrdiff_t>(at),
+                           groups[g].begin() + static_cast<std::ptrdiff_t>(end));
+    }
+  }
+  return batches;
+}
+
 std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<Camera>& cameras,
                                           const FrameOptions& opts) {
   const FramePlan plan = make_plan(PlanInput{scene, opts.resolution_scale});
@@ -433,39 +470,8 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
     gl_check("glEnable(0) (injected test failure)");
   }
   std::vector<FrameResult> frames(cameras.size());
-  // Batches: cameras of one size, in order of first appearance, split where a
-  // batch would pass the view or memory bound. A batch of one takes the
-  // per-camera path, and so do scaled frames (resolution_scale < 1: the
-  // interactive preview, one camera per request).
-  std::vector<std::vector<std::size_t>> batches;
-  const bool scaled = PlanInput{scene, opts.resolution_scale}.scaled();
-  if (opts.batch && !scaled) {
-    std::vector<std::pair<int, int>> sizes;
-    std::vector<std::vector<std::size_t>> groups;
-    for (std::size_t i = 0; i < cameras.size(); ++i) {
-      const std::pair<int, int> size{cameras[i].width, cameras[i].height};
-      auto it = std::find(sizes.begin(), sizes.end(), size);
-      if (it == sizes.end()) {
-        sizes.push_back(size);
-        groups.emplace_back();
-        it = sizes.end() - 1;
-      }
-      groups[static_cast<std::size_t>(it - sizes.begin())].push_back(i);
-    }
-    for (std::size_t g = 0; g < groups.size(); ++g) {
-      const std::int64_t pixels = static_cast<std::int64_t>(sizes[g].first) * sizes[g].second;
-      const std::size_t cap = static_cast<std::size_t>(std::max<std::int64_t>(
-          1, std::min<std::int64_t>({opts.max_batch_views, kMaxBatchViews, impl_->max_layers,
-                                     opts.max_batch_pixels / std::max<std::int64_t>(1, pixels)})));
-      for (std::size_t at = 0; at < groups[g].size(); at += cap) {
-        const std::size_t end = std::min(groups[g].size(), at + cap);
-        batches.emplace_back(groups[g].begin() + static_cast<std::ptrdiff_t>(at),
-                             groups[g].begin() + static_cast<std::ptrdiff_t>(end));
-      }
-    }
-  } else {
-    for (std::size_t i = 0; i < cameras.size(); ++i) batches.push_back({i});
-  }
+  const std::vector<std::vector<std::size_t>> batches =
+      camera_batches(cameras, opts, std::min(kMaxBatchViews, impl_->max_layers));
   // Multi-view batches are pipelined: batch b's read-back is finished after
   // batch b+1's passes are submitted (render_batch, finish_batch).
   std::array<PendingReadback, 2> pending;

@@ -98,6 +98,15 @@ struct FrameResult {
   BatchTiming batch;
 };
 
+// The cameras' indices in the batches Renderer::render draws them in: cameras
+// of one size in order of first appearance, at most opts.max_batch_views,
+// device_max_views and opts.max_batch_pixels (at least one camera) per batch;
+// one camera per batch without batching or with scaled frames. The server's
+// scheduler slices renders by the same rule. No GL.
+std::vector<std::vector<std::size_t>> camera_batches(const std::vector<Camera>& cameras,
+                                                    const FrameOptions& opts,
+                                                    int device_max_views = 64);  // kMaxBatchViews
+
 class Renderer {
  public:
   // Creates the EGL context (throws std::runtime_error if none can be had).

@@ -42,40 +42,11 @@ class GlFrameRenderer final : public FrameRenderer {
   Renderer renderer_;
 };
 
-// A job's cameras in slices of camera indices, as the renderer batches them:
-// cameras of one size in order of first appearance, at most max_batch_views
-// (and max_batch_pixels) per slice; one camera per slice where the renderer
-// does not batch (scaled frames, batching off). Never empty.
+// A job's cameras in slices of camera indices, as the renderer batches them
+// (camera_batches); never empty.
 std::vector<std::vector<std::size_t>> make_slices(const std::vector<Camera>& cameras,
                                                   const FrameOptions& o) {
-  std::vector<std::vector<std::size_t>> slices;
-  // Scaled frames render one camera at a time (PlanInput::scaled).
-  const bool single = !o.batch || (o.resolution_scale > 0.0 && o.resolution_scale < 1.0);
-  std::vector<std::pair<int, int>> sizes;
-  std::vector<std::vector<std::size_t>> groups;
-  for (std::size_t i = 0; i < cameras.size(); ++i) {
-    const std::pair<int, int> size{cameras[i].width, cameras[i].height};
-    auto it = std::find(sizes.begin(), sizes.end(), size);
-    if (it == sizes.end()) {
-      sizes.push_back(size);
-      groups.emplace_back();
-      it = sizes.end() - 1;
-    }
-    groups[static_cast<std::size_t>(it - sizes.begin())].push_back(i);
-  }
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    const std::int64_t pixels =
-        std::max<std::int64_t>(1, static_cast<std::int64_t>(sizes[g].first) * sizes[g].second);
-    const std::size_t cap =
-        single ? 1
-               : static_cast<std::size_t>(std::max<std::int64_t>(
-                     1, std::min<std::int64_t>(o.max_batch_views, o.max_batch_pixels / pixels)));
-    for (std::size_t at = 0; at < groups[g].size(); at += cap) {
-      const std::size_t end = std::min(groups[g].size(), at + cap);
-      slices.emplace_back(groups[g].begin() + static_cast<std::ptrdiff_t>(at),
-                          groups[g].begin() + static_cast<std::ptrdiff_t>(end));
-    }
-  }
+  std::vector<std::vector<std::size_t>> slices = camera_batches(cameras, o);
   if (slices.empty()) slices.emplace_back();  // no cameras: one empty render
   return slices;
 }
