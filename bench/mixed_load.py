@@ -29,35 +29,19 @@ import json
 import math
 import os
 import platform
-import signal
 import statistics
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "client", "python"))
 from beamcast_client import BeamcastClient  # noqa: E402
+from local_server import start_server, stop_server  # noqa: E402
 
 SCENE_ID = "mixed-load-bench"
-
-
-def start_server(binary):
-    proc = subprocess.Popen([binary, "--port", "0", "--http-port", "0"],
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    line = []
-    t = threading.Thread(target=lambda: line.append(proc.stdout.readline()), daemon=True)
-    t.start()
-    t.join(60)
-    if not line or "listening on" not in line[0]:
-        proc.kill()
-        raise SystemExit(f"{binary} printed no 'listening on' line")
-    port = int(line[0].strip().rsplit(":", 1)[1])
-    threading.Thread(target=lambda: [None for _ in proc.stdout], daemon=True).start()
-    return proc, port
 
 
 def orbit_cameras(cam, count, size):
@@ -249,7 +233,7 @@ def main():
     with open(os.path.join(ROOT, "examples", "paper_10sets.json")) as f:
         scene = json.load(f)
 
-    proc, port = start_server(server)
+    proc, port = start_server([server, "--http-port", "0"])
     try:
         with BeamcastClient("127.0.0.1", port, timeout=120) as c:
             c.call("scene.put", {"scene_id": SCENE_ID, "scene": scene})
@@ -280,11 +264,7 @@ def main():
         print("3. fairness: 4 connections x 16 pipelined renders", flush=True)
         res["fairness"] = measure_fairness(beamcast, port, duration, res["fairness_size"])
     finally:
-        proc.send_signal(signal.SIGTERM)
-        try:
-            proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            proc.kill()
+        stop_server(proc)
     with open(os.path.join(out, "mixed_load.json"), "w") as f:
         json.dump(res, f, indent=1)
     md = markdown(res)

@@ -15,6 +15,8 @@ import subprocess
 import sys
 import tempfile
 
+from checks import check, summary  # tests/python/checks.py
+
 HEADER = ("scene,method,layout,filter,table_size,samples,rule,gpu_ms,beam_gpu_ms,wall_ms,repeats,"
           "max_abs,rms,rel_l1,psnr_db,nonfinite")
 # The quick set: thin_shell's density has no antiderivative, so no closed_form row there.
@@ -35,20 +37,6 @@ REL_SLACK = 1.10
 # operations per pixel), so rel_l1 cannot settle below about 1e-6; 2e-6 keeps
 # settings that have both reached that floor from counting as "rising".
 ABS_FLOOR = 2e-6
-
-passed = 0
-failed = 0
-
-
-def check(name, ok, detail=""):
-    global passed, failed
-    if ok:
-        passed += 1
-        print(f"ok   {name}")
-    else:
-        failed += 1
-        print(f"FAIL {name}{': ' + detail if detail else ''}")
-
 
 def monotone(points, what):
     """points: (knob, rel_l1) in increasing knob order; returns the violations."""
@@ -126,8 +114,7 @@ def main():
 
 
 def finish():
-    print(f"{passed} passed, {failed} failed")
-    return 0 if failed == 0 else 1
+    return summary()
 
 
 if __name__ == "__main__":

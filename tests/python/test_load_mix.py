@@ -19,38 +19,14 @@ No speed targets (those are measured by bench/mixed_load.py and recorded in
 docs/performance.md). Plain python3; exit status 0 only if all passed.
 """
 import json
-import signal
+import os
 import subprocess
 import sys
-import threading
 
-passed = 0
-failed = 0
-
-
-def check(name, ok, detail=""):
-    global passed, failed
-    if ok:
-        passed += 1
-        print(f"ok   {name}")
-    else:
-        failed += 1
-        print(f"FAIL {name}{': ' + str(detail) if detail else ''}")
-
-
-def start_server(server):
-    proc = subprocess.Popen([server, "--port", "0", "--http-port", "0"],
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    line = []
-    reader = threading.Thread(target=lambda: line.append(proc.stdout.readline()), daemon=True)
-    reader.start()
-    reader.join(60)
-    if not line or not line[0]:
-        proc.kill()
-        raise SystemExit("the server printed no 'listening on' line")
-    port = int(line[0].strip().rsplit(":", 1)[1])
-    threading.Thread(target=lambda: [None for _ in proc.stdout], daemon=True).start()
-    return proc, port
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                "client", "python"))
+from checks import check, summary  # noqa: E402 (tests/python/checks.py)
+from local_server import start_server, stop_server  # noqa: E402
 
 
 def run_load(beamcast, port, args):
@@ -132,18 +108,13 @@ def test_fairness(beamcast, port):
 
 def main():
     beamcast, server = sys.argv[1], sys.argv[2]
-    proc, port = start_server(server)
+    proc, port = start_server([server, "--http-port", "0"])
     try:
         test_mix(beamcast, port)
         test_fairness(beamcast, port)
     finally:
-        proc.send_signal(signal.SIGTERM)
-        try:
-            proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-    print(f"{passed} passed, {failed} failed")
-    return 0 if failed == 0 and passed > 0 else 1
+        stop_server(proc)
+    return summary()
 
 
 if __name__ == "__main__":

@@ -12,12 +12,12 @@ import signal
 import struct
 import subprocess
 import sys
-import threading
 import traceback
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "client", "python"))
 from beamcast_client import BeamcastClient, ServerError  # noqa: E402
+from local_server import start_server  # noqa: E402
 
 # One sphere beam seen from the front by one 64x64 camera.
 TINY_SCENE = {
@@ -90,27 +90,11 @@ def test_pipelined_by_id(c):
     assert len(binary) == msg["result"]["frames"][0]["attachment"]["length"]
 
 
-def start_server(argv):
-    proc = subprocess.Popen(argv + ["--port", "0"], stdout=subprocess.PIPE, text=True)
-    line = []
-    reader = threading.Thread(target=lambda: line.append(proc.stdout.readline()), daemon=True)
-    reader.start()
-    reader.join(60)
-    if not line or not line[0]:
-        proc.kill()
-        raise SystemExit(f"the server printed no 'listening on' line: {argv}")
-    port = int(line[0].strip().rsplit(":", 1)[1])
-    # Keep draining stdout so a chatty server never blocks on a full pipe.
-    threading.Thread(target=lambda: [sys.stdout.write("server: " + l) for l in proc.stdout],
-                     daemon=True).start()
-    return proc, port
-
-
 def main():
     if len(sys.argv) < 2:
         print(__doc__, file=sys.stderr)
         return 2
-    proc, port = start_server(sys.argv[1:2] + sys.argv[2:])
+    proc, port = start_server(sys.argv[1:2] + sys.argv[2:], echo=True)
     passed = failed = 0
     tests = [test_hello, test_ping, test_render_demo_binary, test_render_inline_base64,
              test_bad_scene_names_path, test_pipelined_by_id]

@@ -13,24 +13,12 @@ import subprocess
 import sys
 import tempfile
 
+from checks import check, summary  # tests/python/checks.py
+
 HEADER = ("k,mode,round,e2e_ms,render_ms,gpu_ms,readback_ms,encode_ms,submit_ms,"
           "readback_wait_ms,readback_copy_ms")
 MODES = {"one_request", "k_requests", "renderer_batched", "renderer_batched_sync",
          "renderer_single"}
-
-passed = 0
-failed = 0
-
-
-def check(name, ok, detail=""):
-    global passed, failed
-    if ok:
-        passed += 1
-        print(f"ok   {name}")
-    else:
-        failed += 1
-        print(f"FAIL {name}{': ' + detail if detail else ''}")
-
 
 def main():
     beamcast = sys.argv[1]
@@ -78,5 +66,4 @@ def main():
 
 
 main()
-print(f"{passed} passed, {failed} failed")
-sys.exit(1 if failed else 0)
+sys.exit(summary())
