@@ -19,13 +19,13 @@ import argparse
 import json
 import math
 import os
-import subprocess
 import sys
 import threading
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "client", "python"))
 from beamcast_client import BeamcastClient  # noqa: E402
+from local_server import start_server, stop_server  # noqa: E402
 
 
 def orbit_camera(angle, size, name="cam"):
@@ -90,6 +90,16 @@ def pipelined_loop(port, stop, out, cameras, depth, size):
     c.close()
 
 
+def run_for(threads, stop, seconds):
+    """Starts `threads`, lets them run `seconds`, then sets `stop` and joins them."""
+    for t in threads:
+        t.start()
+    time.sleep(seconds)
+    stop.set()
+    for t in threads:
+        t.join()
+
+
 def run_phase(port, seconds, preview, batch, fps=0.0):
     stop = threading.Event()
     res_p, res_b, threads = {}, {}, []
@@ -98,12 +108,7 @@ def run_phase(port, seconds, preview, batch, fps=0.0):
     if batch:
         threads.append(threading.Thread(target=pipelined_loop,
                                         args=(port, stop, res_b, 16, 2, 256)))
-    for t in threads:
-        t.start()
-    time.sleep(seconds)
-    stop.set()
-    for t in threads:
-        t.join()
+    run_for(threads, stop, seconds)
     out = {}
     if preview:
         out["preview_fps"] = res_p["frames"] / res_p["seconds"]
@@ -119,12 +124,7 @@ def fairness(port, seconds):
     results = [{} for _ in range(4)]
     threads = [threading.Thread(target=pipelined_loop, args=(port, stop, results[i], 1, 16, 128))
                for i in range(4)]
-    for t in threads:
-        t.start()
-    time.sleep(seconds)
-    stop.set()
-    for t in threads:
-        t.join()
+    run_for(threads, stop, seconds)
     fps = [r["frames"] / r["seconds"] for r in results]
     return {"fps": fps, "min_over_max": min(fps) / max(fps)}
 
@@ -155,11 +155,8 @@ def main():
                     help="pace the preview loop at this many frames/s (0: closed loop)")
     ap.add_argument("--skip", nargs="*", default=[], help="phases to skip: fairness cancel")
     a = ap.parse_args()
-    srv = subprocess.Popen([a.server_binary, "--port", "0", "--http-port", "0", "--quiet-requests"],
-                           stdout=subprocess.PIPE, text=True)
+    srv, port = start_server([a.server_binary, "--http-port", "0", "--quiet-requests"])
     try:
-        line = srv.stdout.readline()
-        port = int(line.rsplit(":", 1)[1])
         # Warm-up: tables, programs, the accuracy controller's first levels.
         run_phase(port, 2.0, True, True)
         res = {"load_avg_start": os.getloadavg()[0]}
@@ -184,8 +181,7 @@ def main():
         res["load_avg_end"] = os.getloadavg()[0]
         print(json.dumps(res, indent=1))
     finally:
-        srv.terminate()
-        srv.wait()
+        stop_server(srv)
 
 
 if __name__ == "__main__":
