@@ -154,8 +154,10 @@ def main():
     ap.add_argument("--preview-fps", type=float, default=0.0,
                     help="pace the preview loop at this many frames/s (0: closed loop)")
     ap.add_argument("--skip", nargs="*", default=[], help="phases to skip: fairness cancel")
+    ap.add_argument("--server-arg", action="append", default=[],
+                    help="an extra server option (repeatable), e.g. --server-arg=--no-encode-hold")
     a = ap.parse_args()
-    srv, port = start_server([a.server_binary, "--http-port", "0", "--quiet-requests"])
+    srv, port = start_server([a.server_binary, "--http-port", "0", "--quiet-requests"] + a.server_arg)
     try:
         # Warm-up: tables, programs, the accuracy controller's first levels.
         run_phase(port, 2.0, True, True)

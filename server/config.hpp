@@ -45,6 +45,10 @@ struct ServerConfig {
   // but 1.11-1.20x at 512x512, where one-camera slices gave 0.96-1.03x
   // (docs/performance.md, "Slice size").
   std::int64_t slice_pixels = 1 << 18;
+  // Batch frames' encodes wait while an interactive slice renders (the
+  // preview's render then has the CPU to itself on a software rasterizer);
+  // docs/performance.md, "Encode hold".
+  bool hold_batch_encodes = true;
   // PNG zlib level and libpng filter mask (PNG_FILTER_SUB = 0x10), chosen by
   // measurement: docs/performance.md, "PNG encoding".
   int png_level = 2;

@@ -61,6 +61,9 @@ int main(int argc, char** argv) {
   app.add_option("--slice-pixels", c.slice_pixels,
                  "Pixels per slice at most (cameras x width x height; at least one camera)")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 30))->capture_default_str();
+  bool no_encode_hold = false;
+  app.add_flag("--no-encode-hold", no_encode_hold,
+               "Let batch frames' encodes run while an interactive frame renders");
   app.add_option("--network-threads", c.network_threads, "Threads running connections")
       ->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--png-level", c.png_level, "zlib level of PNG frames (docs/performance.md)")
@@ -87,6 +90,7 @@ int main(int argc, char** argv) {
   for (std::size_t i = 0; i < limit_table().size(); ++i) limit_table()[i].set(c, limit_values[i]);
   c.assets_dir = assets;
   c.request_log = !quiet_requests;
+  c.hold_batch_encodes = !no_encode_hold;
   // libpng's PNG_FILTER_* masks.
   c.png_filters = png_filter == "none"    ? 0x08
                   : png_filter == "sub"   ? 0x10

@@ -417,6 +417,7 @@ void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer
       while (inject > 0 && !inject_failures_.compare_exchange_weak(inject, inject - 1)) {
       }
       if (inject > 0) renderer->fail_next_render_for_test();
+      InteractiveRender hold(this, task.cls == WorkClass::kInteractive);
       // Merged jobs share a render only with the same stored scene and default
       // options (RenderJob::batch_key), so the first job's options hold for all.
       frames = renderer->render(*task.members.front().scene, cameras, task.options);
@@ -617,6 +618,30 @@ void RenderService::gather_batch(Task& first, std::unique_lock<std::mutex>& lock
   first.slices = make_slices(first.cameras, first.options);
 }
 
+void RenderService::set_hold_batch_encodes(bool hold) {
+  {
+    std::lock_guard lock(encode_mu_);
+    hold_batch_encodes_ = hold;
+  }
+  encode_cv_.notify_all();
+}
+
+RenderService::InteractiveRender::InteractiveRender(RenderService* service, bool interactive)
+    : service_(interactive ? service : nullptr) {
+  if (service_ == nullptr) return;
+  std::lock_guard lock(service_->encode_mu_);
+  ++service_->interactive_rendering_;
+}
+
+RenderService::InteractiveRender::~InteractiveRender() {
+  if (service_ == nullptr) return;
+  {
+    std::lock_guard lock(service_->encode_mu_);
+    --service_->interactive_rendering_;
+  }
+  service_->encode_cv_.notify_all();
+}
+
 void RenderService::set_interactive_window(std::chrono::milliseconds window) {
   interactive_window_ms_.store(window.count());
 }
@@ -628,16 +653,25 @@ void RenderService::set_batch_window(std::chrono::milliseconds window, int max_v
 }
 
 // One pool task per queued encode; each runs the most urgent queued encode,
-// so an interactive frame is encoded before the batch frames queued ahead of it.
+// so an interactive frame is encoded before the batch frames queued ahead of
+// it. A batch encode does not start while an interactive slice renders
+// (set_hold_batch_encodes); an interactive one posted meanwhile still runs.
 void RenderService::post_encode(WorkClass c, std::function<void()> fn) {
   {
     std::lock_guard lock(encode_mu_);
     encode_queue_[static_cast<int>(c)].push_back(std::move(fn));
   }
+  encode_cv_.notify_all();
   boost::asio::post(encoders_, [this] {
     std::function<void()> next;
     {
-      std::lock_guard lock(encode_mu_);
+      std::unique_lock lock(encode_mu_);
+      auto& interactive = encode_queue_[static_cast<int>(WorkClass::kInteractive)];
+      auto& batch = encode_queue_[static_cast<int>(WorkClass::kBatch)];
+      encode_cv_.wait(lock, [&] {
+        return !interactive.empty() || batch.empty() || !hold_batch_encodes_ ||
+               interactive_rendering_ == 0 || encoders_stopping_;
+      });
       for (auto& q : encode_queue_) {
         if (!q.empty()) {
           next = std::move(q.front());
@@ -671,6 +705,11 @@ void RenderService::stop() {
       for (const TaskPtr& t : tasks) left.emplace_back(t, withdraw_locked(*t));
     }
   }
+  {
+    std::lock_guard lock(encode_mu_);
+    encoders_stopping_ = true;
+  }
+  encode_cv_.notify_all();
   for (auto& [t, n] : left) {
     {
       std::lock_guard lock(t->mu);

@@ -144,6 +144,11 @@ class RenderService {
   // preview frame waits for at most one batch frame; 0: always full slices.
   void set_interactive_window(std::chrono::milliseconds window);
 
+  // While an interactive slice renders, batch frames' encodes wait to start
+  // (default on): on llvmpipe the renderer runs on the same cores as the
+  // encoders, and the preview frame then has them to itself.
+  void set_hold_batch_encodes(bool hold);
+
   // False if `max_inflight` jobs are already accepted and unanswered (busy).
   bool submit(RenderJob job);
   int inflight() const { return inflight_.load(); }
@@ -231,7 +236,25 @@ class RenderService {
   std::condition_variable ready_cv_;
   std::vector<SizedThread> workers_;  // each owns a GL context
   std::mutex encode_mu_;
+  std::condition_variable encode_cv_;  // batch encodes wait here for interactive renders
   std::array<std::deque<std::function<void()>>, kWorkClasses> encode_queue_;
+  // Interactive slices being rendered now: batch encodes do not start
+  // meanwhile (on a software rasterizer the render shares the CPU with them).
+  int interactive_rendering_ = 0;  // guarded by encode_mu_
+  bool hold_batch_encodes_ = true;  // guarded by encode_mu_
+  bool encoders_stopping_ = false;  // guarded by encode_mu_
+  // Counts an interactive render in interactive_rendering_ for its scope
+  // (nothing for a batch one).
+  class InteractiveRender {
+   public:
+    InteractiveRender(RenderService* service, bool interactive);
+    ~InteractiveRender();
+    InteractiveRender(const InteractiveRender&) = delete;
+    InteractiveRender& operator=(const InteractiveRender&) = delete;
+
+   private:
+    RenderService* service_;
+  };
   boost::asio::thread_pool encoders_;
 };
 

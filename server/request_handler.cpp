@@ -73,7 +73,7 @@ json hello_result(const ServerCore& core, const json& params) {
                        {"encodings", {"binary", "base64"}},
                        {"batch_window_ms", core.config.batch_window_ms},
                        {"stream", true},
-                       {"scheduling", {{"classes", {"interactive", "batch"}}, {"slice_views", core.config.slice_views}, {"slice_pixels", core.config.slice_pixels}}},
+                       {"scheduling", {{"classes", {"interactive", "batch"}}, {"slice_views", core.config.slice_views}, {"slice_pixels", core.config.slice_pixels}, {"hold_batch_encodes", core.config.hold_batch_encodes}}},
                        {"passes", passes}};
   capabilities.update(scene_capabilities());
   return {{"protocol", kProtocolVersion},

@@ -60,6 +60,7 @@ unsigned short Server::start() {
                                                   c.max_inflight_total);
   core_.renders->set_batch_window(std::chrono::milliseconds(c.batch_window_ms),
                                   c.scene_limits.max_cameras);
+  core_.renders->set_hold_batch_encodes(c.hold_batch_encodes);
   core_.renderer_description = core_.renders->wait_ready();
   const tcp::endpoint ep(asio::ip::make_address(c.bind), c.port);
   acceptor_.open(ep.protocol());

@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 #include <stdexcept>
@@ -40,6 +41,19 @@ struct FakeRendererControl {
     }
     cv.notify_all();
   }
+  // Render call number `k` (1-based) waits until release_call(k); other
+  // calls are not held by it.
+  void hold_call(std::size_t k) {
+    std::lock_guard lock(mu);
+    held.insert(k);
+  }
+  void release_call(std::size_t k) {
+    {
+      std::lock_guard lock(mu);
+      held.erase(k);
+    }
+    cv.notify_all();
+  }
   std::size_t call_count() {
     std::lock_guard lock(mu);
     return calls.size();
@@ -56,13 +70,14 @@ struct FakeRendererControl {
     for (const Camera& c : cameras) names.push_back(c.name);
     calls.push_back(std::move(names));
     const std::size_t me = calls.size();
-    cv.wait(lock, [&] { return me <= allowed; });
+    cv.wait(lock, [&] { return me <= allowed && held.count(me) == 0; });
   }
 
   std::mutex mu;
   std::condition_variable cv;
   std::vector<std::vector<std::string>> calls;
   std::size_t allowed = std::numeric_limits<std::size_t>::max();
+  std::set<std::size_t> held;
 };
 
 class FakeFrameRenderer final : public FrameRenderer {

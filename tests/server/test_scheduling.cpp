@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <map>
 #include <string>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "client/client.hpp"
+#include "protocol/scene_json.hpp"
 #include "render/image.hpp"
 #include "tests/server/fake_renderer.hpp"
 #include "tests/server/server_fixture.hpp"
@@ -153,6 +155,62 @@ TEST(Scheduling, FourPipelinedConnectionsTakeTurns) {
     }
     ASSERT_LE(hi - lo, 1) << "render " << k << " (" << log[k][0] << ")";
   }
+}
+
+// The encode hold (RenderService::set_hold_batch_encodes): two render
+// workers, an interactive frame held in one renderer while the other renders
+// a batch frame. The batch frame's encode (an 8x8 PNG, microseconds) must not
+// start until the interactive render returns: its job is not answered while
+// the interactive one is in the renderer, and is once it is out. With the hold
+// off the same batch job is answered while the interactive frame is still
+// held. The 300 ms wait only bounds how long "not answered" is watched; a
+// broken hold answers within microseconds of the render.
+RenderJob hold_job(const std::shared_ptr<const Scene>& scene, WorkClass cls, std::uint64_t client,
+                   std::atomic<int>* answered) {
+  RenderJob job;
+  job.scene = scene;
+  job.cameras = {scene->cameras.front()};
+  job.cameras[0].name = cls == WorkClass::kInteractive ? "i" : "b";
+  job.client_alive = std::make_shared<std::atomic<bool>>(true);
+  job.arrived = std::chrono::steady_clock::now();
+  job.work_class = cls;
+  job.client = client;
+  job.done = [answered](RenderOutcome&& o) {
+    EXPECT_FALSE(o.error.has_value());
+    EXPECT_EQ(o.pngs.size(), 1u);
+    answered->fetch_add(1);
+  };
+  return job;
+}
+
+void check_encode_hold(bool hold) {
+  auto control = std::make_shared<test::FakeRendererControl>();
+  RenderService service(test::fake_renderer_factory(control), 2, 1, 2, 0x10, 16);
+  service.wait_ready();
+  service.set_hold_batch_encodes(hold);
+  const auto scene = std::make_shared<const Scene>(parse_scene(test::tiny_scene(8), {}));
+  std::atomic<int> interactive{0}, batch{0};
+  control->hold_call(1);
+  ASSERT_TRUE(service.submit(hold_job(scene, WorkClass::kInteractive, 1, &interactive)));
+  ASSERT_TRUE(eventually([&] { return control->call_count() == 1; }));
+  ASSERT_TRUE(service.submit(hold_job(scene, WorkClass::kBatch, 2, &batch)));
+  ASSERT_TRUE(eventually([&] { return control->call_count() == 2; }));
+  if (hold) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_EQ(batch.load(), 0) << "a batch encode ran while an interactive frame rendered";
+  } else {
+    EXPECT_TRUE(eventually([&] { return batch.load() == 1; }));
+  }
+  EXPECT_EQ(interactive.load(), 0);
+  control->release_call(1);
+  EXPECT_TRUE(eventually([&] { return interactive.load() == 1 && batch.load() == 1; }));
+  service.stop();
+}
+
+TEST(Scheduling, BatchEncodesWaitWhileAnInteractiveFrameRenders) { check_encode_hold(true); }
+
+TEST(Scheduling, WithoutTheHoldBatchEncodesRunBesideAnInteractiveRender) {
+  check_encode_hold(false);
 }
 
 TEST(Scheduling, ADisconnectedClientsJobStopsWithinOneSlice) {
