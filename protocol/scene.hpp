@@ -14,6 +14,7 @@
 
 #include "protocol/beams/beams.hpp"
 #include "protocol/density.hpp"
+#include "protocol/lights/lights.hpp"
 #include "protocol/occluders/occluders.hpp"
 #include "protocol/vec.hpp"
 
@@ -32,9 +33,48 @@ struct Beam {
 
 // One module per kind in protocol/occluders/ (parsing, bounds, GPU form, CPU
 // reference intersection); the kinds are listed once, in OccluderShape.
+// How a surface scatters light (photon tracing and the path-traced
+// reference; the raster path shades every kind with `albedo`).
+enum class MaterialType {
+  kDiffuse,  // Lambertian, reflectance Occluder::albedo
+  kMirror,   // perfect specular reflection, scaled by `reflectance`
+  kGlass,    // smooth dielectric: Fresnel reflection and refraction, `ior`, `tint`
+};
+struct Material {
+  MaterialType type = MaterialType::kDiffuse;
+  Color reflectance{1.0, 1.0, 1.0};  // mirror
+  double ior = 1.5;                  // glass (the outside is vacuum, ior 1)
+  Color tint{1.0, 1.0, 1.0};         // glass: transmittance per crossing
+};
+
 struct Occluder {
   OccluderShape shape;
   Color albedo{0.8, 0.8, 0.8};
+  Material material;
+};
+
+// A light of the global-illumination path (photon mapping; "lights" in
+// JSON). One module per kind in protocol/lights/; `flux` is the emitted
+// power per channel, color x power (a quad may give its radiance instead).
+struct Light {
+  LightShape shape;
+  Color flux{1.0, 1.0, 1.0};
+};
+
+// Photon mapping settings ("gi" in JSON), the accuracy knobs of issue 14.
+enum class SplatKernel { kBox, kCone, kEpanechnikov };
+enum class DirectLighting {
+  kRaster,   // direct light by shadow-mapped rasterization, photons for the rest
+  kPhotons,  // every bounce from the photon map (the seed's approach)
+};
+struct GiSettings {
+  std::int64_t photons = 100000;          // emitted for the global map
+  std::int64_t caustic_photons = 100000;  // emitted for the caustic map (with specular surfaces)
+  double radius = 0.0;                    // splat / gather radius; 0: from the scene size
+  SplatKernel kernel = SplatKernel::kEpanechnikov;
+  std::uint64_t seed = 1;
+  int max_depth = 16;  // bounces a photon may take
+  DirectLighting direct = DirectLighting::kRaster;
 };
 
 // One directional light for Lambert shading of occluders.
@@ -118,9 +158,15 @@ struct Scene {
   DirectionalLight light;
   std::vector<Beam> beams;
   std::vector<Occluder> occluders;
+  std::vector<Light> lights;
   std::vector<Camera> cameras;
   OutputSettings output;
   RenderSettings render;
+  GiSettings gi;
+
+  // Global illumination runs when a light of "lights" lights the scene;
+  // otherwise the directional light shades it.
+  bool has_gi() const { return !lights.empty(); }
 };
 
 }  // namespace beamcast

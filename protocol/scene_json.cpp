@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -13,6 +14,7 @@
 #include "protocol/camera.hpp"
 #include "protocol/json_reader.hpp"
 #include "protocol/kinds.hpp"
+#include "protocol/lights/light_parse.hpp"
 #include "protocol/occluders/occluder_parse.hpp"
 #include "protocol/rigs.hpp"
 
@@ -48,6 +50,16 @@ int read_int_limited(const Node& n, std::int64_t lo, std::int64_t hi, const char
          n.name() + " must be >= " + std::to_string(lo) + ", got " + std::to_string(v));
   }
   return static_cast<int>(v);
+}
+
+// "type", the kind's own keys (Kind::kFields), then the keys every element of
+// its family shares, as one fixed array.
+template <class Kind, std::size_t N>
+auto kind_keys(const std::array<std::string_view, N>& shared) {
+  std::array<std::string_view, 1 + Kind::kFields.size() + N> keys{"type"};
+  std::copy(Kind::kFields.begin(), Kind::kFields.end(), keys.begin() + 1);
+  std::copy(shared.begin(), shared.end(), keys.begin() + 1 + Kind::kFields.size());
+  return keys;
 }
 
 // ---- Beams --------------------------------------------------------------------------
@@ -133,10 +145,7 @@ Beam parse_beam(const Node& n, const SceneLimits& limits) {
   Beam b;
   b.shape = parse_kind<BeamShape>(o.required("type"), [&](auto kind) {
     using Kind = typename decltype(kind)::type;
-    std::vector<std::string_view> allowed{"type"};
-    allowed.insert(allowed.end(), Kind::kFields.begin(), Kind::kFields.end());
-    allowed.insert(allowed.end(), kBeamFields.begin(), kBeamFields.end());
-    o.allow_only(allowed);
+    o.allow_only(kind_keys<Kind>(kBeamFields));
     b.radius = read_size(o.required("radius"), limits);
     if (auto c = o.optional("color")) b.color = read_color(*c);
     if (auto i = o.optional("intensity")) b.intensity = check_non_negative(*i, read_number(*i));
@@ -148,15 +157,148 @@ Beam parse_beam(const Node& n, const SceneLimits& limits) {
 
 // ---- Occluders ----------------------------------------------------------------------
 
+// {"type": "diffuse" | "mirror" | "glass", ...}; a diffuse material's
+// albedo is the occluder's "albedo" (given in one place only).
+Material parse_material(const Node& n, bool albedo_given, Color* albedo) {
+  ObjectReader o(n, "a material");
+  const Node type = o.required("type");
+  Material m;
+  m.type = read_enum<MaterialType>(type, {{"diffuse", MaterialType::kDiffuse},
+                                          {"mirror", MaterialType::kMirror},
+                                          {"glass", MaterialType::kGlass}});
+  switch (m.type) {
+    case MaterialType::kDiffuse:
+      o.allow_only({"type", "albedo"});
+      if (auto a = o.optional("albedo")) {
+        if (albedo_given) {
+          fail("invalid_value", a->path,
+               "albedo is given twice: in the occluder and in its material; give it once");
+        }
+        *albedo = read_albedo(*a);
+      }
+      break;
+    case MaterialType::kMirror:
+      o.allow_only({"type", "reflectance"});
+      if (auto r = o.optional("reflectance")) m.reflectance = read_albedo(*r);
+      break;
+    case MaterialType::kGlass:
+      o.allow_only({"type", "ior", "tint"});
+      if (auto i = o.optional("ior")) {
+        m.ior = read_number(*i);
+        // 1 would be no surface at all; above 4 no transparent material.
+        if (!(m.ior > 1.0 && m.ior <= 4.0)) {
+          fail("out_of_range", i->path, "ior must be in (1, 4], got " + format_number(m.ior));
+        }
+      }
+      if (auto t = o.optional("tint")) m.tint = read_albedo(*t);
+      break;
+  }
+  return m;
+}
+
 // The kind's own parse function (protocol/occluders/) reads its fields;
-// "albedo" is common to every kind.
+// "albedo" and "material" are common to every kind.
 Occluder parse_occluder(const Node& n, const SceneLoadOptions& opts, std::int64_t* mesh_triangles) {
   ObjectReader o(n, "an occluder");
   const Node type = o.required("type");
   Occluder occ;
   occ.shape = parse_occluder_shape(type, OccluderParse{o, opts, mesh_triangles});
-  if (auto a = o.optional("albedo")) occ.albedo = read_albedo(*a);
+  const auto albedo = o.optional("albedo");
+  if (albedo) occ.albedo = read_albedo(*albedo);
+  if (auto m = o.optional("material")) occ.material = parse_material(*m, albedo.has_value(), &occ.albedo);
   return occ;
+}
+
+// ---- Lights of the global-illumination path -------------------------------------------
+
+// Every light has "color" (default white) and "power" (watts, default 1):
+// flux = color x power. A quad may give "radiance" instead of both.
+constexpr std::array<std::string_view, 2> kLightFields{"color", "power"};
+
+Light parse_gi_light(const Node& n, const SceneLimits& limits) {
+  ObjectReader o(n, "a light");
+  Light l;
+  l.shape = parse_kind<LightShape>(o.required("type"), [&](auto kind) {
+    using Kind = typename decltype(kind)::type;
+    o.allow_only(kind_keys<Kind>(kLightFields));
+    return Kind::parse(LightParse{o, limits});
+  });
+  Color color{1.0, 1.0, 1.0};
+  double power = 1.0;
+  const auto c = o.optional("color");
+  const auto p = o.optional("power");
+  if (c) color = read_color(*c);
+  if (p) {
+    power = read_number(*p);
+    if (!(power >= 0.0)) {
+      fail("out_of_range", p->path, "power must be >= 0 (watts), got " + format_number(power));
+    }
+  }
+  l.flux = power * color;
+  if (const auto* quad = std::get_if<QuadLight>(&l.shape)) {
+    if (auto r = o.optional("radiance")) {
+      if (c || p) {
+        fail("invalid_value", r->path,
+             "give a quad light either radiance or color and power, not both");
+      }
+      // A Lambertian emitter of radiance L sends pi L area into its hemisphere.
+      l.flux = (std::numbers::pi * quad->area) * read_color(*r);
+    }
+  }
+  return l;
+}
+
+GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
+  ObjectReader o(n, "gi settings");
+  o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth", "direct"});
+  GiSettings g;
+  std::int64_t total = 0;
+  auto count = [&](const Node& v) {
+    const std::int64_t k = read_integer(v);
+    if (k < 0) fail("out_of_range", v.path, v.name() + " must be >= 0, got " + std::to_string(k));
+    if (k > limits.max_photons - total) {
+      fail("limit_exceeded", v.path,
+           "photons and caustic_photons together are over the limit max_photons = " +
+               std::to_string(limits.max_photons) + " (" + v.name() + " is " + std::to_string(k) +
+               ")");
+    }
+    total += k;
+    return k;
+  };
+  if (auto v = o.optional("photons")) {
+    g.photons = count(*v);
+  } else {
+    total += std::min(g.photons, limits.max_photons);
+    g.photons = std::min(g.photons, limits.max_photons);
+  }
+  if (auto v = o.optional("caustic_photons")) {
+    g.caustic_photons = count(*v);
+  } else {
+    g.caustic_photons = std::min(g.caustic_photons, limits.max_photons - total);
+  }
+  if (auto v = o.optional("radius")) {
+    g.radius = read_number(*v);
+    if (!(g.radius >= 0.0 && g.radius <= limits.max_abs_coordinate)) {
+      fail("out_of_range", v->path,
+           "radius must be >= 0 (0: chosen from the scene size), got " + format_number(g.radius));
+    }
+  }
+  if (auto v = o.optional("kernel")) {
+    g.kernel = read_enum<SplatKernel>(*v, {{"box", SplatKernel::kBox},
+                                           {"cone", SplatKernel::kCone},
+                                           {"epanechnikov", SplatKernel::kEpanechnikov}});
+  }
+  if (auto v = o.optional("seed")) {
+    const std::int64_t s = read_integer(*v);
+    if (s < 0) fail("out_of_range", v->path, "seed must be >= 0, got " + std::to_string(s));
+    g.seed = static_cast<std::uint64_t>(s);
+  }
+  if (auto v = o.optional("max_depth")) g.max_depth = read_int_in(*v, 1, 64);
+  if (auto v = o.optional("direct")) {
+    g.direct = read_enum<DirectLighting>(*v, {{"raster", DirectLighting::kRaster},
+                                              {"photons", DirectLighting::kPhotons}});
+  }
+  return g;
 }
 
 // ---- Scene-wide settings ------------------------------------------------------------
@@ -588,7 +730,8 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   const Node root{&j, ""};
   ObjectReader o(root, "a scene");
   o.allow_only(
-      {"version", "background", "light", "beams", "occluders", "cameras", "output", "render"});
+      {"version", "background", "light", "lights", "gi", "beams", "occluders", "cameras", "output",
+       "render"});
   Scene scene;
   if (auto v = o.optional("version")) {
     const std::int64_t version = read_integer(*v);
@@ -601,6 +744,17 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   if (auto v = o.optional("light")) scene.light = parse_light(*v);
   if (auto v = o.optional("output")) scene.output = parse_output(*v);
   if (auto v = o.optional("render")) scene.render = parse_render(*v, limits);
+  if (auto v = o.optional("lights")) {
+    for (const Node& l : read_array(*v, limits.max_lights, "max_lights")) {
+      scene.lights.push_back(parse_gi_light(l, limits));
+    }
+  }
+  if (auto v = o.optional("gi")) {
+    scene.gi = parse_gi(*v, limits);
+  } else {
+    scene.gi.photons = std::min(scene.gi.photons, limits.max_photons);
+    scene.gi.caustic_photons = std::min(scene.gi.caustic_photons, limits.max_photons - scene.gi.photons);
+  }
 
   if (auto v = o.optional("beams")) {
     for (const Node& b : read_array(*v, limits.max_beams, "max_beams")) {
@@ -658,6 +812,9 @@ nlohmann::json scene_capabilities() {
   return {{"beam_types", beam_types()},
           {"densities", densities},
           {"occluder_types", occluder_types()},
+          {"light_types", light_types()},
+          {"material_types", {"diffuse", "mirror", "glass"}},
+          {"gi_kernels", {"box", "cone", "epanechnikov"}},
           {"camera_rigs", enum_names(kRigKinds)}};
 }
 

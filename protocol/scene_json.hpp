@@ -30,6 +30,8 @@ struct SceneLimits {
   int min_table = 8;
   int max_table = 1024;
   double max_abs_coordinate = 1e12;  // any position or size, world units
+  int max_lights = 1024;
+  std::int64_t max_photons = 20000000;  // gi.photons + gi.caustic_photons
 };
 
 // The server's scene limits (PROTOCOL.md, "Limits"), stricter than the
@@ -40,7 +42,9 @@ inline constexpr SceneLimits kServerSceneLimits{.max_beams = 10000,
                                                 .max_width = 4096,
                                                 .max_height = 4096,
                                                 .max_pixels = 4096LL * 4096LL,
-                                                .max_mesh_triangles = 1000000};
+                                                .max_mesh_triangles = 1000000,
+                                                .max_lights = 64,
+                                                .max_photons = 4000000};
 
 struct SceneLoadOptions {
   // Mesh files are read only from below this directory; absolute paths and

@@ -32,6 +32,7 @@ void OccluderParse::allow(std::initializer_list<std::string_view> kind_fields) c
   std::vector<std::string_view> all{"type"};
   all.insert(all.end(), kind_fields.begin(), kind_fields.end());
   all.push_back("albedo");
+  all.push_back("material");
   fields.allow_only(all);
 }
 

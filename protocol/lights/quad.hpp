@@ -1,0 +1,31 @@
+// Light "quad": a one-sided Lambertian emitting parallelogram corner + a
+// edge_u + b edge_v (a, b in [0, 1]), emitting to the side cross(edge_u,
+// edge_v) points to (the Cornell box's ceiling light faces down). Its
+// radiance is flux / (pi area); "radiance" in JSON gives it directly.
+#pragma once
+
+#include <string_view>
+
+#include "protocol/lights/light_base.hpp"
+
+namespace beamcast {
+
+struct QuadLight {
+  static constexpr std::string_view kType = "quad";
+  static constexpr std::array<std::string_view, 4> kFields{"corner", "edge_u", "edge_v",
+                                                           "radiance"};
+  Vec3 corner{};
+  Vec3 edge_u{1.0, 0.0, 0.0};
+  Vec3 edge_v{0.0, 0.0, 1.0};
+  Vec3 normal{0.0, 1.0, 0.0};  // unit, derived
+  double area = 1.0;           // derived
+
+  static QuadLight parse(const LightParse& in);
+  Aabb bounds() const;
+  Emission emit(const LightRandom& u) const;
+  LightSample sample(const Vec3& x, const LightRandom& u) const;
+  std::optional<double> hit(const Vec3& o, const Vec3& v, double t_max) const;
+  double radiance_scale() const;
+};
+
+}  // namespace beamcast
