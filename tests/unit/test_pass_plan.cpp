@@ -14,7 +14,7 @@ namespace {
 Scene scene_with(bool beams, bool occluders) {
   Scene s;
   if (beams) s.beams.emplace_back();
-  if (occluders) s.occluders.push_back(Occluder{SphereOccluder{}, {0.5, 0.5, 0.5}});
+  if (occluders) s.occluders.push_back(Occluder{SphereOccluder{}, {0.5, 0.5, 0.5}, {}});
   return s;
 }
 

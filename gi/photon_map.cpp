@@ -1,0 +1,215 @@
+#include "gi/photon_map.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <thread>
+#include <variant>
+
+#include "gi/optics.hpp"
+#include "protocol/lights/sampling.hpp"
+
+namespace beamcast {
+namespace {
+
+// Photons per unit of work: a chunk is traced by one thread with its own
+// random sequence, seeded by (seed, map, chunk), so the result does not
+// depend on which thread took which chunk.
+constexpr std::int64_t kChunk = 4096;
+
+class Random {
+ public:
+  Random(std::uint64_t seed, std::uint32_t map, std::uint64_t chunk) {
+    std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32), map,
+                      static_cast<std::uint32_t>(chunk), static_cast<std::uint32_t>(chunk >> 32)};
+    rng_.seed(seq);
+  }
+  // Uniform in [0, 1), the same on every platform (53 bits of the generator).
+  double next() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
+
+ private:
+  std::mt19937_64 rng_;
+};
+
+double luminance(const Color& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+// Lights chosen in proportion to their flux's luminance (all equal if none has any).
+struct LightChoice {
+  std::vector<double> cdf;
+  std::vector<double> prob;
+  explicit LightChoice(const Scene& s) {
+    double total = 0.0;
+    for (const Light& l : s.lights) total += luminance(l.flux);
+    double acc = 0.0;
+    for (const Light& l : s.lights) {
+      const double p = total > 0.0 ? luminance(l.flux) / total : 1.0 / s.lights.size();
+      prob.push_back(p);
+      acc += p;
+      cdf.push_back(acc);
+    }
+  }
+  std::size_t pick(double u) const {
+    const auto it = std::upper_bound(cdf.begin(), cdf.end(), u * cdf.back());
+    return std::min<std::size_t>(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
+  }
+};
+
+enum class MapKind : std::uint32_t { kGlobal = 0, kCaustic = 1 };
+
+Photon make_photon(const SurfaceHit& h, const Vec3& dir, const Color& power, int bounces,
+                   bool caustic) {
+  Photon ph{};
+  for (int k = 0; k < 3; ++k) {
+    ph.p[k] = static_cast<float>(h.p[k]);
+    ph.power[k] = static_cast<float>(power[k]);
+    ph.dir[k] = static_cast<float>(dir[k]);
+    ph.n[k] = static_cast<float>(h.n[k]);
+  }
+  ph.bounces = static_cast<std::uint16_t>(std::min(bounces, 65535));
+  ph.caustic = caustic ? 1 : 0;
+  return ph;
+}
+
+Color scale(const Color& a, const Color& b) { return {a[0] * b[0], a[1] * b[1], a[2] * b[2]}; }
+
+// One photon's path. `global_skips_caustics`: L S+ D hits are left to the
+// caustic map. For the caustic map only L S+ D hits are stored, and the path
+// ends at its first diffuse hit.
+void trace_one(const Scene& scene, const GiScene& surfaces, const LightChoice& lights,
+               std::int64_t emitted, MapKind map, bool global_skips_caustics, Random& rng,
+               std::vector<Photon>* out) {
+  const std::size_t li = lights.pick(rng.next());
+  const Light& light = scene.lights[li];
+  const LightRandom u{rng.next(), rng.next(), rng.next(), rng.next()};
+  const Emission e = std::visit([&](const auto& kind) { return kind.emit(u); }, light.shape);
+  if (e.weight <= 0.0) return;
+  Color power = (e.weight / (static_cast<double>(emitted) * lights.prob[li])) * light.flux;
+  Vec3 o = e.origin;
+  Vec3 d = e.dir;
+  const double eps = surfaces.epsilon();
+  bool specular_only = true;  // every bounce so far was specular (or none)
+  for (int depth = 0; depth < scene.gi.max_depth; ++depth) {
+    const auto hit = surfaces.intersect(o, d, eps, std::numeric_limits<double>::infinity());
+    if (!hit || hit->light >= 0) return;  // leaves the scene, or absorbed by an emitter
+    const Occluder& occ = scene.occluders[static_cast<std::size_t>(hit->occluder)];
+    const Material& m = occ.material;
+    if (m.type == MaterialType::kDiffuse) {
+      const bool caustic = specular_only && depth > 0;
+      if (map == MapKind::kCaustic) {
+        if (caustic) out->push_back(make_photon(*hit, d, power, depth, true));
+        return;
+      }
+      if (!(caustic && global_skips_caustics)) {
+        out->push_back(make_photon(*hit, d, power, depth, caustic));
+      }
+      // Russian roulette on the albedo: survive with p = its mean, carry albedo / p.
+      const double p = (occ.albedo[0] + occ.albedo[1] + occ.albedo[2]) / 3.0;
+      if (!(rng.next() < p)) return;
+      power = (1.0 / p) * scale(power, occ.albedo);
+      const double u1 = rng.next();
+      const double u2 = rng.next();
+      d = cosine_hemisphere(hit->n, u1, u2);
+      specular_only = false;
+    } else if (m.type == MaterialType::kMirror) {
+      if (map == MapKind::kCaustic && !specular_only) return;
+      const double p = std::max({m.reflectance[0], m.reflectance[1], m.reflectance[2]});
+      if (!(rng.next() < p)) return;
+      power = (1.0 / p) * scale(power, m.reflectance);
+      d = reflect(d, hit->n);
+    } else {  // glass: the hit normal faces the incoming side
+      if (map == MapKind::kCaustic && !specular_only) return;
+      const double n1 = hit->entering ? 1.0 : m.ior;
+      const double n2 = hit->entering ? m.ior : 1.0;
+      const double f = fresnel_dielectric(-dot(d, hit->n), n1, n2);
+      const auto t = refract(d, hit->n, n1, n2);
+      if (!t || rng.next() < f) {
+        d = reflect(d, hit->n);
+      } else {
+        d = normalize(*t);
+        power = scale(power, m.tint);
+      }
+    }
+    o = hit->p;
+  }
+}
+
+std::vector<Photon> trace_map(const Scene& scene, const GiScene& surfaces, std::int64_t count,
+                              MapKind map, bool global_skips_caustics, int threads) {
+  const LightChoice lights(scene);
+  const std::int64_t chunks = (count + kChunk - 1) / kChunk;
+  std::vector<std::vector<Photon>> parts(static_cast<std::size_t>(chunks));
+  std::atomic<std::int64_t> next{0};
+  auto work = [&] {
+    for (std::int64_t c = next++; c < chunks; c = next++) {
+      Random rng(scene.gi.seed, static_cast<std::uint32_t>(map), static_cast<std::uint64_t>(c));
+      const std::int64_t n = std::min(kChunk, count - c * kChunk);
+      std::vector<Photon>& out = parts[static_cast<std::size_t>(c)];
+      for (std::int64_t i = 0; i < n; ++i) {
+        trace_one(scene, surfaces, lights, count, map, global_skips_caustics, rng, &out);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  std::size_t total = 0;
+  for (const auto& p : parts) total += p.size();
+  std::vector<Photon> all;
+  all.reserve(total);
+  for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
+  return all;
+}
+
+}  // namespace
+
+bool has_specular(const Scene& scene) {
+  return std::any_of(scene.occluders.begin(), scene.occluders.end(), [](const Occluder& o) {
+    return o.material.type != MaterialType::kDiffuse;
+  });
+}
+
+PhotonMaps trace_photons(const Scene& scene, const GiScene& surfaces,
+                         const PhotonTraceOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PhotonMaps maps;
+  if (scene.lights.empty()) return maps;
+  int threads = options.threads > 0 ? options.threads
+                                    : static_cast<int>(std::thread::hardware_concurrency());
+  threads = std::max(1, threads);
+  const bool caustics = has_specular(scene) && scene.gi.caustic_photons > 0;
+  maps.emitted_global = scene.gi.photons;
+  if (maps.emitted_global > 0) {
+    maps.global = trace_map(scene, surfaces, maps.emitted_global, MapKind::kGlobal, caustics, threads);
+  }
+  if (caustics) {
+    maps.emitted_caustic = scene.gi.caustic_photons;
+    maps.caustic = trace_map(scene, surfaces, maps.emitted_caustic, MapKind::kCaustic, true, threads);
+  }
+  maps.trace_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return maps;
+}
+
+double default_photon_radius(const Scene& scene, std::int64_t photons) {
+  Aabb box;
+  for (const Occluder& o : scene.occluders) {
+    const Aabb b = std::visit([](const auto& k) { return k.bounds(); }, o.shape);
+    if (std::isfinite(b.lo[0]) && std::isfinite(b.hi[0])) box.grow(b);
+  }
+  for (const Light& l : scene.lights) {
+    box.grow(std::visit([](const auto& k) { return k.bounds(); }, l.shape));
+  }
+  if (box.empty() || photons <= 0) return 1.0;
+  const Vec3 s = box.hi - box.lo;
+  const double area = 2.0 * (s[0] * s[1] + s[1] * s[2] + s[2] * s[0]);
+  if (!(area > 0.0)) return 1.0;
+  // 50 photons in pi r^2 of `area` spread over `photons`.
+  return std::sqrt(50.0 * area / (std::numbers::pi * static_cast<double>(photons)));
+}
+
+}  // namespace beamcast

@@ -1,0 +1,58 @@
+// Photon tracing on the CPU (seed 001, chapter 2; issue 14, item 2): photons
+// leave the scene's lights, bounce off surfaces with Russian roulette on
+// their reflectance, reflect off mirrors and reflect or refract at glass by
+// Fresnel, and are stored where they hit a diffuse surface. Two maps: the
+// global map (every diffuse hit, except L S+ D paths when a caustic map is
+// traced) and the caustic map (the first diffuse hit after one or more
+// specular bounces straight from the light). Multi-threaded; for one seed the
+// maps are identical whatever the thread count.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "gi/gi_scene.hpp"
+#include "protocol/scene.hpp"
+
+namespace beamcast {
+
+struct Photon {
+  float p[3];      // where it hit
+  float power[3];  // flux it carries (watts per channel)
+  float dir[3];    // unit travel direction when it arrived
+  float n[3];      // unit normal of the surface it hit, facing where it came from
+  // Surface interactions before this one: 0 = straight from the light (direct light).
+  std::uint16_t bounces;
+  // Set for L S+ D paths (only specular bounces before this hit).
+  std::uint16_t caustic;
+};
+
+struct PhotonMaps {
+  std::vector<Photon> global;
+  std::vector<Photon> caustic;
+  std::int64_t emitted_global = 0;   // photons sent into the scene for each map
+  std::int64_t emitted_caustic = 0;
+  double trace_ms = 0.0;             // wall time of tracing both
+};
+
+struct PhotonTraceOptions {
+  int threads = 0;  // 0: std::thread::hardware_concurrency()
+};
+
+// Traces scene.gi.photons photons for the global map and, if the scene has a
+// mirror or glass occluder, scene.gi.caustic_photons for the caustic map.
+// Each photon carries flux / (emitted x probability of its light), so the
+// powers of one map's photons sum, in expectation, to what reaches the
+// surfaces.
+PhotonMaps trace_photons(const Scene& scene, const GiScene& surfaces,
+                         const PhotonTraceOptions& options = {});
+
+// Whether any occluder is a mirror or glass (a caustic map is traced).
+bool has_specular(const Scene& scene);
+
+// The splat / gather radius when gi.radius is 0: about 50 photons per disk
+// if the global map's photons spread evenly over the six faces of the scene's
+// bounding box.
+double default_photon_radius(const Scene& scene, std::int64_t photons);
+
+}  // namespace beamcast
