@@ -18,11 +18,11 @@ bool RenderAtlas::operator==(const RenderAtlas& o) const {
 }
 
 bool RenderFrame::operator==(const RenderFrame& o) const {
-  return std::tie(camera, index, width, height, gpu_ms, pass_ms, readback_ms, gpu_batch, x, y,
-                  format, bit_depth, encode_ms, attachment, data_base64) ==
+  return std::tie(camera, index, width, height, gpu_ms, pass_ms, readback_ms, gpu_batch, photons,
+                  x, y, format, bit_depth, encode_ms, attachment, data_base64) ==
              std::tie(o.camera, o.index, o.width, o.height, o.gpu_ms, o.pass_ms, o.readback_ms,
-                      o.gpu_batch, o.x, o.y, o.format, o.bit_depth, o.encode_ms, o.attachment,
-                      o.data_base64) &&
+                      o.gpu_batch, o.photons, o.x, o.y, o.format, o.bit_depth, o.encode_ms,
+                      o.attachment, o.data_base64) &&
          atlas.has_value() == o.atlas.has_value() && (!atlas || *atlas == *o.atlas);
 }
 
@@ -43,6 +43,11 @@ json to_json(const RenderFrame& f) {
                       {"views", b.views},
                       {"gpu_ms", b.gpu_ms},
                       {"readback_ms", b.readback_ms}};
+  }
+  if (f.photons) {
+    j["photons"] = {{"count", f.photons->count},
+                    {"trace_ms", f.photons->trace_ms},
+                    {"upload_ms", f.photons->upload_ms}};
   }
   if (f.x) j["x"] = *f.x;
   if (f.y) j["y"] = *f.y;
@@ -150,6 +155,11 @@ RenderFrame read_frame(const Node& n) {
     f.gpu_batch =
         GpuBatch{read_int(br.required("index")), read_int(br.required("views")),
                  read_number(br.required("gpu_ms")), read_number(br.required("readback_ms"))};
+  }
+  if (auto p = r.optional("photons")) {
+    const ObjectReader pr(*p, "photons");
+    f.photons = PhotonReport{read_integer(pr.required("count")), read_number(pr.required("trace_ms")),
+                             read_number(pr.required("upload_ms"))};
   }
   f.x = read_optional<int>(r, "x", read_int);
   f.y = read_optional<int>(r, "y", read_int);

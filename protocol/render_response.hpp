@@ -29,6 +29,16 @@ struct GpuBatch {
   bool operator==(const GpuBatch&) const = default;
 };
 
+// Lit scenes: the photons splatted into the frame and the CPU time of the
+// render's photon tracing (0 when the maps came from the server's cache) and
+// upload.
+struct PhotonReport {
+  std::int64_t count = 0;
+  double trace_ms = 0.0;
+  double upload_ms = 0.0;
+  bool operator==(const PhotonReport&) const = default;
+};
+
 // Where a frame's PNG lies in the message's binary section.
 struct Attachment {
   std::uint64_t offset = 0;
@@ -55,6 +65,7 @@ struct RenderFrame {
   std::optional<std::vector<PassTime>> pass_ms;  // on the wire an object keyed by pass name
   std::optional<double> readback_ms;
   std::optional<GpuBatch> gpu_batch;
+  std::optional<PhotonReport> photons;  // lit scenes only
   // Atlas tiles only: top-left pixel in the atlas.
   std::optional<int> x, y;
   // The image: on camera frames and the atlas frame, not on tiles.

@@ -63,10 +63,6 @@ struct Light {
 
 // Photon mapping settings ("gi" in JSON), the accuracy knobs of issue 14.
 enum class SplatKernel { kBox, kCone, kEpanechnikov };
-enum class DirectLighting {
-  kRaster,   // direct light by shadow-mapped rasterization, photons for the rest
-  kPhotons,  // every bounce from the photon map (the seed's approach)
-};
 struct GiSettings {
   std::int64_t photons = 100000;          // emitted for the global map
   std::int64_t caustic_photons = 100000;  // emitted for the caustic map (with specular surfaces)
@@ -74,7 +70,6 @@ struct GiSettings {
   SplatKernel kernel = SplatKernel::kEpanechnikov;
   std::uint64_t seed = 1;
   int max_depth = 16;  // bounces a photon may take
-  DirectLighting direct = DirectLighting::kRaster;
 };
 
 // One directional light for Lambert shading of occluders.

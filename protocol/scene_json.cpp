@@ -250,7 +250,7 @@ Light parse_gi_light(const Node& n, const SceneLimits& limits) {
 
 GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "gi settings");
-  o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth", "direct"});
+  o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth"});
   GiSettings g;
   std::int64_t total = 0;
   auto count = [&](const Node& v) {
@@ -294,10 +294,6 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
     g.seed = static_cast<std::uint64_t>(s);
   }
   if (auto v = o.optional("max_depth")) g.max_depth = read_int_in(*v, 1, 64);
-  if (auto v = o.optional("direct")) {
-    g.direct = read_enum<DirectLighting>(*v, {{"raster", DirectLighting::kRaster},
-                                              {"photons", DirectLighting::kPhotons}});
-  }
   return g;
 }
 

@@ -20,15 +20,33 @@ const std::vector<TargetDecl>& target_catalog() {
       {"depth", TargetFormat::kDepth32f, TargetSize::kRender, TargetClear::kFarDepth},
       {"output", TargetFormat::kDisplay, TargetSize::kRender, TargetClear::kNone},
       {"upscaled", TargetFormat::kDisplay, TargetSize::kCamera, TargetClear::kNone},
+      // G-buffer of lit (global illumination) scenes: the surface normal
+      // facing the camera, and albedo with the material code (w).
+      {"gb_normal", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kNone},
+      {"gb_albedo", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kNone},
   };
   return kTargets;
 }
 
 const std::vector<PassDecl>& pass_catalog() {
   static const std::vector<PassDecl> kCatalog = {
-      // Occluders: shaded colour, the view depth of the nearest surface, depth.
-      {PassId::kSurfaces, "surfaces", [](const PlanInput& in) { return !in.scene.occluders.empty(); },
-       {}, {}, {"hdr", "view_depth", "depth"}, {"occluders"}},
+      // Occluders lit by the directional light: shaded colour, the view depth
+      // of the nearest surface, depth.
+      {PassId::kSurfaces, "surfaces",
+       [](const PlanInput& in) { return !in.scene.occluders.empty() && !in.scene.has_gi(); }, {}, {},
+       {"hdr", "view_depth", "depth"}, {"occluders"}},
+      // Occluders of a lit scene (scene lights): the same draws into a
+      // G-buffer (view depth, normal, albedo and material); hdr gets what
+      // the surfaces emit (nothing yet) in place of the background.
+      {PassId::kGbuffer, "gbuffer",
+       [](const PlanInput& in) { return !in.scene.occluders.empty() && in.scene.has_gi(); }, {}, {},
+       {"hdr", "view_depth", "gb_normal", "gb_albedo", "depth"}, {"occluders"}},
+      // Photon splatting (seed 001, section 4.2): one camera-facing disk per
+      // photon adds its reflected radiance to the G-buffer's pixels within
+      // the radius.
+      {PassId::kPhotons, "photons",
+       [](const PlanInput& in) { return !in.scene.occluders.empty() && in.scene.has_gi(); },
+       {"hdr", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {"photons"}},
       // Beams: energy added to hdr; a ray ends at the nearest surface if
       // anything wrote view_depth.
       {PassId::kBeams, "beams", [](const PlanInput& in) { return !in.scene.beams.empty(); },

@@ -199,6 +199,8 @@ class SurfacePass final : public Pass {
     glDisable(GL_DEPTH_CLAMP);  // triangles are clipped by the near and far planes
     const bool raster = ctx.resources.triangle_vertex_count() > 0;
     const bool analytic = ctx.resources.analytic_count() > 0;
+    // The same draws serve "surfaces" (directional light) and "gbuffer" (lit scenes).
+    const int gi = self.id == PassId::kGbuffer ? 1 : 0;
     if (analytic) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ctx.resources.analytic_buffer());
     // Per view: both draws into the view's framebuffer.
     const int views = multi ? ctx.views : 1;
@@ -207,12 +209,14 @@ class SurfacePass final : public Pass {
       if (raster) {
         glUseProgram(raster_.get(multi));
         if (multi) glUniform1i(raster_.uniform(true, "u_view"), v);
+        glUniform1i(raster_.uniform(multi, "u_gi"), gi);
         glBindVertexArray(ctx.resources.triangle_vao());
         glDrawArrays(GL_TRIANGLES, 0, ctx.resources.triangle_vertex_count());
       }
       if (analytic) {
         glUseProgram(analytic_.get(multi));
         if (multi) glUniform1i(analytic_.uniform(true, "u_view"), v);
+        glUniform1i(analytic_.uniform(multi, "u_gi"), gi);
         glUniform1i(analytic_.uniform(multi, "u_count"), ctx.resources.analytic_count());
         glBindVertexArray(ctx.empty_vao);
         glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -225,6 +229,56 @@ class SurfacePass final : public Pass {
  private:
   ProgramPair raster_;
   ProgramPair analytic_;
+};
+
+// Photon splatting: one instanced draw of camera-facing quads, one per
+// photon; the fragment shader reads the G-buffer and adds the photon's
+// reflected radiance (shaders/photon_splat.frag), additively into hdr.
+class PhotonPass final : public Pass {
+ public:
+  PhotonPass() : program_("photon_splat") {}
+  void execute(FrameContext& ctx, const PassDecl& self) override {
+    if (ctx.resources.photon_count() == 0) return;
+    const bool multi = ctx.views > 0;
+    glUseProgram(program_.get(multi));
+    const float radius = static_cast<float>(ctx.resources.photon_radius());
+    glUniform1f(program_.uniform(multi, "u_radius"), radius);
+    glUniform1i(program_.uniform(multi, "u_kernel"), static_cast<int>(ctx.scene.gi.kernel));
+    // A photon lights a surface point whose normal is within 25 degrees of
+    // its own (curved surfaces turn within a radius; a thin wall's other
+    // side is 180 degrees off) and that lies within a tenth of the radius of
+    // its plane (a parallel surface nearby: a slab's top over its floor).
+    glUniform1f(program_.uniform(multi, "u_min_cos"), 0.906f);
+    glUniform1f(program_.uniform(multi, "u_max_plane"), 0.1f);
+    glBindTextureUnit(0, ctx.targets.texture("view_depth"));
+    glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
+    glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, ctx.resources.photon_buffer());
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glBindVertexArray(ctx.empty_vao);
+    const GLint offset = program_.uniform(multi, "u_photon_offset");
+    const GLint view = multi ? program_.uniform(true, "u_view") : -1;
+    const int views = multi ? ctx.views : 1;
+    for (int v = 0; v < views; ++v) {
+      glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, multi ? v : -1));
+      if (multi) glUniform1i(view, v);
+      // Photon anchor minus this view's eye, in double.
+      const Vec3 eye = multi ? ctx.view_eyes[static_cast<std::size_t>(v)] : ctx.basis.eye;
+      const Vec3 off = ctx.resources.photon_anchor() - eye;
+      glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
+                  static_cast<float>(off[2]));
+      glDrawArraysInstanced(GL_TRIANGLES, 0, 6, ctx.resources.photon_count());
+    }
+    glDisable(GL_BLEND);
+    gl_check("photons pass");
+  }
+
+ private:
+  ProgramPair program_;
 };
 
 // Beams: additive energy from the line-integral tables, one instanced draw of
@@ -333,7 +387,10 @@ class UpscalePass final : public Pass {
 std::unique_ptr<Pass> make_pass(PassId id) {
   switch (id) {
     case PassId::kSurfaces:
+    case PassId::kGbuffer:
       return std::make_unique<SurfacePass>();
+    case PassId::kPhotons:
+      return std::make_unique<PhotonPass>();
     case PassId::kBeams:
       return std::make_unique<BeamPass>();
     case PassId::kTonemap:

@@ -72,6 +72,9 @@ struct FrameContext {
   // for scaled frames, which the upscale pass brings back to this size).
   int output_width = 0;
   int output_height = 0;
+  // Multi-view: each view's eye (world, double), for passes that place
+  // world-anchored data relative to it.
+  std::vector<Vec3> view_eyes;
 };
 
 // Views in one multi-view batch: the size of the shaders' camera array

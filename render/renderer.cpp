@@ -61,6 +61,7 @@ struct Renderer::Impl {
   std::unique_ptr<EglContext> context;
   std::array<std::unique_ptr<Pass>, kPassCount> passes;  // by PassId
   TableCache tables;
+  PhotonCache photons;  // photon maps by what they depend on (gi/photon_cache.hpp)
   FrameTargets targets;
   FrameTargets layered;  // multi-view batches
   GlVertexArray empty_vao;
@@ -152,7 +153,7 @@ struct Renderer::Impl {
     glViewport(0, 0, cam.width, cam.height);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.camera_buffer());
     FrameContext ctx{scene,           plan, cam, basis, res, targets, empty_vao.get(), 0,
-                     full_cam.width, full_cam.height};
+                     full_cam.width, full_cam.height, {}};
     run_passes(scene, ctx, query_sets[0]);
     const double submit_ms = ms_since(wall0);
 
@@ -235,7 +236,8 @@ struct Renderer::Impl {
     glViewport(0, 0, w, h);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.views_camera_buffer());
     FrameContext ctx{scene, plan, cams[0], bases[0], res, layered, empty_vao.get(),
-                     static_cast<int>(k), w, h};
+                     static_cast<int>(k), w, h, {}};
+    for (const CameraBasis& b : bases) ctx.view_eyes.push_back(b.eye);
     run_passes(scene, ctx, query_sets[static_cast<std::size_t>(slot)]);
 
     const bool wide = scene.output.bit_depth == 16;
@@ -464,7 +466,7 @@ std::vector<std::vector<std::size_t>> camera_batches(const std::vector<Camera>& 
 std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<Camera>& cameras,
                                           const FrameOptions& opts) {
   const FramePlan plan = make_plan(PlanInput{scene, opts.resolution_scale});
-  SceneResources res(scene, impl_->tables, plan);
+  SceneResources res(scene, impl_->tables, plan, &impl_->photons);
   if (std::exchange(impl_->fail_next, false)) {
     glEnable(0);  // GL_INVALID_ENUM
     gl_check("glEnable(0) (injected test failure)");
@@ -490,6 +492,11 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
   impl_->finish_batch(plan, frames, pending[cur ^ 1]);
   for (std::size_t b = 0; b < batches.size(); ++b) {
     for (std::size_t i : batches[b]) frames[i].batch.index = static_cast<int>(b);
+  }
+  for (FrameResult& f : frames) {
+    f.photons = res.photon_count();
+    f.photon_trace_ms = res.photon_trace_ms();
+    f.photon_upload_ms = res.photon_upload_ms();
   }
   return frames;
 }

@@ -96,6 +96,11 @@ struct FrameResult {
   double readback_ms = 0.0;  // glReadPixels, wall clock
   double wall_ms = 0.0;      // the whole call for this camera, wall clock (batch share)
   BatchTiming batch;
+  // Lit scenes: photons splatted, and the CPU time of this render call's
+  // photon tracing (0 when the maps came from the cache) and upload.
+  std::int64_t photons = 0;
+  double photon_trace_ms = 0.0;
+  double photon_upload_ms = 0.0;
 };
 
 // The cameras' indices in the batches Renderer::render draws them in: cameras

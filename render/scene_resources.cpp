@@ -1,5 +1,7 @@
 #include "render/scene_resources.hpp"
 
+#include <chrono>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -56,6 +58,7 @@ struct Vertex {
   float normal[3];
   float albedo[3];
   float one_sided;  // 1: drawn only from the side the normal points to
+  float material;   // MaterialType (the G-buffer of lit scenes)
 };
 
 void set3(float* dst, const Vec3& v, float w) {
@@ -104,6 +107,7 @@ class VertexSink final : public TriangleSink {
  public:
   VertexSink(const Vec3& anchor, std::vector<Vertex>* out) : anchor_(anchor), out_(out) {}
   Color albedo{};
+  float material = 0.0f;
   void add(const Vec3& wa, const Vec3& wb, const Vec3& wc, bool one_sided) override {
     const Vec3 a = wa - anchor_, b = wb - anchor_, c = wc - anchor_;
     const Vec3 cr = cross(b - a, c - a);
@@ -118,6 +122,7 @@ class VertexSink final : public TriangleSink {
         v.albedo[k] = static_cast<float>(albedo[k]);
       }
       v.one_sided = one_sided ? 1.0f : 0.0f;
+      v.material = material;
       out_->push_back(v);
     }
   }
@@ -129,10 +134,15 @@ class VertexSink final : public TriangleSink {
 
 }  // namespace
 
-SceneResources::SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan)
+SceneResources::SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan,
+                               PhotonCache* photons)
     : scene_(scene) {
   if (plan.uploads_group("beams")) upload_beams(tables);
   if (plan.uploads_group("occluders")) upload_occluders();
+  if (plan.uploads_group("photons")) {
+    if (!photons) throw GlError("the plan splats photons but the renderer has no photon cache");
+    upload_photons(*photons);
+  }
   GLuint id = 0;
   glCreateBuffers(1, &id);
   camera_ubo_ = GlBuffer(id);
@@ -198,6 +208,53 @@ void SceneResources::upload_beams(TableCache& tables) {
   }
 }
 
+// Both maps in one buffer (the splat pass draws them alike), positions
+// relative to the centre of their bounds; photons straight from the lights
+// are marked (position.w = 1).
+void SceneResources::upload_photons(PhotonCache& cache) {
+  const auto t0 = std::chrono::steady_clock::now();
+  bool traced = false;
+  maps_ = cache.get(scene_, &traced);
+  photon_trace_ms_ = traced ? maps_->trace_ms : 0.0;
+  Aabb box;
+  for (const auto* map : {&maps_->global, &maps_->caustic}) {
+    for (const Photon& p : *map) box.grow(Vec3{p.p[0], p.p[1], p.p[2]});
+  }
+  photon_anchor_ = box.empty() ? Vec3{0.0, 0.0, 0.0} : box.centre();
+  struct PhotonData {
+    float position[4];
+    float power[4];
+    float normal[4];
+  };
+  std::vector<PhotonData> data;
+  data.reserve(maps_->global.size() + maps_->caustic.size());
+  for (const auto* map : {&maps_->global, &maps_->caustic}) {
+    for (const Photon& p : *map) {
+      PhotonData d{};
+      for (int k = 0; k < 3; ++k) {
+        d.position[k] = static_cast<float>(p.p[k] - photon_anchor_[static_cast<std::size_t>(k)]);
+        d.power[k] = p.power[k];
+        d.normal[k] = p.n[k];
+      }
+      d.position[3] = p.bounces == 0 ? 1.0f : 0.0f;
+      data.push_back(d);
+    }
+  }
+  photon_count_ = static_cast<GLsizei>(data.size());
+  if (!data.empty()) {
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    photon_ssbo_ = GlBuffer(id);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(PhotonData)), data.data(), 0);
+  }
+  photon_radius_ = scene_.gi.radius > 0.0 ? scene_.gi.radius
+                                          : default_photon_radius(scene_, scene_.gi.photons);
+  photon_upload_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() -
+      photon_trace_ms_;
+  gl_check("upload photons");
+}
+
 void SceneResources::upload_occluders() {
   const Scene& scene = scene_;
   // Triangle kinds go into one vertex buffer, stored relative to an anchor
@@ -222,6 +279,7 @@ void SceneResources::upload_occluders() {
     VertexSink sink(mesh_anchor_, &verts);
     for (const Occluder& occ : scene.occluders) {
       sink.albedo = occ.albedo;
+      sink.material = static_cast<float>(occ.material.type);
       std::visit(
           [&](const auto& shape) {
             if constexpr (std::decay_t<decltype(shape)>::kGpu == GpuForm::kTriangles) {
@@ -240,11 +298,11 @@ void SceneResources::upload_occluders() {
     glCreateVertexArrays(1, &id);
     tri_vao_ = GlVertexArray(id);
     glVertexArrayVertexBuffer(id, 0, tri_vbo_.get(), 0, sizeof(Vertex));
-    // position, normal, albedo (3 floats each), one_sided (1 float).
-    for (GLuint a = 0; a < 4; ++a) {
+    // position, normal, albedo (3 floats each), one_sided, material (1 float each).
+    for (GLuint a = 0; a < 5; ++a) {
       glEnableVertexArrayAttrib(id, a);
       glVertexArrayAttribFormat(id, a, a < 3 ? 3 : 1, GL_FLOAT, GL_FALSE,
-                                static_cast<GLuint>(a * 3 * sizeof(float)));
+                                static_cast<GLuint>((a < 4 ? a * 3 : 10) * sizeof(float)));
       glVertexArrayAttribBinding(id, a, 0);
     }
     tri_vertices_ = static_cast<GLsizei>(verts.size());
@@ -303,7 +361,7 @@ void SceneResources::fill_analytic(const Vec3& eye, void* analytic) const {
     const Occluder& occ = *analytic_[i];
     AnalyticData& d = data[i];
     d = AnalyticData{};
-    set3(d.albedo, occ.albedo, 1.0f);
+    set3(d.albedo, occ.albedo, static_cast<float>(occ.material.type));
     const AnalyticGpu g = std::visit(
         [&](const auto& shape) {
           if constexpr (std::decay_t<decltype(shape)>::kGpu == GpuForm::kAnalytic) {

@@ -13,6 +13,7 @@
 
 #include "protocol/camera.hpp"
 #include "protocol/scene.hpp"
+#include "gi/photon_cache.hpp"
 #include "render/gl_util.hpp"
 #include "render/lut.hpp"
 #include "render/pass_plan.hpp"
@@ -34,8 +35,10 @@ class TableCache {
 class SceneResources {
  public:
   // Uploads the resource groups the plan's passes declare: "beams" (tables,
-  // beam instances), "occluders" (triangles, analytic occluders).
-  SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan);
+  // beam instances), "occluders" (triangles, analytic occluders), "photons"
+  // (the scene's photon maps from `photons`, traced there unless cached).
+  SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan,
+                 PhotonCache* photons = nullptr);
   // Uploads the camera block and camera-relative beam and occluder data.
   void bind_camera(const Camera& cam, const CameraBasis& basis);
   // Multi-view: uploads one camera block per view (the CameraBlocks uniform
@@ -62,6 +65,15 @@ class SceneResources {
     return views_ ? views_analytic_ssbo_.get() : analytic_ssbo_.get();
   }
   GLsizei analytic_count() const { return static_cast<GLsizei>(analytic_.size()); }
+  // Photons (both maps), positions relative to photon_anchor().
+  GLuint photon_buffer() const { return photon_ssbo_.get(); }
+  GLsizei photon_count() const { return photon_count_; }
+  const Vec3& photon_anchor() const { return photon_anchor_; }
+  double photon_radius() const { return photon_radius_; }
+  // Time spent tracing the maps for this render (0 when they came from the
+  // cache) and uploading them.
+  double photon_trace_ms() const { return photon_trace_ms_; }
+  double photon_upload_ms() const { return photon_upload_ms_; }
 
  private:
   const Scene& scene_;
@@ -79,6 +91,14 @@ class SceneResources {
 
   void upload_beams(TableCache& tables);
   void upload_occluders();
+  void upload_photons(PhotonCache& cache);
+  std::shared_ptr<const PhotonMaps> maps_;
+  GlBuffer photon_ssbo_;
+  GLsizei photon_count_ = 0;
+  Vec3 photon_anchor_{};
+  double photon_radius_ = 1.0;
+  double photon_trace_ms_ = 0.0;
+  double photon_upload_ms_ = 0.0;
   // The per-camera data of bind_camera, written to `out` (for bind_views).
   void fill_camera(const Camera& cam, const CameraBasis& basis, void* block) const;
   void fill_beams(const Vec3& eye, void* beams) const;

@@ -9,6 +9,7 @@ PACKAGES=(
   libglm-dev nlohmann-json3-dev libpng-dev libtinyobjloader-dev libcli11-dev
   libturbojpeg0-dev                                   # JPEG frames of the interactive preview
   libembree-dev                                       # photon tracing and the path-traced reference (gi/)
+  libnanoflann-dev                                    # k-nearest photons of the CPU gather (gi/)
   glslang-tools                                       # shader compile check in the tests
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev libboost-system-dev

@@ -78,6 +78,10 @@ RenderResponse build_render_response(const RenderOutcome& out, const RenderResul
     for (const PassTiming& p : fr.passes) f.pass_ms->push_back({p.name, p.gpu_ms});
     f.readback_ms = fr.readback_ms;
     f.gpu_batch = GpuBatch{fr.batch.index, fr.batch.views, fr.batch.gpu_ms, fr.batch.readback_ms};
+    if (std::find_if(fr.passes.begin(), fr.passes.end(),
+                     [](const PassTiming& p) { return p.name == "photons"; }) != fr.passes.end()) {
+      f.photons = PhotonReport{fr.photons, fr.photon_trace_ms, fr.photon_upload_ms};
+    }
     readback_ms += fr.readback_ms;
     if (out.atlas) {
       f.x = out.atlas->tiles[i].x;

@@ -5,13 +5,17 @@
 struct AnalyticOccluder {
   vec4 a;       // plane: point; sphere: centre (camera-relative); w: sphere radius
   vec4 b;       // plane: unit normal; w: 0 plane, 1 sphere
-  vec4 albedo;  // rgb
+  vec4 albedo;  // rgb; w: MaterialType (0 diffuse, 1 mirror, 2 glass)
 };
 layout(std430, binding = 2) readonly buffer Analytic { AnalyticOccluder occ[]; };
 uniform int u_count;  // per view; view v's occluders start at v * u_count
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_view_depth;
+// The G-buffer of lit scenes (pass "gbuffer"; ignored by "surfaces").
+layout(location = 2) out vec4 out_normal;
+layout(location = 3) out vec4 out_albedo;
+uniform int u_gi;  // 1: G-buffer pass (no directional light)
 
 void main() {
   select_view(view_index());
@@ -47,8 +51,14 @@ void main() {
     }
   }
   if (hit < 0) discard;
-  out_color = vec4(lambert(occ[first + hit].albedo.rgb, normal, ray.dir), 0.0);
   float z = best * ray.cos_axis;
+  if (u_gi == 1) {
+    out_color = vec4(0.0);
+    out_normal = vec4(dot(normal, ray.dir) > 0.0 ? -normal : normal, 0.0);
+    out_albedo = occ[first + hit].albedo;
+  } else {
+    out_color = vec4(lambert(occ[first + hit].albedo.rgb, normal, ray.dir), 0.0);
+  }
   out_view_depth = z;
   gl_FragDepth = window_depth(z);
 }

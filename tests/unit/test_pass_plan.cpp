@@ -11,10 +11,11 @@
 namespace beamcast {
 namespace {
 
-Scene scene_with(bool beams, bool occluders) {
+Scene scene_with(bool beams, bool occluders, bool lit = false) {
   Scene s;
   if (beams) s.beams.emplace_back();
   if (occluders) s.occluders.push_back(Occluder{SphereOccluder{}, {0.5, 0.5, 0.5}, {}});
+  if (lit) s.lights.push_back(Light{PointLight{}, {1.0, 1.0, 1.0}});
   return s;
 }
 
@@ -66,9 +67,11 @@ TEST(PassPlan, EveryCatalogPassIsReachable) {
   std::vector<std::string> seen;
   for (bool b : {false, true}) {
     for (bool o : {false, true}) {
-      for (double scale : {1.0, 0.5}) {
-        for (const auto& n : make_plan(PlanInput{scene_with(b, o), scale}).names()) {
-          seen.push_back(n);
+      for (bool lit : {false, true}) {
+        for (double scale : {1.0, 0.5}) {
+          for (const auto& n : make_plan(PlanInput{scene_with(b, o, lit), scale}).names()) {
+            seen.push_back(n);
+          }
         }
       }
     }
@@ -106,9 +109,25 @@ TEST(PassPlan, ReadingATargetNobodyWritesFailsAtPlanTime) {
   EXPECT_TRUE(plan.uses("gbuffer.normal"));
 }
 
+// A lit scene (lights) runs the G-buffer and photon splatting in place of
+// the directional-light surfaces; without occluders there is nothing to light.
+TEST(PassPlan, LitScenesSplatPhotonsOverAGbuffer) {
+  const FramePlan plan = make_plan(PlanInput{scene_with(true, true, true)});
+  EXPECT_EQ(plan.names(), (std::vector<std::string>{"gbuffer", "photons", "beams", "tonemap"}));
+  EXPECT_EQ(target_names(plan), (std::vector<std::string>{"depth", "gb_albedo", "gb_normal", "hdr",
+                                                           "output", "view_depth"}));
+  EXPECT_TRUE(plan.uploads_group("photons"));
+  EXPECT_TRUE(plan.written("view_depth"));
+  EXPECT_EQ(make_plan(PlanInput{scene_with(true, false, true)}).names(),
+            (std::vector<std::string>{"beams", "tonemap"}));
+  // Unlit scenes never upload photons.
+  EXPECT_FALSE(make_plan(PlanInput{scene_with(true, true)}).uploads_group("photons"));
+}
+
 TEST(PassPlan, UnknownTargetsAndRepeatedIdsFail) {
   std::vector<PassDecl> catalog = pass_catalog();
-  catalog[2].writes = {"outptu"};
+  // The tonemap pass (planned for every frame) names a target that does not exist.
+  catalog[4].writes = {"outptu"};
   EXPECT_THROW(make_plan(PlanInput{scene_with(false, false)}, catalog), PlanError);
   catalog = pass_catalog();
   catalog[1].id = PassId::kSurfaces;

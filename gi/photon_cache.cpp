@@ -1,0 +1,116 @@
+#include "gi/photon_cache.hpp"
+
+#include <cstring>
+#include <functional>
+#include <string_view>
+#include <type_traits>
+#include <variant>
+
+#include "gi/gi_scene.hpp"
+
+namespace beamcast {
+namespace {
+
+// Appends the bytes of values; hashed at the end.
+class KeyWriter final : public TriangleSink {
+ public:
+  template <class T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto* p = reinterpret_cast<const char*>(&v);
+    bytes_.append(p, sizeof(T));
+  }
+  void add(const Vec3& a, const Vec3& b, const Vec3& c, bool one_sided) override {
+    put(a);
+    put(b);
+    put(c);
+    put(one_sided);
+  }
+  std::string digest() const {
+    // 64-bit hash and length: a false match needs a collision of both.
+    const std::size_t h = std::hash<std::string_view>{}(bytes_);
+    return std::to_string(h) + ":" + std::to_string(bytes_.size());
+  }
+
+ private:
+  std::string bytes_;
+};
+
+}  // namespace
+
+std::string photon_key(const Scene& scene) {
+  KeyWriter k;
+  for (const Occluder& o : scene.occluders) {
+    k.put(o.shape.index());
+    k.put(o.albedo);
+    k.put(o.material.type);
+    k.put(o.material.reflectance);
+    k.put(o.material.ior);
+    k.put(o.material.tint);
+    std::visit(
+        [&](const auto& kind) {
+          using Kind = std::decay_t<decltype(kind)>;
+          if constexpr (Kind::kGpu == GpuForm::kTriangles) {
+            kind.gpu_triangles(k);
+          } else {
+            const AnalyticGpu g = kind.analytic(Vec3{0.0, 0.0, 0.0});
+            k.put(g.a);
+            k.put(g.b);
+          }
+        },
+        o.shape);
+  }
+  for (const Light& l : scene.lights) {
+    k.put(l.shape.index());
+    k.put(l.flux);
+    std::visit(
+        [&](const auto& kind) {
+          using Kind = std::decay_t<decltype(kind)>;
+          if constexpr (std::is_same_v<Kind, PointLight>) {
+            k.put(kind.position);
+          } else if constexpr (std::is_same_v<Kind, SpotLight>) {
+            k.put(kind.position);
+            k.put(kind.direction);
+            k.put(kind.inner_deg);
+            k.put(kind.outer_deg);
+          } else {
+            static_assert(std::is_same_v<Kind, QuadLight>, "a light kind missing from photon_key");
+            k.put(kind.corner);
+            k.put(kind.edge_u);
+            k.put(kind.edge_v);
+          }
+        },
+        l.shape);
+  }
+  // The settings tracing reads (radius and kernel only shape the splats).
+  k.put(scene.gi.photons);
+  k.put(scene.gi.caustic_photons);
+  k.put(scene.gi.seed);
+  k.put(scene.gi.max_depth);
+  return k.digest();
+}
+
+std::shared_ptr<const PhotonMaps> PhotonCache::get(const Scene& scene, bool* traced) {
+  const std::string key = photon_key(scene);
+  for (auto it = entries_.begin(); it != entries_.end(); ++it) {
+    if (it->key == key) {
+      entries_.splice(entries_.begin(), entries_, it);
+      if (traced) *traced = false;
+      return entries_.front().maps;
+    }
+  }
+  const GiScene surfaces(scene);
+  auto maps = std::make_shared<const PhotonMaps>(trace_photons(scene, surfaces));
+  if (traced) *traced = true;
+  const std::size_t bytes = (maps->global.size() + maps->caustic.size()) * sizeof(Photon);
+  entries_.push_front({key, maps, bytes});
+  bytes_ += bytes;
+  // Evict the least recently used, but keep the one just traced.
+  while (bytes_ > max_bytes_ && entries_.size() > 1) {
+    bytes_ -= entries_.back().bytes;
+    entries_.pop_back();
+  }
+  return maps;
+}
+
+}  // namespace beamcast

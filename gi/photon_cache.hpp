@@ -1,0 +1,41 @@
+// Photon maps kept across renders (issue 14, item 2): keyed by everything the
+// tracing depends on (occluder geometry and materials, lights, gi settings)
+// and nothing else, so a render that changes only cameras, output or beams
+// re-traces nothing. Bounded in bytes; least recently used maps go first.
+// One per renderer (render thread); not thread-safe.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <list>
+#include <memory>
+#include <string>
+
+#include "gi/photon_map.hpp"
+
+namespace beamcast {
+
+// A digest of what photon tracing of `scene` depends on: equal for scenes
+// whose maps are equal.
+std::string photon_key(const Scene& scene);
+
+class PhotonCache {
+ public:
+  explicit PhotonCache(std::size_t max_bytes = std::size_t{256} << 20) : max_bytes_(max_bytes) {}
+  // The scene's maps, traced now (and kept) unless cached; `traced` tells which.
+  std::shared_ptr<const PhotonMaps> get(const Scene& scene, bool* traced = nullptr);
+  std::size_t bytes() const { return bytes_; }
+  std::size_t entries() const { return entries_.size(); }
+
+ private:
+  struct Entry {
+    std::string key;
+    std::shared_ptr<const PhotonMaps> maps;
+    std::size_t bytes;
+  };
+  std::size_t max_bytes_;
+  std::size_t bytes_ = 0;
+  std::list<Entry> entries_;  // most recently used first
+};
+
+}  // namespace beamcast

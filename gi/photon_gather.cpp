@@ -1,0 +1,153 @@
+#include "gi/photon_gather.hpp"
+
+#include <nanoflann.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <thread>
+
+#include "protocol/camera.hpp"
+
+namespace beamcast {
+
+double splat_kernel(SplatKernel kernel, double d, double r) {
+  if (!(d < r)) return 0.0;
+  const double area = std::numbers::pi * r * r;
+  switch (kernel) {
+    case SplatKernel::kBox:
+      return 1.0 / area;
+    case SplatKernel::kCone:
+      return 3.0 / area * (1.0 - d / r);
+    case SplatKernel::kEpanechnikov:
+      return 2.0 / area * (1.0 - (d * d) / (r * r));
+  }
+  return 0.0;
+}
+
+namespace {
+
+struct Cloud {
+  const std::vector<Photon>* photons;
+  std::size_t kdtree_get_point_count() const { return photons->size(); }
+  float kdtree_get_pt(std::size_t i, std::size_t dim) const { return (*photons)[i].p[dim]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3>;
+
+Vec3 pos(const Photon& p) { return {p.p[0], p.p[1], p.p[2]}; }
+Vec3 normal(const Photon& p) { return {p.n[0], p.n[1], p.n[2]}; }
+
+bool passes(const Photon& p, const Vec3& x, const Vec3& n, double r, const SplatTests& t) {
+  if (dot(normal(p), n) < t.min_cos) return false;
+  return std::abs(dot(x - pos(p), n)) <= t.max_plane * r;
+}
+
+}  // namespace
+
+struct PhotonGather::Index {
+  Cloud cloud;
+  Tree tree;
+  explicit Index(const std::vector<Photon>* photons)
+      : cloud{photons}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+    tree.buildIndex();
+  }
+};
+
+PhotonGather::PhotonGather(const PhotonMaps& maps) {
+  photons_ = maps.global;
+  photons_.insert(photons_.end(), maps.caustic.begin(), maps.caustic.end());
+  index_ = std::make_unique<Index>(&photons_);
+}
+
+PhotonGather::~PhotonGather() = default;
+
+Color PhotonGather::fixed_radius(const Vec3& x, const Vec3& n, const Color& albedo, double r,
+                                 SplatKernel kernel, const SplatTests& tests) const {
+  const float q[3] = {static_cast<float>(x[0]), static_cast<float>(x[1]), static_cast<float>(x[2])};
+  std::vector<std::pair<std::uint32_t, float>> found;
+  nanoflann::SearchParams params;
+  params.sorted = false;
+  index_->tree.radiusSearch(q, static_cast<float>(r * r) * 1.0001f, found, params);
+  Color sum{0.0, 0.0, 0.0};
+  for (const auto& [i, d2] : found) {
+    const Photon& p = photons_[i];
+    const double d = length(x - pos(p));
+    const double w = splat_kernel(kernel, d, r);
+    if (w == 0.0 || !passes(p, x, n, r, tests)) continue;
+    for (int k = 0; k < 3; ++k) sum[k] += w * p.power[k];
+  }
+  return {albedo[0] / std::numbers::pi * sum[0], albedo[1] / std::numbers::pi * sum[1],
+          albedo[2] / std::numbers::pi * sum[2]};
+}
+
+Color PhotonGather::nearest(const Vec3& x, const Vec3& n, const Color& albedo, int k,
+                            const SplatTests& tests) const {
+  if (photons_.empty() || k <= 0) return {0.0, 0.0, 0.0};
+  const float q[3] = {static_cast<float>(x[0]), static_cast<float>(x[1]), static_cast<float>(x[2])};
+  std::vector<std::uint32_t> idx(static_cast<std::size_t>(k));
+  std::vector<float> d2(static_cast<std::size_t>(k));
+  const std::size_t found = index_->tree.knnSearch(q, static_cast<std::size_t>(k), idx.data(), d2.data());
+  if (found == 0) return {0.0, 0.0, 0.0};
+  double r = 0.0;
+  for (std::size_t i = 0; i < found; ++i) r = std::max(r, length(x - pos(photons_[idx[i]])));
+  if (!(r > 0.0)) return {0.0, 0.0, 0.0};
+  Color sum{0.0, 0.0, 0.0};
+  for (std::size_t i = 0; i < found; ++i) {
+    const Photon& p = photons_[idx[i]];
+    if (!passes(p, x, n, r, tests)) continue;
+    for (int c = 0; c < 3; ++c) sum[c] += p.power[c];
+  }
+  const double scale = 1.0 / (std::numbers::pi * std::numbers::pi * r * r);
+  return {albedo[0] * scale * sum[0], albedo[1] * scale * sum[1], albedo[2] * scale * sum[2]};
+}
+
+HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonGather& gather,
+                      const Camera& cam, const GatherImageOptions& opts) {
+  HdrImage img;
+  img.width = cam.width;
+  img.height = cam.height;
+  img.rgb.assign(3 * static_cast<std::size_t>(cam.width) * cam.height, 0.0f);
+  const CameraBasis basis = camera_basis(cam);
+  const double r = scene.gi.radius > 0.0 ? scene.gi.radius
+                                         : default_photon_radius(scene, scene.gi.photons);
+  auto row = [&](int y) {
+    const int py = cam.height - 1 - y;  // GL pixel rows count from the bottom
+    for (int x = 0; x < cam.width; ++x) {
+      const Ray ray = camera_ray(cam, basis, x, py);
+      const auto hit = surfaces.intersect(ray.origin, ray.dir, ray.t_min, ray.t_max);
+      Color c = scene.background;
+      if (hit) {
+        c = {0.0, 0.0, 0.0};
+        if (hit->occluder >= 0) {
+          const Occluder& o = scene.occluders[static_cast<std::size_t>(hit->occluder)];
+          if (o.material.type == MaterialType::kDiffuse) {
+            c = opts.method == GatherMethod::kFixedRadius
+                    ? gather.fixed_radius(hit->p, hit->n, o.albedo, r, scene.gi.kernel)
+                    : gather.nearest(hit->p, hit->n, o.albedo, opts.k);
+          }
+        }
+      }
+      float* px = img.at(x, y);
+      for (int k = 0; k < 3; ++k) px[k] = static_cast<float>(c[k]);
+    }
+  };
+  const int threads = opts.threads > 0 ? opts.threads
+                                       : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<std::thread> pool;
+  std::atomic<int> next{0};
+  auto work = [&] {
+    for (int y = next++; y < cam.height; y = next++) row(y);
+  };
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  return img;
+}
+
+}  // namespace beamcast

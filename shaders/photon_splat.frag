@@ -1,0 +1,49 @@
+// A photon's reflected radiance at the G-buffer's surface point x (seed 001,
+// eq. 4.2): L += (albedo / pi) * power * w(|x - p|) with the kernel w
+// normalized over the disk of radius r. The photon's power is already what
+// crossed the surface (cosine-weighted by the tracing): no n.l factor here.
+// Photons do not light surfaces facing another way (normal test: a thin
+// wall's other side) or off their plane (plane-distance test: a parallel
+// surface within the radius).
+layout(binding = 0) uniform VIEW_SAMPLER u_view_depth;
+layout(binding = 1) uniform VIEW_SAMPLER u_gb_normal;
+layout(binding = 2) uniform VIEW_SAMPLER u_gb_albedo;
+uniform float u_radius;
+uniform int u_kernel;      // SplatKernel: 0 box, 1 cone, 2 epanechnikov
+uniform float u_min_cos;   // normal test: cos of the largest angle between the normals
+uniform float u_max_plane; // plane test: largest distance off the surface's plane, x radius
+
+flat in vec3 v_center;
+flat in vec3 v_power;
+flat in vec3 v_normal;
+
+layout(location = 0) out vec4 out_color;
+
+const float kPi = 3.14159265358979;
+
+void main() {
+  select_view(view_index());
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  float z = VIEW_TEXEL(u_view_depth, px).r;
+  if (z >= 1e29) discard;  // no surface on this pixel
+  vec4 albedo = VIEW_TEXEL(u_gb_albedo, px);
+  if (albedo.w > 0.5) discard;  // mirrors and glass store no photons
+  vec3 n = VIEW_TEXEL(u_gb_normal, px).xyz;
+  ViewRay ray = view_ray(gl_FragCoord.xy);
+  vec3 x = ray.origin + (z / ray.cos_axis) * ray.dir;
+  vec3 d = x - v_center;
+  float r2 = u_radius * u_radius;
+  float d2 = dot(d, d);
+  if (d2 >= r2) discard;
+  if (dot(n, v_normal) < u_min_cos) discard;
+  if (abs(dot(d, n)) > u_max_plane * u_radius) discard;
+  float w;
+  if (u_kernel == 0) {
+    w = 1.0 / (kPi * r2);
+  } else if (u_kernel == 1) {
+    w = 3.0 / (kPi * r2) * (1.0 - sqrt(d2 / r2));
+  } else {
+    w = 2.0 / (kPi * r2) * (1.0 - d2 / r2);
+  }
+  out_color = vec4(albedo.rgb / kPi * v_power * w, 0.0);
+}

@@ -1,0 +1,39 @@
+// One camera-facing quad per photon (seed 001, section 4.2), covering every
+// pixel whose surface point can lie within the radius of the photon: the
+// projection of the sphere of that radius about it.
+struct PhotonData {
+  vec4 position;  // xyz: relative to the photon anchor; w: 1 if straight from the light
+  vec4 power;     // rgb: flux (W per channel)
+  vec4 normal;    // xyz: the normal of the surface it hit, facing where it came from
+};
+layout(std430, binding = 3) readonly buffer Photons { PhotonData photons[]; };
+uniform vec3 u_photon_offset;  // photon anchor minus eye
+uniform float u_radius;
+
+flat out vec3 v_center;  // camera-relative
+flat out vec3 v_power;
+flat out vec3 v_normal;
+
+void main() {
+  select_view(view_index());
+  PhotonData p = photons[gl_InstanceID];
+  vec3 c = p.position.xyz + u_photon_offset;
+  v_center = c;
+  v_power = p.power.rgb;
+  v_normal = p.normal.xyz;
+  // Corner of two triangles: (-1,-1) (1,-1) (1,1) / (-1,-1) (1,1) (-1,1).
+  const vec2 corners[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1), vec2(1, 1),
+                                  vec2(-1, 1));
+  vec2 k = corners[gl_VertexID];
+  // Perspective: a sphere of radius r at distance D subtends asin(r / D); a
+  // quad in its centre's plane facing the camera covers that cone with half
+  // size r D / sqrt(D^2 - r^2) (here along the view axis, the worst case
+  // for screen-aligned axes is within the same bound for the pixels it needs).
+  float s = u_radius;
+  if (!is_orthographic()) {
+    float d2 = dot(c, c);
+    s = u_radius * sqrt(d2 / max(d2 - u_radius * u_radius, 0.01 * d2));
+  }
+  vec3 corner = c + s * (k.x * cam.cam_right.xyz + k.y * cam.cam_up.xyz);
+  gl_Position = cam.view_proj * vec4(corner, 1.0);
+}
