@@ -10,6 +10,9 @@
 
 #include "gi/gi_scene.hpp"
 #include "gi/path_tracer.hpp"
+#include "protocol/camera.hpp"
+#include "protocol/density.hpp"
+#include "render/reference.hpp"
 
 namespace beamcast {
 namespace {
@@ -270,6 +273,37 @@ TEST(PathTracer, DeterministicForSeedAndThreadCount) {
   }
   EXPECT_GT(a, 0.0);
   EXPECT_NEAR(a / b, 1.0, 0.1);
+}
+
+TEST(PathTracer, ReferenceAddsBeamsUpToTheLitSurface) {
+  // render_reference on a scene with lights: the path-traced radiance (here a
+  // quad light seen directly, exact) plus the beams in front of it; a beam
+  // behind the light is hidden.
+  Scene scene;
+  const Color L{2.0, 1.0, 0.5};
+  scene.lights.push_back(quad_light({-2.0, -2.0, 0.0}, {4.0, 0.0, 0.0}, {0.0, 4.0, 0.0}, L));
+  for (const double z : {1.5, -1.0}) {
+    Beam b;
+    b.shape = SphereBeam{{0.0, 0.0, z}};
+    b.radius = 0.6;
+    b.color = {0.5, 1.0, 2.0};
+    ASSERT_TRUE(density_from_name("linear", &b.density));
+    scene.beams.push_back(b);
+  }
+  const Camera cam = make_camera({0.0, 0.0, 3.0}, {0.0, 0.0, 0.0}, 20.0, 12, 12);
+  const HdrImage img = render_reference(scene, cam, ReferenceOptions{.gi_spp = 2});
+  const CameraBasis basis = camera_basis(cam);
+  for (int y = 0; y < cam.height; ++y) {
+    for (int x = 0; x < cam.width; ++x) {
+      const Ray ray = camera_ray(cam, basis, x, cam.height - 1 - y);
+      const double t_light = 3.0 / -ray.dir[2];
+      const double e =
+          beam_energy_reference(scene.beams[0], ray.origin, ray.dir, ray.t_min, t_light);
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(img.at(x, y)[k], L[k] + scene.beams[0].color[k] * e, 1e-5) << x << " " << y;
+      }
+    }
+  }
 }
 
 }  // namespace
