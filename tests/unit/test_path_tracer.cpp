@@ -223,6 +223,41 @@ TEST(PathTracer, GlassSlabTransmitsTheFresnelSeries) {
   }
 }
 
+// A diffuse floor under a quad light, nothing else: every path after the
+// first diffuse bounce leaves the scene or ends on the light, so the floor's
+// radiance is the direct term alone, rho L F with F the view factor from the
+// floor point to the light. Were the light counted both by next-event
+// estimation and when a bounce hits it, the result would be about twice that.
+// F from a point to a parallel a x b rectangle at height h above one of its
+// corners: (1 / 2 pi) [X / sqrt(1 + X^2) atan(Y / sqrt(1 + X^2)) + (X <-> Y)],
+// X = a / h, Y = b / h; under the centre, four such rectangles.
+TEST(PathTracer, DiffuseFloorUnderQuadLightIsTheDirectTermOnly) {
+  const double a = 1.0, b = 0.6, h = 0.8, rho = 0.6, L = 3.0;
+  Scene scene;
+  scene.occluders.push_back(
+      quad_occluder({-20.0, 0.0, -20.0}, {0.0, 0.0, 40.0}, {40.0, 0.0, 0.0}, {}, {rho, rho, rho}));
+  // Facing down: cross((a, 0, 0), (0, 0, b)) = (0, -ab, 0).
+  scene.lights.push_back(quad_light({-a / 2, h, -b / 2}, {a, 0.0, 0.0}, {0.0, 0.0, b}, {L, L, L}));
+  const GiScene gi(scene);
+  // Looking at the point under the light's centre from beside it (the light
+  // does not hide it); the pixels see a spot 0.02 wide, where F varies < 1e-4.
+  const Camera cam = make_camera({2.0, 1.0, 0.3}, {0.0, 0.0, 0.0}, 0.5, 32, 32);
+  PathTraceOptions po;
+  po.spp = 64;
+  const std::vector<Color> img = path_trace(gi, cam, po);
+  const auto corner = [](double X, double Y) {
+    const double sx = std::sqrt(1.0 + X * X), sy = std::sqrt(1.0 + Y * Y);
+    return (X / sx * std::atan(Y / sx) + Y / sy * std::atan(X / sy)) / (2.0 * kPi);
+  };
+  const double F = 4.0 * corner(a / 2 / h, b / 2 / h);
+  const double expected = rho * L * F;
+  const Stats st = pixel_stats(img, 0);
+  std::printf("floor under quad light: %.6f expected %.6f (%+.3f%%, standard error %.3f%%)\n",
+              st.mean, expected, 100.0 * (st.mean / expected - 1.0), 100.0 * st.se / expected);
+  EXPECT_LT(st.se / expected, 0.005);
+  EXPECT_NEAR(st.mean, expected, 5.0 * st.se);
+}
+
 // A small closed room with every material: a diffuse box of quads, a quad
 // light under the ceiling, a mirror and a glass sphere.
 Scene material_room() {
