@@ -9,6 +9,7 @@
 #include <thread>
 #include <variant>
 
+#include "gi/optics.hpp"
 #include "protocol/camera.hpp"
 #include "protocol/check.hpp"
 #include "protocol/lights/sampling.hpp"
@@ -30,21 +31,6 @@ std::uint64_t mix64(std::uint64_t x) {
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
   x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
   return x ^ (x >> 31);
-}
-
-// Fresnel reflectance of unpolarized light from a medium of index eta_i into
-// one of eta_t, cos_i = cos of the angle of incidence (> 0); 1 past the
-// critical angle. Writes cos of the refracted angle.
-double fresnel(double cos_i, double eta_i, double eta_t, double* cos_t) {
-  const double sin2_t = (eta_i / eta_t) * (eta_i / eta_t) * std::max(0.0, 1.0 - cos_i * cos_i);
-  if (sin2_t >= 1.0) {
-    *cos_t = 0.0;
-    return 1.0;  // total internal reflection
-  }
-  *cos_t = std::sqrt(1.0 - sin2_t);
-  const double rs = (eta_i * cos_i - eta_t * *cos_t) / (eta_i * cos_i + eta_t * *cos_t);
-  const double rp = (eta_t * cos_i - eta_i * *cos_t) / (eta_t * cos_i + eta_i * *cos_t);
-  return 0.5 * (rs * rs + rp * rp);
 }
 
 // Everything a path needs that does not change per path: the lights' pick
@@ -99,7 +85,7 @@ class Tracer {
           break;
         }
         case MaterialType::kMirror:
-          v = v - (2.0 * dot(v, n)) * n;
+          v = reflect(v, n);
           beta = mul(beta, occ.material.reflectance);
           specular = true;
           break;
@@ -107,17 +93,15 @@ class Tracer {
           // Outside is vacuum; `entering` says which side of the surface the ray came from.
           const double eta_i = hit->entering ? 1.0 : occ.material.ior;
           const double eta_t = hit->entering ? occ.material.ior : 1.0;
-          const double cos_i = -dot(v, n);
-          double cos_t = 0.0;
-          const double F = fresnel(cos_i, eta_i, eta_t, &cos_t);
-          if (uniform(rng) < F) {
-            v = v + (2.0 * cos_i) * n;  // reflection, chosen with probability F: weight 1
+          const double F = fresnel_dielectric(-dot(v, n), eta_i, eta_t);
+          const std::optional<Vec3> t = F < 1.0 ? refract(v, n, eta_i, eta_t) : std::nullopt;
+          if (!t || uniform(rng) < F) {
+            v = reflect(v, n);  // chosen with probability F (1 past the critical angle): weight 1
           } else {
             // Refraction, probability 1 - F: weight 1 times the tint of this crossing.
             // Radiance's (eta_t / eta_i)^2 is left out: it cancels over a path that
             // starts and ends outside the glass (camera and lights are outside).
-            const double eta = eta_i / eta_t;
-            v = normalize(eta * v + (eta * cos_i - cos_t) * n);
+            v = normalize(*t);
             beta = mul(beta, occ.material.tint);
           }
           specular = true;
