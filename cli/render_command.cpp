@@ -28,6 +28,7 @@ struct RenderArgs {
   int device = -1;
   std::string platform = "auto";
   int threads = 0;
+  int spp = 64;
 };
 
 std::string frame_stem(const Camera& cam, std::size_t index) {
@@ -79,6 +80,8 @@ int run_render(const RenderArgs& args) {
     summary["renderer"] = "CPU reference (double precision)";
     ReferenceOptions refopts;
     refopts.threads = args.threads;
+    refopts.gi_spp = args.spp;
+    if (scene.has_gi()) summary["gi_spp"] = args.spp;
     for (const Camera& cam : scene.cameras) {
       const auto t0 = std::chrono::steady_clock::now();
       FrameResult fr;
@@ -159,6 +162,9 @@ void add_render_command(CLI::App& app) {
           ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
   CLI::Option* threads =
       cmd->add_option("--threads", args->threads, "CPU reference threads (0: all cores)");
+  CLI::Option* spp = cmd->add_option("--spp", args->spp,
+                                     "CPU reference, scenes with lights: path-traced samples per pixel")
+                         ->check(CLI::Range(1, 1 << 20));
 
   // Rendering on a server: the scene file is sent inline, or a stored scene named.
   CLI::Option* server = cmd->add_option(
@@ -193,7 +199,7 @@ void add_render_command(CLI::App& app) {
           ->check(CLI::Range(1, 256));
   for (CLI::Option* o : {rig, path}) o->excludes(reference);
   // Options of the local renderer mean nothing to a server render.
-  for (CLI::Option* local : {assets, reference, hdr, device, platform, threads})
+  for (CLI::Option* local : {assets, reference, hdr, device, platform, threads, spp})
     server->excludes(local);
 
   cmd->callback([args, remote, seq, batch] {

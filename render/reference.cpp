@@ -4,10 +4,13 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <thread>
 #include <variant>
 #include <vector>
 
+#include "gi/gi_scene.hpp"
+#include "gi/path_tracer.hpp"
 #include "protocol/camera.hpp"
 #include "render/quadrature.hpp"
 
@@ -266,6 +269,18 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
   const double llen = length(light.direction);
   const Vec3 to_light = llen > 0.0 ? (-1.0 / llen) * light.direction : Vec3{0.0, 0.0, 0.0};
 
+  // Lit scenes: the surfaces' radiance from the path tracer, per pixel.
+  std::optional<GiScene> gi;
+  std::vector<Color> gi_radiance;
+  if (scene.has_gi()) {
+    gi.emplace(scene);
+    PathTraceOptions po;
+    po.spp = opts.gi_spp;
+    po.seed = opts.gi_seed;
+    po.threads = opts.threads;
+    gi_radiance = path_trace(*gi, cam, po);
+  }
+
   auto shade_row = [&](int y) {
     const int py = cam.height - 1 - y;  // GL pixel rows count from the bottom
     for (int x = 0; x < cam.width; ++x) {
@@ -273,7 +288,11 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
       const Hit hit = nearest_hit(scene, ray.origin, ray.dir, ray.t_min, ray.t_max);
       Color c = scene.background;
       double t_end = ray.t_max;
-      if (hit.albedo) {
+      if (gi) {
+        // Beams end at the surface or light the path tracer sees through the centre.
+        if (const auto h = gi->intersect(ray.origin, ray.dir, ray.t_min, ray.t_max)) t_end = h->t;
+        c = gi_radiance[static_cast<std::size_t>(y) * cam.width + x];
+      } else if (hit.albedo) {
         t_end = hit.t;
         Vec3 n = hit.n;
         if (dot(n, ray.dir) > 0.0) n = -1.0 * n;  // two-sided

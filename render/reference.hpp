@@ -4,6 +4,8 @@
 // intersects occluders analytically.
 #pragma once
 
+#include <cstdint>
+
 #include "protocol/scene.hpp"
 #include "render/image.hpp"
 
@@ -12,10 +14,17 @@ namespace beamcast {
 struct ReferenceOptions {
   int threads = 0;          // 0: std::thread::hardware_concurrency()
   double rel_tol = 1e-10;   // quadrature tolerance per ray segment
+  // Scenes with lights (Scene::has_gi): path-traced samples per pixel and seed
+  // of the surfaces' radiance (gi/path_tracer.hpp).
+  int gi_spp = 64;
+  std::uint64_t gi_seed = 1;
 };
 
 // Linear HDR image of `cam` (rows top-down): background or Lambert-shaded
-// occluder, plus the beams' energy along the visible part of each ray.
+// occluder, plus the beams' energy along the visible part of each ray. With
+// lights (Scene::has_gi) the path tracer gives each pixel's radiance instead
+// (surfaces lit by the lights, background where its paths leave the scene);
+// the beams are added on top, clipped at the surface the pixel's centre sees.
 HdrImage render_reference(const Scene& scene, const Camera& cam, const ReferenceOptions& opts = {});
 
 // The energy one beam adds along a ray for t in [t0, t1] (world units), i.e.

@@ -42,6 +42,101 @@ def write(name, scene):
         f.write("\n")
 
 
+# The Cornell box as measured (https://www.graphics.cornell.edu/online/box/data.html):
+# millimetres, each surface a quadrilateral listed by its four vertices.
+CORNELL_WHITE = (0.725, 0.71, 0.68)
+CORNELL_RED = (0.63, 0.065, 0.05)
+CORNELL_GREEN = (0.14, 0.45, 0.091)
+CORNELL_ROOM = {
+    "floor": [(552.8, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 559.2), (549.6, 0.0, 559.2)],
+    "ceiling": [(556.0, 548.8, 0.0), (556.0, 548.8, 559.2), (0.0, 548.8, 559.2), (0.0, 548.8, 0.0)],
+    "back": [(549.6, 0.0, 559.2), (0.0, 0.0, 559.2), (0.0, 548.8, 559.2), (556.0, 548.8, 559.2)],
+    "green": [(0.0, 0.0, 559.2), (0.0, 0.0, 0.0), (0.0, 548.8, 0.0), (0.0, 548.8, 559.2)],
+    "red": [(552.8, 0.0, 0.0), (549.6, 0.0, 559.2), (556.0, 548.8, 559.2), (556.0, 548.8, 0.0)],
+}
+CORNELL_SHORT = [
+    [(130.0, 165.0, 65.0), (82.0, 165.0, 225.0), (240.0, 165.0, 272.0), (290.0, 165.0, 114.0)],
+    [(290.0, 0.0, 114.0), (290.0, 165.0, 114.0), (240.0, 165.0, 272.0), (240.0, 0.0, 272.0)],
+    [(130.0, 0.0, 65.0), (130.0, 165.0, 65.0), (290.0, 165.0, 114.0), (290.0, 0.0, 114.0)],
+    [(82.0, 0.0, 225.0), (82.0, 165.0, 225.0), (130.0, 165.0, 65.0), (130.0, 0.0, 65.0)],
+    [(240.0, 0.0, 272.0), (240.0, 165.0, 272.0), (82.0, 165.0, 225.0), (82.0, 0.0, 225.0)],
+]
+CORNELL_TALL = [
+    [(423.0, 330.0, 247.0), (265.0, 330.0, 296.0), (314.0, 330.0, 456.0), (472.0, 330.0, 406.0)],
+    [(423.0, 0.0, 247.0), (423.0, 330.0, 247.0), (472.0, 330.0, 406.0), (472.0, 0.0, 406.0)],
+    [(472.0, 0.0, 406.0), (472.0, 330.0, 406.0), (314.0, 330.0, 456.0), (314.0, 0.0, 456.0)],
+    [(314.0, 0.0, 456.0), (314.0, 330.0, 456.0), (265.0, 330.0, 296.0), (265.0, 0.0, 296.0)],
+    [(265.0, 0.0, 296.0), (265.0, 330.0, 296.0), (423.0, 330.0, 247.0), (423.0, 0.0, 247.0)],
+]
+
+
+def sub(a, b):
+    return [a[k] - b[k] for k in range(3)]
+
+
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def fit_quad(v, toward):
+    """The parallelogram closest to a measured quadrilateral v0..v3: centred on the
+    vertices' mean, edges the means of opposite sides (each vertex moves by a
+    quarter of v0 - v1 + v2 - v3, at most 1.6 mm here), one-sided with its normal
+    cross(edge_u, edge_v) pointing to `toward`."""
+    eu = [((v[1][k] - v[0][k]) + (v[2][k] - v[3][k])) / 2 for k in range(3)]
+    ev = [((v[3][k] - v[0][k]) + (v[2][k] - v[1][k])) / 2 for k in range(3)]
+    c = [sum(p[k] for p in v) / 4 for k in range(3)]
+    n = cross(eu, ev)
+    if sum(n[k] * (toward[k] - c[k]) for k in range(3)) < 0:
+        eu, ev = ev, eu
+    corner = [round(c[k] - eu[k] / 2 - ev[k] / 2, 4) for k in range(3)]
+    return {"type": "quad", "corner": corner, "edge_u": [round(x, 4) for x in eu],
+            "edge_v": [round(x, 4) for x in ev], "sides": 1}
+
+
+def outward(v, centre):
+    """A point beyond face v as seen from the block's centre (the normal's target)."""
+    c = [sum(p[k] for p in v) / 4 for k in range(3)]
+    return [2 * c[k] - centre[k] for k in range(3)]
+
+
+def cornell_room():
+    inside = (278.0, 274.4, 279.6)
+    colours = {"red": CORNELL_RED, "green": CORNELL_GREEN}
+    walls = []
+    for name, v in CORNELL_ROOM.items():
+        q = fit_quad(v, inside)
+        q["albedo"] = list(colours.get(name, CORNELL_WHITE))
+        walls.append(q)
+    return walls
+
+
+def cornell_block(faces):
+    pts = [p for f in faces for p in f]
+    centre = [sum(p[k] for p in pts) / len(pts) for k in range(3)]
+    out = []
+    for f in faces:
+        q = fit_quad(f, outward(f, centre))
+        q["albedo"] = list(CORNELL_WHITE)
+        out.append(q)
+    return out
+
+
+def cornell(occluders):
+    # Light 130 x 105 mm just below the ceiling, facing down; camera: 35 mm
+    # focal length on a 25 mm film, fov_y = 2 atan(12.5 / 35) = 39.3077 deg.
+    return {
+        "background": [0.0, 0.0, 0.0],
+        "lights": [{"type": "quad", "corner": [213.0, 548.7, 227.0], "edge_u": [130.0, 0.0, 0.0],
+                    "edge_v": [0.0, 0.0, 105.0], "radiance": [17.0, 12.0, 4.0]}],
+        "occluders": cornell_room() + occluders,
+        "cameras": [camera("view", [278.0, 273.0, -800.0], [278.0, 273.0, 0.0],
+                           fov_y=round(2 * math.degrees(math.atan(12.5 / 35.0)), 4),
+                           near=1.0, far=3000.0)],
+        "output": {"exposure": 2.0},
+    }
+
+
 def main():
     for n in (1, 5, 10):
         write(f"paper_{n}set{'s' if n > 1 else ''}.json", {
@@ -113,6 +208,13 @@ def main():
         ],
         "output": {"exposure": 0.7, "bit_depth": 16},
     })
+    write("cornell_box.json", cornell(cornell_block(CORNELL_SHORT) + cornell_block(CORNELL_TALL)))
+    write("cornell_caustic.json", cornell([
+        {"type": "sphere", "center": [380.0, 100.0, 380.0], "radius": 100.0,
+         "material": {"type": "mirror", "reflectance": [0.95, 0.95, 0.95]}},
+        {"type": "sphere", "center": [175.0, 100.0, 200.0], "radius": 100.0,
+         "material": {"type": "glass", "ior": 1.5}},
+    ]))
 
 
 if __name__ == "__main__":
