@@ -53,6 +53,10 @@ struct alignas(16) AnalyticData {
   float albedo[4];
 };
 
+// The G-buffer's material code of an emitter (after the MaterialType values
+// 0 diffuse, 1 mirror, 2 glass); shaders/surface.frag.
+constexpr float kEmitterMaterial = 3.0f;
+
 struct Vertex {
   float position[3];
   float normal[3];
@@ -273,6 +277,19 @@ void SceneResources::upload_occluders() {
         },
         occ.shape);
   }
+  // Lit scenes: quad lights are drawn as what a camera sees of them, their
+  // radiance from the front (G-buffer material code kEmitterMaterial).
+  std::vector<const QuadLight*> emitters;
+  std::vector<Color> radiance;
+  if (scene.has_gi()) {
+    for (const Light& l : scene.lights) {
+      if (const auto* q = std::get_if<QuadLight>(&l.shape)) {
+        emitters.push_back(q);
+        radiance.push_back(q->radiance_scale() * l.flux);
+        bounds.grow(q->bounds());
+      }
+    }
+  }
   std::vector<Vertex> verts;
   if (!bounds.empty()) {
     mesh_anchor_ = bounds.centre();
@@ -287,6 +304,14 @@ void SceneResources::upload_occluders() {
             }
           },
           occ.shape);
+    }
+    sink.material = kEmitterMaterial;
+    for (std::size_t i = 0; i < emitters.size(); ++i) {
+      const QuadLight& q = *emitters[i];
+      sink.albedo = radiance[i];  // the surface shader writes it as emitted radiance
+      const Vec3 far = q.corner + q.edge_u + q.edge_v;
+      sink.add(q.corner, q.corner + q.edge_u, far, true);
+      sink.add(q.corner, far, q.corner + q.edge_v, true);
     }
   }
   if (!verts.empty()) {

@@ -2,7 +2,7 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec3 v_albedo;
 flat in float v_one_sided;
-flat in float v_material;
+flat in float v_material;  // MaterialType, or 3: an emitter (a quad light of a lit scene)
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_view_depth;
@@ -20,7 +20,8 @@ void main() {
   vec3 n = normalize(v_normal);
   out_view_depth = dot(v_position, cam.cam_forward.xyz);
   if (u_gi == 1) {
-    out_color = vec4(0.0);
+    // Material 3: a quad light, whose "albedo" is its emitted radiance.
+    out_color = v_material > 2.5 ? vec4(v_albedo, 0.0) : vec4(0.0);
     out_normal = vec4(dot(n, view_dir) > 0.0 ? -n : n, 0.0);
     out_albedo = vec4(v_albedo, v_material);
     return;
