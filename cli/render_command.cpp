@@ -29,6 +29,7 @@ struct RenderArgs {
   std::string platform = "auto";
   int threads = 0;
   int spp = 64;
+  std::uint64_t seed = 1;
 };
 
 std::string frame_stem(const Camera& cam, std::size_t index) {
@@ -81,6 +82,7 @@ int run_render(const RenderArgs& args) {
     ReferenceOptions refopts;
     refopts.threads = args.threads;
     refopts.gi_spp = args.spp;
+    refopts.gi_seed = args.seed;
     if (scene.has_gi()) summary["gi_spp"] = args.spp;
     for (const Camera& cam : scene.cameras) {
       const auto t0 = std::chrono::steady_clock::now();
@@ -109,6 +111,11 @@ int run_render(const RenderArgs& args) {
       jf["gpu_ms"] = fr.gpu_ms;
       jf["readback_ms"] = fr.readback_ms;
       for (const PassTiming& p : fr.passes) jf["passes"].push_back({{"name", p.name}, {"gpu_ms", p.gpu_ms}});
+      if (scene.has_gi()) {
+        jf["photons"] = {{"count", fr.photons},
+                         {"trace_ms", fr.photon_trace_ms},
+                         {"upload_ms", fr.photon_upload_ms}};
+      }
     }
     if (args.hdr) {
       const fs::path raw = fs::path(args.out) / (frame_stem(cam, i) + ".rgb32f");
@@ -165,6 +172,8 @@ void add_render_command(CLI::App& app) {
   CLI::Option* spp = cmd->add_option("--spp", args->spp,
                                      "CPU reference, scenes with lights: path-traced samples per pixel")
                          ->check(CLI::Range(1, 1 << 20));
+  CLI::Option* seed = cmd->add_option("--seed", args->seed,
+                                      "CPU reference, scenes with lights: the path tracer's seed");
 
   // Rendering on a server: the scene file is sent inline, or a stored scene named.
   CLI::Option* server = cmd->add_option(
@@ -199,7 +208,7 @@ void add_render_command(CLI::App& app) {
           ->check(CLI::Range(1, 256));
   for (CLI::Option* o : {rig, path}) o->excludes(reference);
   // Options of the local renderer mean nothing to a server render.
-  for (CLI::Option* local : {assets, reference, hdr, device, platform, threads, spp})
+  for (CLI::Option* local : {assets, reference, hdr, device, platform, threads, spp, seed})
     server->excludes(local);
 
   cmd->callback([args, remote, seq, batch] {

@@ -50,9 +50,10 @@ PhotonMaps trace_photons(const Scene& scene, const GiScene& surfaces,
 // Whether any occluder is a mirror or glass (a caustic map is traced).
 bool has_specular(const Scene& scene);
 
-// The splat / gather radius when gi.radius is 0: about 50 photons per disk
-// if the global map's photons spread evenly over the six faces of the scene's
-// bounding box.
+// The splat / gather radius when gi.radius is 0: with the global map's
+// photons spread evenly over the six faces of the scene's bounding box, 50
+// photons per disk at 1e5 photons, and r proportional to photons^(-1/6)
+// (the bias-variance balance of a 2D density estimate).
 double default_photon_radius(const Scene& scene, std::int64_t photons);
 
 }  // namespace beamcast

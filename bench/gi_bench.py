@@ -1,0 +1,263 @@
+#!/usr/bin/python3
+"""Photon-mapped global illumination: error against the path-traced reference
+versus time (issue 14, item 6). python3 bench/gi_bench.py --out DIR [--quick].
+
+Runs `beamcast render` (this build) on the Cornell box (examples/cornell_box.json):
+  - the reference: `--reference --spp N` (the double-precision path tracer),
+    twice with different seeds, so the reference's own noise is measured
+    (the L1 difference of two independent references is sqrt(2) x the noise
+    of one);
+  - the GPU frame (photon splatting) for each setting: photon counts 1e3 ...
+    1e6 (default kernel and radius), each kernel at 1e5, the radius at 0.5x
+    and 2x its default at 1e5.
+Per setting: photon tracing time (CPU, first render), photon upload time and
+GPU time per frame with the maps cached (median of the scene's cameras:
+copies of the one camera), and the relative L1 error against the reference
+(sum |gpu - ref| / sum ref over pixels and channels) over the image and per
+wall (pixels labelled by the quad each pixel's centre ray hits first,
+computed here from the scene's quads).
+Writes DIR/gi.csv, DIR/gi.md, DIR/gi.png (error against photon count with the
+log-log slope, error against GPU time), and the images (PNG) of the reference
+and the default setting. Standard library and numpy; matplotlib for the plot.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+# The quads of examples/cornell_box.json, in order (scripts/make_examples.py).
+CORNELL_LABELS = (["floor", "ceiling", "back wall", "green wall", "red wall"] +
+                  ["short block"] * 5 + ["tall block"] * 5)
+
+
+def run_render(binary, scene, out_dir, extra):
+    os.makedirs(out_dir, exist_ok=True)
+    path = os.path.join(out_dir, "scene.json")
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    t0 = time.perf_counter()
+    p = subprocess.run([binary, "render", path, "--json", "--hdr", "-o", out_dir] + extra,
+                       capture_output=True, text=True, check=True)
+    wall = time.perf_counter() - t0
+    return json.loads(p.stdout), wall
+
+
+def load_hdr(frame):
+    w, h = frame["width"], frame["height"]
+    return np.fromfile(frame["hdr_file"], dtype=np.float32).reshape(h, w, 3).astype(np.float64)
+
+
+def camera_rays(cam):
+    """Unit directions of the pixel-centre rays, rows top-down (protocol/camera.cpp)."""
+    w, h = cam["width"], cam["height"]
+    pos = np.array(cam["position"], float)
+    fwd = np.array(cam["target"], float) - pos
+    fwd /= np.linalg.norm(fwd)
+    up = np.array(cam.get("up", [0, 1, 0]), float)
+    right = np.cross(fwd, up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, fwd)
+    th = math.tan(math.radians(cam.get("fov_y", 45.0)) / 2)
+    px = (np.arange(w) + 0.5) / w * 2 - 1
+    py = ((h - 1 - np.arange(h)) + 0.5) / h * 2 - 1
+    nx, ny = np.meshgrid(px, py)
+    d = (fwd[None, None, :] + nx[..., None] * th * (w / h) * right + ny[..., None] * th * up)
+    return pos, d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
+def label_pixels(scene, cam):
+    """Per pixel: the index of the first quad occluder hit (-1: none)."""
+    o, d = camera_rays(cam)
+    best = np.full(d.shape[:2], np.inf)
+    label = np.full(d.shape[:2], -1)
+    for i, q in enumerate(scene["occluders"]):
+        if q["type"] != "quad":
+            continue
+        c, u, v = (np.array(q[k], float) for k in ("corner", "edge_u", "edge_v"))
+        n = np.cross(u, v)
+        denom = d @ n
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.dot(c - o, n) / denom
+        p = o + t[..., None] * d - c
+        n2 = n @ n
+        a = np.cross(p, v) @ n / n2
+        b = np.cross(u, p) @ n / n2
+        ok = (t > 0) & (a >= 0) & (a <= 1) & (b >= 0) & (b <= 1) & (t < best)
+        if q.get("sides", 2) == 1:
+            ok &= denom < 0
+        best = np.where(ok, t, best)
+        label = np.where(ok, i, label)
+    return label
+
+
+def rel_l1(img, ref, mask=None):
+    diff = np.abs(img - ref).sum(axis=-1)
+    tot = ref.sum(axis=-1)
+    if mask is not None:
+        diff, tot = diff[mask], tot[mask]
+    s = tot.sum()
+    return float(diff.sum() / s) if s > 0 else float("nan")
+
+
+def default_radius(scene, photons):
+    """gi/photon_map.cpp default_photon_radius: 50 photons per disk at 1e5, r ~ photons^(-1/6)."""
+    pts = []
+    for q in scene["occluders"]:
+        c, u, v = (np.array(q[k], float) for k in ("corner", "edge_u", "edge_v"))
+        pts += [c, c + u, c + v, c + u + v]
+    for q in scene.get("lights", []):
+        if q["type"] == "quad":
+            c, u, v = (np.array(q[k], float) for k in ("corner", "edge_u", "edge_v"))
+            pts += [c, c + u, c + v, c + u + v]
+    pts = np.array(pts)
+    s = pts.max(axis=0) - pts.min(axis=0)
+    area = 2 * (s[0] * s[1] + s[1] * s[2] + s[2] * s[0])
+    k = 50 * (photons / 1e5) ** (2 / 3)
+    return math.sqrt(k * area / (math.pi * photons))
+
+
+def write_png(path, hdr, exposure):
+    """Tone curve 1 - exp(-x), sRGB, 8 bits (render/image.cpp's default), via matplotlib."""
+    x = 1 - np.exp(-exposure * np.maximum(hdr, 0))
+    srgb = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        plt.imsave(path, np.clip(srgb, 0, 1))
+    except ImportError:
+        pass
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--binary", default=os.path.join(ROOT, "build", "bin", "beamcast"))
+    ap.add_argument("--scene", default=os.path.join(ROOT, "examples", "cornell_box.json"))
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--quick", action="store_true",
+                    help="128x128, reference 64 spp, photons 1e3..1e5 (about a minute)")
+    ap.add_argument("--size", type=int, help="frame size (default 512, 128 with --quick)")
+    ap.add_argument("--spp", type=int, help="reference samples per pixel (default 1024, 64 quick)")
+    ap.add_argument("--views", type=int, default=4,
+                    help="camera copies per GPU render (frame time = median over them)")
+    a = ap.parse_args()
+    size = a.size or (128 if a.quick else 512)
+    spp = a.spp or (64 if a.quick else 1024)
+    os.makedirs(a.out, exist_ok=True)
+    with open(a.scene) as f:
+        base = json.load(f)
+    cam = dict(base["cameras"][0], width=size, height=size)
+    base["cameras"] = [cam]
+    labels = label_pixels(base, cam)
+    exposure = base.get("output", {}).get("exposure", 1.0)
+
+    refs = []
+    ref_wall = []
+    for seed in (1, 2):
+        s = dict(base, gi=dict(base.get("gi", {}), seed=seed))
+        # The path tracer's seed is its own option; two renders with
+        # different seeds give independent references.
+        summary, wall = run_render(a.binary, s, os.path.join(a.out, f"ref{seed}"),
+                                   ["--reference", "--spp", str(spp), "--seed", str(seed)])
+        refs.append(load_hdr(summary["frames"][0]))
+        ref_wall.append(wall)
+    ref = 0.5 * (refs[0] + refs[1])  # the reference: both, 2 x spp
+    # Noise of the averaged reference: |ref1 - ref2| / 2 estimates it (each
+    # has sqrt(2) x its noise; the mean has 1 / sqrt(2) x).
+    ref_noise = rel_l1(refs[0], refs[1]) / 2
+    write_png(os.path.join(a.out, "reference.png"), ref, exposure)
+
+    counts = [1000, 3000, 10000, 30000, 100000] if a.quick else \
+        [1000, 3000, 10000, 30000, 100000, 300000, 1000000]
+    mid = 10000 if a.quick else 100000
+    settings = [("photons", n, "epanechnikov", 1.0) for n in counts]
+    settings += [("kernel", mid, k, 1.0) for k in ("box", "cone")]
+    settings += [("radius", mid, "epanechnikov", s) for s in (0.5, 2.0)]
+    regions = sorted(set(CORNELL_LABELS)) if len(base["occluders"]) == len(CORNELL_LABELS) else []
+
+    rows = []
+    for knob, n, kernel, rscale in settings:
+        r = default_radius(base, n) * rscale
+        s = dict(base, gi=dict(base.get("gi", {}), photons=n, kernel=kernel, radius=r))
+        # Copies of the camera, each nudged by a hair so no two frames are
+        # the same work: the maps are traced once, the frames time a
+        # camera-only change.
+        s["cameras"] = [dict(cam, name=f"v{i}", position=[cam["position"][0] + 0.01 * i] +
+                             cam["position"][1:]) for i in range(a.views)]
+        summary, wall = run_render(a.binary, s, os.path.join(a.out, "gpu"), [])
+        frames = summary["frames"]
+        img = load_hdr(frames[0])
+        row = {"knob": knob, "photons": n, "kernel": kernel, "radius": round(r, 3),
+               "radius_scale": rscale,
+               "stored": frames[0]["photons"]["count"],
+               "trace_ms": round(frames[0]["photons"]["trace_ms"], 1),
+               "upload_ms": round(frames[0]["photons"]["upload_ms"], 1),
+               "gpu_ms": round(statistics.median(f["gpu_ms"] for f in frames), 1),
+               "frame_ms": round(statistics.median(f["wall_ms"] for f in frames), 1),
+               "rel_l1": round(rel_l1(img, ref), 4)}
+        for reg in regions:
+            mask = np.isin(labels, [i for i, l in enumerate(CORNELL_LABELS) if l == reg])
+            row["rel_l1_" + reg.replace(" ", "_")] = round(rel_l1(img, ref, mask), 4)
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+        if knob == "photons" and n == 100000:
+            write_png(os.path.join(a.out, "gpu_1e5.png"), img, exposure)
+        if knob == "photons" and n == counts[-1]:
+            write_png(os.path.join(a.out, f"gpu_{n}.png"), img, exposure)
+
+    with open(os.path.join(a.out, "gi.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+    sweep = [r for r in rows if r["knob"] == "photons"]
+    x = np.log10([r["photons"] for r in sweep])
+    y = np.log10([r["rel_l1"] for r in sweep])
+    slope = float(np.polyfit(x, y, 1)[0]) if len(sweep) > 1 else float("nan")
+    with open(os.path.join(a.out, "gi.md"), "w") as f:
+        f.write(f"# Photon splatting against the path tracer ({os.path.basename(a.scene)}, "
+                f"{size}x{size})\n\n")
+        f.write(f"Reference: 2 x {spp} spp path traced ({ref_wall[0]:.0f} + {ref_wall[1]:.0f} s "
+                f"wall); its own noise (rel. L1): {ref_noise:.4f}.\n")
+        f.write(f"Log-log slope of error against photon count: {slope:.2f}.\n\n")
+        cols = list(rows[0].keys())
+        f.write("| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n")
+        for r in rows:
+            f.write("| " + " | ".join(str(r[c]) for c in cols) + " |\n")
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+        ax[0].loglog([r["photons"] for r in sweep], [r["rel_l1"] for r in sweep], "o-",
+                     label=f"image (slope {slope:.2f})")
+        for reg in regions:
+            key = "rel_l1_" + reg.replace(" ", "_")
+            ax[0].loglog([r["photons"] for r in sweep], [r[key] for r in sweep], ".--", label=reg,
+                         alpha=0.6)
+        ax[0].axhline(ref_noise, color="grey", lw=0.8, label="reference noise")
+        ax[0].set_xlabel("photons emitted")
+        ax[0].set_ylabel("relative L1 error")
+        ax[0].legend(fontsize=7)
+        for knob, mk in (("photons", "o"), ("kernel", "s"), ("radius", "^")):
+            pts = [r for r in rows if r["knob"] == knob]
+            ax[1].loglog([r["gpu_ms"] for r in pts], [r["rel_l1"] for r in pts], mk, label=knob)
+        ax[1].set_xlabel("GPU ms per frame (photons cached)")
+        ax[1].set_ylabel("relative L1 error")
+        ax[1].legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(os.path.join(a.out, "gi.png"), dpi=110)
+    except ImportError:
+        print("matplotlib missing: no plot", file=sys.stderr)
+    print(f"slope {slope:.3f}, reference noise {ref_noise:.4f}; wrote {a.out}/gi.csv, gi.md")
+
+
+if __name__ == "__main__":
+    main()
