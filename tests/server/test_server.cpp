@@ -106,6 +106,53 @@ TEST(Server, RemoteRenderIsPixelIdenticalToOfflineRender) {
   EXPECT_EQ(compare_levels(remote, frames[0].image).max_abs, 0);
 }
 
+// Lit scenes (issue 14) over the wire: the response lists the photon passes
+// and each frame's photons, a camera-only change traces nothing (the
+// render worker's cache), and bad lights, materials and photon counts get
+// errors with their paths while the server keeps serving.
+TEST(Server, LitScenesReportPhotonsAndRefuseBadLightsWithPaths) {
+  TestServer s;
+  json scene = read_example("cornell_box");
+  scene["cameras"][0]["width"] = 64;
+  scene["cameras"][0]["height"] = 64;
+  scene["gi"] = {{"photons", 5000}};
+  Conn c(s.port());
+  Reply r = c.call(render_req(1, scene));
+  ASSERT_TRUE(r.json["ok"]) << r.json;
+  EXPECT_EQ(r.json["result"]["passes"], json({"gbuffer", "photons", "tonemap"}));
+  const RenderResponse first = test::render_result(r);
+  ASSERT_TRUE(first.frames[0].photons);
+  EXPECT_GT(first.frames[0].photons->count, 0);
+  EXPECT_GT(first.frames[0].photons->trace_ms, 0.0);
+  scene["cameras"][0]["position"][0] = 270.0;
+  r = c.call(render_req(2, scene));
+  ASSERT_TRUE(r.json["ok"]) << r.json;
+  EXPECT_EQ(test::render_result(r).frames[0].photons->trace_ms, 0.0);
+  // A beam-only render has no photons member.
+  r = c.call(render_req(3, small_scene(16)));
+  ASSERT_TRUE(r.json["ok"]) << r.json;
+  EXPECT_FALSE(test::render_result(r).frames[0].photons);
+
+  json bad = scene;
+  bad["lights"] = {{{"type", "point"}, {"position", {278, 500, 280}}, {"power", -5}}};
+  r = c.call(render_req(4, bad));
+  EXPECT_EQ(error_code(r), "out_of_range");
+  EXPECT_EQ(error_path(r), "/params/scene/lights/0/power");
+  bad = scene;
+  bad["occluders"][5]["material"] = {{"type", "glass"}, {"ior", 0}};
+  r = c.call(render_req(5, bad));
+  EXPECT_EQ(error_code(r), "out_of_range");
+  EXPECT_EQ(error_path(r), "/params/scene/occluders/5/material/ior");
+  bad = scene;
+  bad["gi"] = {{"photons", 4000001}};  // the server's max_photons is 4 000 000
+  r = c.call(render_req(6, bad));
+  EXPECT_EQ(error_code(r), "limit_exceeded");
+  EXPECT_EQ(error_path(r), "/params/scene/gi/photons");
+  EXPECT_TRUE(s.healthy());
+  r = c.call(render_req(7, scene));
+  EXPECT_TRUE(r.json["ok"]) << r.json;
+}
+
 TEST(Server, PipelinedRequestsAnswerWithTheirIds) {
   TestServer s;
   Conn c(s.port());
