@@ -10,6 +10,7 @@
 #include <variant>
 
 #include "gi/optics.hpp"
+#include "gi/parallel.hpp"
 #include "protocol/camera.hpp"
 #include "protocol/check.hpp"
 #include "protocol/lights/sampling.hpp"
@@ -180,20 +181,7 @@ std::vector<Color> path_trace(const GiScene& gi, const Camera& cam, const PathTr
     }
   };
 
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const int nthreads = std::min(h, opts.threads > 0 ? opts.threads : static_cast<int>(hw));
-  std::atomic<int> next{0};
-  auto worker = [&] {
-    for (int y = next.fetch_add(1); y < h; y = next.fetch_add(1)) trace_row(y);
-  };
-  if (nthreads <= 1) {
-    worker();
-  } else {
-    std::vector<std::thread> pool;
-    pool.reserve(nthreads);
-    for (int k = 0; k < nthreads; ++k) pool.emplace_back(worker);
-    for (auto& th : pool) th.join();
-  }
+  parallel_items(h, opts.threads, trace_row);
   return img;
 }
 

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <thread>
 
+#include "gi/parallel.hpp"
 #include "protocol/camera.hpp"
 
 namespace beamcast {
@@ -137,16 +138,7 @@ HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonG
       for (int k = 0; k < 3; ++k) px[k] = static_cast<float>(c[k]);
     }
   };
-  const int threads = opts.threads > 0 ? opts.threads
-                                       : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::thread> pool;
-  std::atomic<int> next{0};
-  auto work = [&] {
-    for (int y = next++; y < cam.height; y = next++) row(y);
-  };
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
+  parallel_items(cam.height, opts.threads, row);
   return img;
 }
 

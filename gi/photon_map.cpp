@@ -11,6 +11,7 @@
 #include <variant>
 
 #include "gi/optics.hpp"
+#include "gi/parallel.hpp"
 #include "protocol/lights/sampling.hpp"
 
 namespace beamcast {
@@ -142,21 +143,14 @@ std::vector<Photon> trace_map(const Scene& scene, const GiScene& surfaces, std::
   const LightChoice lights(scene);
   const std::int64_t chunks = (count + kChunk - 1) / kChunk;
   std::vector<std::vector<Photon>> parts(static_cast<std::size_t>(chunks));
-  std::atomic<std::int64_t> next{0};
-  auto work = [&] {
-    for (std::int64_t c = next++; c < chunks; c = next++) {
-      Random rng(scene.gi.seed, static_cast<std::uint32_t>(map), static_cast<std::uint64_t>(c));
-      const std::int64_t n = std::min(kChunk, count - c * kChunk);
-      std::vector<Photon>& out = parts[static_cast<std::size_t>(c)];
-      for (std::int64_t i = 0; i < n; ++i) {
-        trace_one(scene, surfaces, lights, count, map, global_skips_caustics, rng, &out);
-      }
+  parallel_items(static_cast<int>(chunks), threads, [&](int c) {
+    Random rng(scene.gi.seed, static_cast<std::uint32_t>(map), static_cast<std::uint64_t>(c));
+    const std::int64_t n = std::min(kChunk, count - c * kChunk);
+    std::vector<Photon>& out = parts[static_cast<std::size_t>(c)];
+    for (std::int64_t i = 0; i < n; ++i) {
+      trace_one(scene, surfaces, lights, count, map, global_skips_caustics, rng, &out);
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
+  });
   std::size_t total = 0;
   for (const auto& p : parts) total += p.size();
   std::vector<Photon> all;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gi/gi_scene.hpp"
+#include "gi/parallel.hpp"
 #include "gi/path_tracer.hpp"
 #include "protocol/camera.hpp"
 #include "render/quadrature.hpp"
@@ -311,21 +312,7 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
     }
   };
 
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const int nthreads =
-      std::min(cam.height, opts.threads > 0 ? opts.threads : static_cast<int>(hw));
-  std::atomic<int> next{0};
-  auto worker = [&] {
-    for (int y = next.fetch_add(1); y < cam.height; y = next.fetch_add(1)) shade_row(y);
-  };
-  if (nthreads <= 1) {
-    worker();
-  } else {
-    std::vector<std::thread> pool;
-    pool.reserve(nthreads);
-    for (int k = 0; k < nthreads; ++k) pool.emplace_back(worker);
-    for (auto& th : pool) th.join();
-  }
+  parallel_items(cam.height, opts.threads, shade_row);
   return img;
 }
 

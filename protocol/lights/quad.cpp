@@ -4,6 +4,7 @@
 
 #include "protocol/lights/light_parse.hpp"
 #include "protocol/lights/sampling.hpp"
+#include "protocol/parallelogram.hpp"
 
 namespace beamcast {
 
@@ -11,28 +12,17 @@ using namespace json_read;
 
 QuadLight QuadLight::parse(const LightParse& in) {
   QuadLight q;
-  q.corner = read_point(in.fields.required("corner"), in.limits);
-  q.edge_u = read_point(in.fields.required("edge_u"), in.limits);
-  const Node v = in.fields.required("edge_v");
-  q.edge_v = read_point(v, in.limits);
-  const Vec3 n = cross(q.edge_u, q.edge_v);
+  const Parallelogram p = Parallelogram::read(in.fields, in.limits, "light");
+  q.corner = p.corner;
+  q.edge_u = p.edge_u;
+  q.edge_v = p.edge_v;
+  const Vec3 n = p.normal_unnormalized();
   q.area = length(n);
-  // The rule of the quad occluder: sin(angle between the edges) >= 1e-9.
-  if (!(q.area > 1e-9 * length(q.edge_u) * length(q.edge_v))) {
-    fail("invalid_value", v.path,
-         "edge_v must not be zero or parallel to edge_u (the light would have no area)");
-  }
   q.normal = (1.0 / q.area) * n;
   return q;
 }
 
-Aabb QuadLight::bounds() const {
-  Aabb b;
-  for (const Vec3& p : {corner, corner + edge_u, corner + edge_v, corner + edge_u + edge_v}) {
-    b.grow(p);
-  }
-  return b;
-}
+Aabb QuadLight::bounds() const { return Parallelogram{corner, edge_u, edge_v}.bounds(); }
 
 Emission QuadLight::emit(const LightRandom& u) const {
   // Uniform in area, cosine-weighted in direction: each photon carries an
@@ -53,16 +43,9 @@ LightSample QuadLight::sample(const Vec3& x, const LightRandom& u) const {
 }
 
 std::optional<double> QuadLight::hit(const Vec3& o, const Vec3& v, double t_max) const {
-  const double denom = dot(v, normal);
-  if (denom >= 0.0) return std::nullopt;  // seen only from the side it emits to
-  const double t = dot(corner - o, normal) / denom;
-  if (!(t > 0.0 && t <= t_max)) return std::nullopt;
-  const Vec3 p = (o + t * v) - corner;
-  const Vec3 n = cross(edge_u, edge_v);
-  const double n2 = dot(n, n);
-  const double a = dot(cross(p, edge_v), n) / n2;
-  const double b = dot(cross(edge_u, p), n) / n2;
-  if (a < 0.0 || a > 1.0 || b < 0.0 || b > 1.0) return std::nullopt;
+  // Seen only from the side it emits to; t > 0 strictly.
+  const auto t = Parallelogram{corner, edge_u, edge_v}.hit(o, v, 0.0, t_max, true);
+  if (!t || !(*t > 0.0)) return std::nullopt;
   return t;
 }
 
