@@ -91,13 +91,13 @@ std::string fps_cell(const AccuracyRow* r) {
                               : "n/a";
 }
 
+}  // namespace
+
 std::string shell_quote(const std::string& s) {
   std::string q = "'";
   for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return q + "'";
 }
-
-}  // namespace
 
 const char* csv_header() {
   return "scene,method,layout,filter,table_size,samples,rule,gpu_ms,beam_gpu_ms,wall_ms,repeats,"

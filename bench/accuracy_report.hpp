@@ -44,5 +44,7 @@ void write_summary(const std::filesystem::path& file, const std::vector<Accuracy
 // Runs /usr/bin/python3 bench/plot_accuracy.py CSV OUT_DIR. Returns an empty
 // string on success, else one line saying why there are no plots.
 std::string run_plot_script(const std::filesystem::path& csv, const std::filesystem::path& out_dir);
+// `s` as one POSIX shell word (single quotes).
+std::string shell_quote(const std::string& s);
 
 }  // namespace beamcast::bench

@@ -10,6 +10,10 @@ Runs `beamcast render` (this build) on the Cornell box (examples/cornell_box.jso
   - the GPU frame (photon splatting) for each setting: photon counts 1e3 ...
     1e6 (default kernel and radius), each kernel at 1e5, the radius at 0.5x
     and 2x its default at 1e5.
+Per photon count also the CPU photon gather on the same photons
+(`beamcast render --gather radius`: the splat estimator in double; and
+`--gather nearest`, k = 50): its error against the reference, and the GPU
+frame's difference from it (the splatting's own error).
 Per setting: photon tracing time (CPU, first render), photon upload time and
 GPU time per frame with the maps cached (median of the scene's cameras:
 copies of the one camera), and the relative L1 error against the reference
@@ -206,6 +210,19 @@ def main():
         for reg in regions:
             mask = np.isin(labels, [i for i, l in enumerate(CORNELL_LABELS) if l == reg])
             row["rel_l1_" + reg.replace(" ", "_")] = round(rel_l1(img, ref, mask), 4)
+        if knob == "photons":
+            # The same photons estimated on the CPU in double: the splat
+            # estimator (separates the GPU splatting's own error from the
+            # photons' noise and bias) and the textbook k-nearest estimator.
+            one = dict(s, cameras=[dict(cam, name="v0")])
+            g, _ = run_render(a.binary, one, os.path.join(a.out, "gather"), ["--gather", "radius"])
+            gimg = load_hdr(g["frames"][0])
+            k, _ = run_render(a.binary, one, os.path.join(a.out, "knn"), ["--gather", "nearest"])
+            kimg = load_hdr(k["frames"][0])
+            row["gather_ms"] = round(g["frames"][0]["wall_ms"], 1)
+            row["gather_rel_l1"] = round(rel_l1(gimg, ref), 4)
+            row["splat_vs_gather"] = round(rel_l1(img, gimg), 4)
+            row["knn50_rel_l1"] = round(rel_l1(kimg, ref), 4)
         rows.append(row)
         print(json.dumps(row), flush=True)
         if knob == "photons" and n == 100000:
@@ -214,7 +231,7 @@ def main():
             write_png(os.path.join(a.out, f"gpu_{n}.png"), img, exposure)
 
     with open(os.path.join(a.out, "gi.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()), restval="")
         w.writeheader()
         w.writerows(rows)
     sweep = [r for r in rows if r["knob"] == "photons"]
@@ -230,7 +247,7 @@ def main():
         cols = list(rows[0].keys())
         f.write("| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n")
         for r in rows:
-            f.write("| " + " | ".join(str(r[c]) for c in cols) + " |\n")
+            f.write("| " + " | ".join(str(r.get(c, "")) for c in cols) + " |\n")
     try:
         import matplotlib
         matplotlib.use("Agg")

@@ -1,5 +1,13 @@
-// `beamcast bench accuracy`: the accuracy/time benchmark of bench/accuracy.hpp.
+// `beamcast bench accuracy`: the accuracy/time benchmark of bench/accuracy.hpp;
+// `bench views`; `bench gi` (bench/gi_bench.py, run with this binary).
+#include <sys/wait.h>
+
+#include <filesystem>
 #include <memory>
+#include <string>
+
+#include "bench/accuracy_report.hpp"
+#include "protocol/data_dir.hpp"
 
 #include "bench/accuracy.hpp"
 #include "bench/views.hpp"
@@ -56,6 +64,42 @@ void add_bench_command(CLI::App& app) {
   views->callback([vopts] {
     const int rc = bench::run_views(*vopts);
     if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+
+  // Photon-mapped GI against the path tracer: bench/gi_bench.py drives this
+  // binary's `render` (GPU, --reference, --gather) and compares the images
+  // with numpy; the subcommand runs it with this binary.
+  struct GiArgs {
+    std::string out, scene;
+    bool quick = false;
+    int size = 0, spp = 0;
+  };
+  auto gopts = std::make_shared<GiArgs>();
+  CLI::App* gi = bench->add_subcommand(
+      "gi",
+      "Photon splatting against the path-traced reference on the Cornell box: photon count, "
+      "kernel and radius, error per wall against time; writes gi.csv, gi.md and gi.png to --out "
+      "(runs bench/gi_bench.py with /usr/bin/python3 and numpy)");
+  gi->add_option("--out,-o", gopts->out, "Output directory (created if missing)")->required();
+  gi->add_flag("--quick", gopts->quick, "128x128, reference 64 spp, up to 1e5 photons (seconds)");
+  gi->add_option("--size", gopts->size, "Frame width and height (default 512, 128 with --quick)")
+      ->check(CLI::Range(16, 4096));
+  gi->add_option("--spp", gopts->spp, "Reference samples per pixel (default 1024, 64 with --quick)")
+      ->check(CLI::Range(1, 1 << 20));
+  gi->add_option("--scene", gopts->scene, "Scene (default examples/cornell_box.json)");
+  gi->callback([gopts] {
+    const std::filesystem::path script = find_data_dir("bench") / "gi_bench.py";
+    std::string cmd = "/usr/bin/python3 " + bench::shell_quote(script.string()) + " --binary " +
+                      bench::shell_quote(std::filesystem::read_symlink("/proc/self/exe").string()) +
+                      " --out " + bench::shell_quote(gopts->out);
+    if (gopts->quick) cmd += " --quick";
+    if (gopts->size > 0) cmd += " --size " + std::to_string(gopts->size);
+    if (gopts->spp > 0) cmd += " --spp " + std::to_string(gopts->spp);
+    if (!gopts->scene.empty()) cmd += " --scene " + bench::shell_quote(gopts->scene);
+    const int status = std::system(cmd.c_str());
+    if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      throw CLI::RuntimeError(status == -1 || !WIFEXITED(status) ? 1 : WEXITSTATUS(status));
+    }
   });
 }
 

@@ -9,6 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "gi/gi_scene.hpp"
+#include "gi/photon_gather.hpp"
+#include "gi/photon_map.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
 #include "render/pass_plan.hpp"
@@ -30,6 +33,8 @@ struct RenderArgs {
   int threads = 0;
   int spp = 64;
   std::uint64_t seed = 1;
+  std::string gather;  // "", "radius" or "nearest": the CPU photon gather
+  int gather_k = 50;
 };
 
 std::string frame_stem(const Camera& cam, std::size_t index) {
@@ -63,13 +68,41 @@ int run_render(const RenderArgs& args) {
 
   nlohmann::json summary;
   summary["scene"] = args.scene;
-  summary["method"] = args.reference ? "reference" : "gpu";
+  summary["method"] = args.reference ? "reference" : !args.gather.empty() ? "gather" : "gpu";
   summary["passes"] = plan_passes(scene);
   summary["frames"] = nlohmann::json::array();
 
   std::unique_ptr<Renderer> renderer;
   std::vector<FrameResult> frames;
-  if (!args.reference) {
+  if (!args.gather.empty()) {
+    // The CPU estimate from the same photon maps the GPU splats (gi/photon_gather):
+    // "radius" is the splat pass's estimator in double, "nearest" the
+    // textbook k-nearest one.
+    if (!scene.has_gi()) {
+      std::fprintf(stderr, "beamcast: --gather needs a scene with lights\n");
+      return 2;
+    }
+    summary["renderer"] = "CPU photon gather (" + args.gather + ")";
+    const GiScene surfaces(scene);
+    const PhotonMaps maps = trace_photons(scene, surfaces, {.threads = args.threads});
+    const PhotonGather gather(maps);
+    summary["photons"] = {{"count", maps.global.size() + maps.caustic.size()},
+                          {"trace_ms", maps.trace_ms}};
+    GatherImageOptions gopts;
+    gopts.method = args.gather == "nearest" ? GatherMethod::kNearest : GatherMethod::kFixedRadius;
+    gopts.k = args.gather_k;
+    gopts.threads = args.threads;
+    for (const Camera& cam : scene.cameras) {
+      const auto t0 = std::chrono::steady_clock::now();
+      FrameResult fr;
+      fr.hdr = gather_image(scene, surfaces, gather, cam, gopts);
+      fr.image = tone_map(fr.hdr, scene.output);
+      fr.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                       .count();
+      if (!args.hdr) fr.hdr = {};
+      frames.push_back(std::move(fr));
+    }
+  } else if (!args.reference) {
     RendererOptions ropts;
     ropts.egl.device_index = args.device;
     ropts.egl.platform = args.platform;
@@ -107,7 +140,7 @@ int run_render(const RenderArgs& args) {
     jf["width"] = cam.width;
     jf["height"] = cam.height;
     jf["wall_ms"] = fr.wall_ms;
-    if (!args.reference) {
+    if (!args.reference && args.gather.empty()) {
       jf["gpu_ms"] = fr.gpu_ms;
       jf["readback_ms"] = fr.readback_ms;
       for (const PassTiming& p : fr.passes) jf["passes"].push_back({{"name", p.name}, {"gpu_ms", p.gpu_ms}});
@@ -126,7 +159,7 @@ int run_render(const RenderArgs& args) {
     if (!args.json) {
       std::printf("%-24s %4dx%-4d wall %8.2f ms", file.filename().c_str(), cam.width, cam.height,
                   fr.wall_ms);
-      if (!args.reference) {
+      if (!args.reference && args.gather.empty()) {
         std::printf("  gpu %7.3f ms (", fr.gpu_ms);
         for (std::size_t k = 0; k < fr.passes.size(); ++k) {
           std::printf("%s%s %.3f", k ? ", " : "", fr.passes[k].name.c_str(), fr.passes[k].gpu_ms);
@@ -174,6 +207,15 @@ void add_render_command(CLI::App& app) {
                          ->check(CLI::Range(1, 1 << 20));
   CLI::Option* seed = cmd->add_option("--seed", args->seed,
                                       "CPU reference, scenes with lights: the path tracer's seed");
+  CLI::Option* gather =
+      cmd->add_option("--gather", args->gather,
+                      "Scenes with lights: the CPU photon gather on the same photons instead of "
+                      "the GPU (radius: the splat estimator in double; nearest: k nearest)")
+          ->check(CLI::IsMember({"radius", "nearest"}))
+          ->excludes(reference);
+  cmd->add_option("--gather-k", args->gather_k, "With --gather nearest: photons per estimate")
+      ->check(CLI::Range(1, 100000))
+      ->needs(gather);
 
   // Rendering on a server: the scene file is sent inline, or a stored scene named.
   CLI::Option* server = cmd->add_option(
@@ -206,9 +248,12 @@ void add_render_command(CLI::App& app) {
       cmd->add_option("--batch", seq->batch,
                       "With --rig or --path: views per render call or request (default 12)")
           ->check(CLI::Range(1, 256));
-  for (CLI::Option* o : {rig, path}) o->excludes(reference);
+  for (CLI::Option* o : {rig, path}) {
+    o->excludes(reference);
+    o->excludes(gather);
+  }
   // Options of the local renderer mean nothing to a server render.
-  for (CLI::Option* local : {assets, reference, hdr, device, platform, threads, spp, seed})
+  for (CLI::Option* local : {assets, reference, hdr, device, platform, threads, spp, seed, gather})
     server->excludes(local);
 
   cmd->callback([args, remote, seq, batch] {

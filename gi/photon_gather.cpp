@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <thread>
+#include <variant>
 
 #include "gi/parallel.hpp"
 #include "protocol/camera.hpp"
@@ -125,7 +126,11 @@ HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonG
       Color c = scene.background;
       if (hit) {
         c = {0.0, 0.0, 0.0};
-        if (hit->occluder >= 0) {
+        if (hit->light >= 0) {  // a quad light seen from its front: its radiance
+          const Light& l = scene.lights[static_cast<std::size_t>(hit->light)];
+          const double scale = std::visit([](const auto& k) { return k.radiance_scale(); }, l.shape);
+          c = {scale * l.flux[0], scale * l.flux[1], scale * l.flux[2]};
+        } else if (hit->occluder >= 0) {
           const Occluder& o = scene.occluders[static_cast<std::size_t>(hit->occluder)];
           if (o.material.type == MaterialType::kDiffuse) {
             c = opts.method == GatherMethod::kFixedRadius

@@ -52,7 +52,8 @@ struct GatherImageOptions {
 
 // A lit scene's image (rows top-down, like render_reference): the nearest
 // surface along each pixel's centre ray; diffuse surfaces get the photon
-// estimate, mirrors and glass and the background as the GPU draws them.
+// estimate, quad lights their radiance, mirrors and glass and the background
+// as the GPU draws them.
 HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonGather& gather,
                       const Camera& cam, const GatherImageOptions& opts = {});
 
