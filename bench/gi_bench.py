@@ -7,6 +7,7 @@ Runs `beamcast render` (this build) on the Cornell box (examples/cornell_box.jso
     twice with different seeds, so the reference's own noise is measured
     (the L1 difference of two independent references is sqrt(2) x the noise
     of one);
+  - the path tracer alone at a few sample counts (time to equal error);
   - the GPU frame (photon splatting) for each setting: photon counts 1e3 ...
     1e6 (default kernel and radius), each kernel at 1e5, the radius at 0.5x
     and 2x its default at 1e5.
@@ -230,6 +231,22 @@ def main():
         if knob == "photons" and n == counts[-1]:
             write_png(os.path.join(a.out, f"gpu_{n}.png"), img, exposure)
 
+    # The path tracer itself at a few sample counts (another seed than the
+    # reference's): its time to reach a given error, against the photons'.
+    for spp_pt in ([4, 16] if a.quick else [4, 16, 64]):
+        summary, wall = run_render(a.binary, base, os.path.join(a.out, "pt"),
+                                   ["--reference", "--spp", str(spp_pt), "--seed", "7"])
+        img = load_hdr(summary["frames"][0])
+        row = {"knob": "path_tracer", "photons": 0, "kernel": f"{spp_pt} spp", "radius": 0,
+               "radius_scale": 0, "stored": 0, "trace_ms": 0, "upload_ms": 0, "gpu_ms": 0,
+               "frame_ms": round(summary["frames"][0]["wall_ms"], 1),
+               "rel_l1": round(rel_l1(img, ref), 4)}
+        for reg in regions:
+            mask = np.isin(labels, [i for i, l in enumerate(CORNELL_LABELS) if l == reg])
+            row["rel_l1_" + reg.replace(" ", "_")] = round(rel_l1(img, ref, mask), 4)
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+
     with open(os.path.join(a.out, "gi.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()), restval="")
         w.writeheader()
@@ -265,8 +282,11 @@ def main():
         ax[0].legend(fontsize=7)
         for knob, mk in (("photons", "o"), ("kernel", "s"), ("radius", "^")):
             pts = [r for r in rows if r["knob"] == knob]
-            ax[1].loglog([r["gpu_ms"] for r in pts], [r["rel_l1"] for r in pts], mk, label=knob)
-        ax[1].set_xlabel("GPU ms per frame (photons cached)")
+            ax[1].loglog([r["frame_ms"] for r in pts], [r["rel_l1"] for r in pts], mk, label=knob)
+        pts = [r for r in rows if r["knob"] == "path_tracer"]
+        ax[1].loglog([r["frame_ms"] for r in pts], [r["rel_l1"] for r in pts], "kx--",
+                     label="CPU path tracer (spp)")
+        ax[1].set_xlabel("ms per frame (photons: cached maps; path tracer: whole frame)")
         ax[1].set_ylabel("relative L1 error")
         ax[1].legend(fontsize=7)
         fig.tight_layout()
