@@ -10,11 +10,14 @@ Runs `beamcast render` (this build) on the Cornell box (examples/cornell_box.jso
   - the path tracer alone at a few sample counts (time to equal error);
   - the GPU frame (photon splatting) for each setting: photon counts 1e3 ...
     1e6 (default kernel and radius), each kernel at 1e5, the radius at 0.5x
-    and 2x its default at 1e5.
+    and 2x its default at 1e5; at 1e5 also direct light from photons (the
+    seed's way) in place of the direct pass, and the direct pass's knobs
+    (points per quad light 4 and 64, shadow maps of 128 and 512 texels).
 Per photon count also the CPU photon gather on the same photons
-(`beamcast render --gather radius`: the splat estimator in double; and
+(`beamcast render --gather radius`: the splat estimator in double, with the
+direct pass's term from the same points with exact visibility; and
 `--gather nearest`, k = 50): its error against the reference, and the GPU
-frame's difference from it (the splatting's own error).
+frame's difference from it (the splatting's and shadow maps' own error).
 Per setting: photon tracing time (CPU, first render), photon upload time and
 GPU time per frame with the maps cached (median of the scene's cameras:
 copies of the one camera), and the relative L1 error against the reference
@@ -183,15 +186,22 @@ def main():
     counts = [1000, 3000, 10000, 30000, 100000] if a.quick else \
         [1000, 3000, 10000, 30000, 100000, 300000, 1000000]
     mid = 10000 if a.quick else 100000
-    settings = [("photons", n, "epanechnikov", 1.0) for n in counts]
-    settings += [("kernel", mid, k, 1.0) for k in ("box", "cone")]
-    settings += [("radius", mid, "epanechnikov", s) for s in (0.5, 2.0)]
+    # (knob, photons, kernel, radius scale, other gi fields, what the row varies)
+    settings = [("photons", n, "epanechnikov", 1.0, {}, "") for n in counts]
+    settings += [("kernel", mid, k, 1.0, {}, "") for k in ("box", "cone")]
+    settings += [("radius", mid, "epanechnikov", s, {}, "") for s in (0.5, 2.0)]
+    # Who carries direct light, and the direct pass's own knobs.
+    settings += [("direct", mid, "epanechnikov", 1.0, {"direct": "photons"}, "photons")]
+    settings += [("direct", mid, "epanechnikov", 1.0, {"direct_samples": k}, f"{k} points")
+                 for k in (4, 64)]
+    settings += [("direct", mid, "epanechnikov", 1.0, {"shadow_size": k}, f"shadow {k}")
+                 for k in (128, 512)]
     regions = sorted(set(CORNELL_LABELS)) if len(base["occluders"]) == len(CORNELL_LABELS) else []
 
     rows = []
-    for knob, n, kernel, rscale in settings:
+    for knob, n, kernel, rscale, extra, varied in settings:
         r = default_radius(base, n) * rscale
-        s = dict(base, gi=dict(base.get("gi", {}), photons=n, kernel=kernel, radius=r))
+        s = dict(base, gi=dict(base.get("gi", {}), photons=n, kernel=kernel, radius=r, **extra))
         # Copies of the camera, each nudged by a hair so no two frames are
         # the same work: the maps are traced once, the frames time a
         # camera-only change.
@@ -201,7 +211,7 @@ def main():
         frames = summary["frames"]
         img = load_hdr(frames[0])
         row = {"knob": knob, "photons": n, "kernel": kernel, "radius": round(r, 3),
-               "radius_scale": rscale,
+               "radius_scale": rscale, "direct": varied or "shadow maps",
                "stored": frames[0]["photons"]["count"],
                "trace_ms": round(frames[0]["photons"]["trace_ms"], 1),
                "upload_ms": round(frames[0]["photons"]["upload_ms"], 1),
@@ -238,7 +248,7 @@ def main():
                                    ["--reference", "--spp", str(spp_pt), "--seed", "7"])
         img = load_hdr(summary["frames"][0])
         row = {"knob": "path_tracer", "photons": 0, "kernel": f"{spp_pt} spp", "radius": 0,
-               "radius_scale": 0, "stored": 0, "trace_ms": 0, "upload_ms": 0, "gpu_ms": 0,
+               "radius_scale": 0, "direct": "", "stored": 0, "trace_ms": 0, "upload_ms": 0, "gpu_ms": 0,
                "frame_ms": round(summary["frames"][0]["wall_ms"], 1),
                "rel_l1": round(rel_l1(img, ref), 4)}
         for reg in regions:
@@ -280,7 +290,7 @@ def main():
         ax[0].set_xlabel("photons emitted")
         ax[0].set_ylabel("relative L1 error")
         ax[0].legend(fontsize=7)
-        for knob, mk in (("photons", "o"), ("kernel", "s"), ("radius", "^")):
+        for knob, mk in (("photons", "o"), ("kernel", "s"), ("radius", "^"), ("direct", "d")):
             pts = [r for r in rows if r["knob"] == knob]
             ax[1].loglog([r["frame_ms"] for r in pts], [r["rel_l1"] for r in pts], mk, label=knob)
         pts = [r for r in rows if r["knob"] == "path_tracer"]

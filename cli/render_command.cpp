@@ -85,7 +85,9 @@ int run_render(const RenderArgs& args) {
     summary["renderer"] = "CPU photon gather (" + args.gather + ")";
     const GiScene surfaces(scene);
     const PhotonMaps maps = trace_photons(scene, surfaces, {.threads = args.threads});
-    const PhotonGather gather(maps);
+    // Direct light as the GPU frame carries it: the direct pass's points with
+    // exact visibility, or the photons straight from the lights.
+    const PhotonGather gather(maps, scene.gi.direct == DirectLightMethod::kShadowMaps);
     summary["photons"] = {{"count", maps.global.size() + maps.caustic.size()},
                           {"trace_ms", maps.trace_ms}};
     GatherImageOptions gopts;

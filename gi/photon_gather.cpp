@@ -61,9 +61,12 @@ struct PhotonGather::Index {
   }
 };
 
-PhotonGather::PhotonGather(const PhotonMaps& maps) {
-  photons_ = maps.global;
-  photons_.insert(photons_.end(), maps.caustic.begin(), maps.caustic.end());
+PhotonGather::PhotonGather(const PhotonMaps& maps, bool skip_direct) {
+  for (const auto* map : {&maps.global, &maps.caustic}) {
+    for (const Photon& p : *map) {
+      if (!skip_direct || p.bounces != 0) photons_.push_back(p);
+    }
+  }
   index_ = std::make_unique<Index>(&photons_);
 }
 
@@ -109,8 +112,60 @@ Color PhotonGather::nearest(const Vec3& x, const Vec3& n, const Color& albedo, i
   return {albedo[0] * scale * sum[0], albedo[1] * scale * sum[1], albedo[2] * scale * sum[2]};
 }
 
+namespace {
+
+struct FluxPoint {
+  DirectPoint point;
+  Color flux;
+};
+
+// The direct pass's sum (shaders/direct_light.frag) with exact visibility.
+Color direct_light(const GiScene& surfaces, const std::vector<FluxPoint>& points, const Vec3& x,
+                   const Vec3& n, const Color& albedo) {
+  Color sum{0.0, 0.0, 0.0};
+  const double eps = surfaces.epsilon();
+  for (const FluxPoint& fp : points) {
+    const DirectPoint& p = fp.point;
+    const Vec3 to = p.position - x;
+    const double d = length(to);
+    if (!(d > 2.0 * eps)) continue;
+    const Vec3 l = (1.0 / d) * to;
+    const double cos_x = dot(n, l);
+    if (cos_x <= 0.0) continue;
+    const double c = -dot(p.axis, l);
+    double angular = 1.0;
+    if (p.mode == DirectPoint::Mode::kCosine) {
+      angular = std::max(c, 0.0);
+    } else if (p.mode == DirectPoint::Mode::kCone) {
+      if (c >= p.cos_inner) {
+        angular = 1.0;
+      } else if (c <= p.cos_outer) {
+        angular = 0.0;
+      } else {
+        const double t = (c - p.cos_outer) / (p.cos_inner - p.cos_outer);
+        angular = t * t * (3.0 - 2.0 * t);
+      }
+    }
+    if (angular <= 0.0 || surfaces.occluded(x, l, eps, d - eps)) continue;
+    const double g = p.scale * angular * cos_x / (d * d);
+    for (std::size_t k = 0; k < 3; ++k) sum[k] += g * fp.flux[k];
+  }
+  for (std::size_t k = 0; k < 3; ++k) sum[k] *= albedo[k] / std::numbers::pi;
+  return sum;
+}
+
+}  // namespace
+
 HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonGather& gather,
                       const Camera& cam, const GatherImageOptions& opts) {
+  std::vector<FluxPoint> direct;
+  if (scene.gi.direct == DirectLightMethod::kShadowMaps) {
+    for (const Light& l : scene.lights) {
+      const auto points =
+          std::visit([&](const auto& k) { return k.direct_points(scene.gi.direct_samples); }, l.shape);
+      for (const DirectPoint& p : points) direct.push_back({p, l.flux});
+    }
+  }
   HdrImage img;
   img.width = cam.width;
   img.height = cam.height;
@@ -136,6 +191,7 @@ HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonG
             c = opts.method == GatherMethod::kFixedRadius
                     ? gather.fixed_radius(hit->p, hit->n, o.albedo, r, scene.gi.kernel)
                     : gather.nearest(hit->p, hit->n, o.albedo, opts.k);
+            if (!direct.empty()) c = c + direct_light(surfaces, direct, hit->p, hit->n, o.albedo);
           }
         }
       }

@@ -27,7 +27,9 @@ double splat_kernel(SplatKernel kernel, double d, double r);
 
 class PhotonGather {
  public:
-  explicit PhotonGather(const PhotonMaps& maps);
+  // skip_direct: leave out the photons straight from a light (a scene whose
+  // direct light comes from the direct pass, gi.direct "shadow_maps").
+  explicit PhotonGather(const PhotonMaps& maps, bool skip_direct = false);
   ~PhotonGather();
   // Fixed radius r with `kernel`: what the splat pass computes at x.
   Color fixed_radius(const Vec3& x, const Vec3& n, const Color& albedo, double r, SplatKernel kernel,
@@ -53,7 +55,10 @@ struct GatherImageOptions {
 // A lit scene's image (rows top-down, like render_reference): the nearest
 // surface along each pixel's centre ray; diffuse surfaces get the photon
 // estimate, quad lights their radiance, mirrors and glass and the background
-// as the GPU draws them.
+// as the GPU draws them. With gi.direct "shadow_maps" diffuse surfaces also
+// get the direct pass's term from the same DirectPoints, with visibility by
+// shadow rays in double (so the GPU's difference is the shadow maps' error);
+// `gather` must then have been built with skip_direct.
 HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonGather& gather,
                       const Camera& cam, const GatherImageOptions& opts = {});
 

@@ -63,6 +63,9 @@ struct Light {
 
 // Photon mapping settings ("gi" in JSON), the accuracy knobs of issue 14.
 enum class SplatKernel { kBox, kCone, kEpanechnikov };
+// Who carries direct light (light -> diffuse surface): the raster pass
+// "direct" (shadow-mapped point emitters, no splat noise) or the photons.
+enum class DirectLightMethod { kShadowMaps, kPhotons };
 struct GiSettings {
   std::int64_t photons = 100000;          // emitted for the global map
   std::int64_t caustic_photons = 100000;  // emitted for the caustic map (with specular surfaces)
@@ -70,6 +73,9 @@ struct GiSettings {
   SplatKernel kernel = SplatKernel::kEpanechnikov;
   std::uint64_t seed = 1;
   int max_depth = 16;  // bounces a photon may take
+  DirectLightMethod direct = DirectLightMethod::kShadowMaps;
+  int direct_samples = 16;  // points per area light in the direct pass
+  int shadow_size = 256;    // texels per cube-map face of a direct point's shadow map
 };
 
 // One directional light for Lambert shading of occluders.

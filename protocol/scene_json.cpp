@@ -248,9 +248,33 @@ Light parse_gi_light(const Node& n, const SceneLimits& limits) {
   return l;
 }
 
+// The direct-light pass's shadow maps, checked against max_shadow_texels
+// (the scene's lights and gi settings together decide their size).
+void check_shadow_budget(const Scene& scene, const SceneLimits& limits, const std::string& path) {
+  if (!scene.has_gi() || scene.gi.direct != DirectLightMethod::kShadowMaps) return;
+  std::int64_t points = 0;
+  for (const Light& l : scene.lights) {
+    points += std::visit(
+        [&](const auto& kind) {
+          return static_cast<std::int64_t>(kind.direct_points(scene.gi.direct_samples).size());
+        },
+        l.shape);
+  }
+  const std::int64_t size = scene.gi.shadow_size;
+  const std::int64_t texels = points * 6 * size * size;
+  if (texels > limits.max_shadow_texels) {
+    fail("limit_exceeded", path,
+         "the direct light's shadow maps need " + std::to_string(texels) + " texels (" +
+             std::to_string(points) + " points x 6 faces x " + std::to_string(size) +
+             "^2), over the limit max_shadow_texels = " + std::to_string(limits.max_shadow_texels) +
+             ": lower gi.shadow_size or gi.direct_samples, or set gi.direct to \"photons\"");
+  }
+}
+
 GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "gi settings");
-  o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth"});
+  o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth", "direct",
+                "direct_samples", "shadow_size"});
   GiSettings g;
   std::int64_t total = 0;
   auto count = [&](const Node& v) {
@@ -294,6 +318,12 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
     g.seed = static_cast<std::uint64_t>(s);
   }
   if (auto v = o.optional("max_depth")) g.max_depth = read_int_in(*v, 1, 64);
+  if (auto v = o.optional("direct")) {
+    g.direct = read_enum<DirectLightMethod>(
+        *v, {{"shadow_maps", DirectLightMethod::kShadowMaps}, {"photons", DirectLightMethod::kPhotons}});
+  }
+  if (auto v = o.optional("direct_samples")) g.direct_samples = read_int_in(*v, 1, 256);
+  if (auto v = o.optional("shadow_size")) g.shadow_size = read_int_in(*v, 16, 2048);
   return g;
 }
 
@@ -745,12 +775,15 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
       scene.lights.push_back(parse_gi_light(l, limits));
     }
   }
+  std::string gi_path = o.path_of("lights");
   if (auto v = o.optional("gi")) {
     scene.gi = parse_gi(*v, limits);
+    gi_path = v->path;
   } else {
     scene.gi.photons = std::min(scene.gi.photons, limits.max_photons);
     scene.gi.caustic_photons = std::min(scene.gi.caustic_photons, limits.max_photons - scene.gi.photons);
   }
+  check_shadow_budget(scene, limits, gi_path);
 
   if (auto v = o.optional("beams")) {
     for (const Node& b : read_array(*v, limits.max_beams, "max_beams")) {
@@ -811,6 +844,7 @@ nlohmann::json scene_capabilities() {
           {"light_types", light_types()},
           {"material_types", {"diffuse", "mirror", "glass"}},
           {"gi_kernels", {"box", "cone", "epanechnikov"}},
+          {"gi_direct", {"shadow_maps", "photons"}},
           {"camera_rigs", enum_names(kRigKinds)}};
 }
 

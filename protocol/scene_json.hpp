@@ -32,6 +32,10 @@ struct SceneLimits {
   double max_abs_coordinate = 1e12;  // any position or size, world units
   int max_lights = 1024;
   std::int64_t max_photons = 20000000;  // gi.photons + gi.caustic_photons
+  // Depth texels of the direct-light pass's shadow maps: direct points
+  // (one per point or spot light, about gi.direct_samples per quad light)
+  // x 6 cube faces x gi.shadow_size^2; 4 bytes each.
+  std::int64_t max_shadow_texels = 256LL << 20;
 };
 
 // The server's scene limits (PROTOCOL.md, "Limits"), stricter than the
@@ -44,7 +48,8 @@ inline constexpr SceneLimits kServerSceneLimits{.max_beams = 10000,
                                                 .max_pixels = 4096LL * 4096LL,
                                                 .max_mesh_triangles = 1000000,
                                                 .max_lights = 64,
-                                                .max_photons = 4000000};
+                                                .max_photons = 4000000,
+                                                .max_shadow_texels = 32LL << 20};
 
 struct SceneLoadOptions {
   // Mesh files are read only from below this directory; absolute paths and

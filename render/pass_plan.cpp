@@ -41,9 +41,20 @@ const std::vector<PassDecl>& pass_catalog() {
       {PassId::kGbuffer, "gbuffer",
        [](const PlanInput& in) { return !in.scene.occluders.empty() && in.scene.has_gi(); }, {}, {},
        {"hdr", "view_depth", "gb_normal", "gb_albedo", "depth"}, {"occluders"}},
+      // Direct light of a lit scene (gi.direct "shadow_maps"): every light as
+      // a few point emitters (DirectPoint), each with a cube shadow map of
+      // the triangles (rendered once per scene and kept) and shadow rays to
+      // the analytic occluders; adds what diffuse surfaces reflect to hdr.
+      {PassId::kDirect, "direct",
+       [](const PlanInput& in) {
+         return !in.scene.occluders.empty() && in.scene.has_gi() &&
+                in.scene.gi.direct == DirectLightMethod::kShadowMaps;
+       },
+       {"hdr", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {"shadows"}},
       // Photon splatting (seed 001, section 4.2): one camera-facing disk per
       // photon adds its reflected radiance to the G-buffer's pixels within
-      // the radius.
+      // the radius (without the photons straight from a light when the
+      // direct pass carries that light).
       {PassId::kPhotons, "photons",
        [](const PlanInput& in) { return !in.scene.occluders.empty() && in.scene.has_gi(); },
        {"hdr", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {"photons"}},

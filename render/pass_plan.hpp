@@ -20,8 +20,8 @@ namespace beamcast {
 // make_pass (render/passes.cpp), whose switch over this enum has no default:
 // a new id without an executor does not compile (-Wswitch) and fails the
 // renderer's construction check.
-enum class PassId { kSurfaces, kGbuffer, kPhotons, kBeams, kTonemap, kUpscale };
-inline constexpr std::size_t kPassCount = 6;
+enum class PassId { kSurfaces, kGbuffer, kDirect, kPhotons, kBeams, kTonemap, kUpscale };
+inline constexpr std::size_t kPassCount = 7;
 
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {

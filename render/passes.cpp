@@ -1,5 +1,7 @@
 #include "render/passes.hpp"
 
+#include <algorithm>
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -231,6 +233,149 @@ class SurfacePass final : public Pass {
   ProgramPair analytic_;
 };
 
+// The projection of one face of a cube map: clip (s, t, m - 2 near, m) of a
+// point relative to the cube's centre, where m is the coordinate along the
+// face's axis and s, t the GL cube-map face coordinates (GL 4.5 table 8.19),
+// so that the face's texel (s, t) / m holds what lies in that direction.
+// Row-major.
+std::array<float, 16> cube_face_matrix(int face, float near) {
+  // (s, t, m) as rows of coefficients of (x, y, z).
+  static constexpr float kRows[6][3][3] = {
+      {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}},   // +X
+      {{0, 0, 1}, {0, -1, 0}, {-1, 0, 0}},   // -X
+      {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},     // +Y
+      {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},   // -Y
+      {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}},    // +Z
+      {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}},  // -Z
+  };
+  const auto& r = kRows[face];
+  return {r[0][0], r[0][1], r[0][2], 0.0f,  //
+          r[1][0], r[1][1], r[1][2], 0.0f,  //
+          r[2][0], r[2][1], r[2][2], -2.0f * near,
+          r[2][0], r[2][1], r[2][2], 0.0f};
+}
+
+// Direct light (shaders/direct_light.frag): one full-screen draw per view
+// over the G-buffer, every light as its DirectPoints. Their cube shadow maps
+// of the scene's triangles are rendered here on the first frame of a scene
+// and kept while the geometry, lights and direct settings stay the same
+// (SceneResources::shadow_key), so a camera-only change renders none.
+class DirectPass final : public Pass {
+ public:
+  DirectPass() : program_("direct_light"), shadow_("shadow_depth") {}
+  void execute(FrameContext& ctx, const PassDecl& self) override {
+    SceneResources& res = ctx.resources;
+    const auto count = static_cast<GLsizei>(res.direct_points().size());
+    if (count == 0) return;
+    if (res.shadow_key() != key_) render_shadows(ctx);
+    const bool multi = ctx.views > 0;
+    glUseProgram(program_.get(multi));
+    glUniform1i(program_.uniform(multi, "u_point_count"), count);
+    glUniform1f(program_.uniform(multi, "u_far"), far_);
+    glUniform1f(program_.uniform(multi, "u_texel"), 2.0f / static_cast<float>(size_));
+    glUniform1i(program_.uniform(multi, "u_count"), res.analytic_count());
+    glBindTextureUnit(0, ctx.targets.texture("view_depth"));
+    glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
+    glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
+    glBindTextureUnit(3, cubes_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, res.direct_buffer());
+    if (res.analytic_count() > 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, res.analytic_buffer());
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glBindVertexArray(ctx.empty_vao);
+    const GLint offset = program_.uniform(multi, "u_point_offset");
+    const GLint view = multi ? program_.uniform(true, "u_view") : -1;
+    const int views = multi ? ctx.views : 1;
+    for (int v = 0; v < views; ++v) {
+      glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, multi ? v : -1));
+      if (multi) glUniform1i(view, v);
+      const Vec3 eye = multi ? ctx.view_eyes[static_cast<std::size_t>(v)] : ctx.basis.eye;
+      const Vec3 off = res.direct_anchor() - eye;
+      glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
+                  static_cast<float>(off[2]));
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    glDisable(GL_BLEND);
+    gl_check("direct pass");
+  }
+
+ private:
+  void render_shadows(FrameContext& ctx) {
+    const SceneResources& res = ctx.resources;
+    const std::vector<DirectPoint>& points = res.direct_points();
+    size_ = ctx.scene.gi.shadow_size;
+    const auto layers = static_cast<GLsizei>(6 * points.size());
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_CUBE_MAP_ARRAY, 1, &id);
+    cubes_ = GlTexture(id);
+    glTextureStorage3D(id, 1, GL_DEPTH_COMPONENT32F, size_, size_, layers);
+    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(id, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTextureParameteri(id, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    // Distances are stored over the farthest the triangles can be from any
+    // point (1 = nothing there: the clear value).
+    const Aabb& box = res.mesh_bounds();
+    double far = 0.0;
+    for (const DirectPoint& p : points) {
+      for (int c = 0; c < 8 && !box.empty(); ++c) {
+        const Vec3 corner{(c & 1) ? box.hi[0] : box.lo[0], (c & 2) ? box.hi[1] : box.lo[1],
+                          (c & 4) ? box.hi[2] : box.lo[2]};
+        far = std::max(far, length(corner - p.position));
+      }
+    }
+    // Without triangles every map stays clear: any finite distance is lit.
+    far_ = box.empty() ? 1e30f : static_cast<float>(std::max(far * 1.01, 1e-30));
+    const float near = 1e-5f * far_;
+    GLint viewport[4];
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    glCreateFramebuffers(1, &id);
+    GlFramebuffer fbo(id);
+    glNamedFramebufferDrawBuffer(id, GL_NONE);
+    glViewport(0, 0, size_, size_);
+    glBindFramebuffer(GL_FRAMEBUFFER, id);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(shadow_.get(false));
+    glUniform1f(shadow_.uniform(false, "u_far"), far_);
+    const GLint offset = shadow_.uniform(false, "u_offset");
+    const GLint face_matrix = shadow_.uniform(false, "u_face");
+    glBindVertexArray(res.triangle_vao());
+    const float one = 1.0f;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Vec3 off = res.mesh_anchor() - points[i].position;
+      glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
+                  static_cast<float>(off[2]));
+      for (int face = 0; face < 6; ++face) {
+        glNamedFramebufferTextureLayer(id, GL_DEPTH_ATTACHMENT, cubes_.get(), 0,
+                                       static_cast<GLint>(6 * i) + face);
+        glClearNamedFramebufferfv(id, GL_DEPTH, 0, &one);
+        if (res.triangle_vertex_count() == 0) continue;
+        const std::array<float, 16> m = cube_face_matrix(face, near);
+        glUniformMatrix4fv(face_matrix, 1, GL_TRUE, m.data());
+        glDrawArrays(GL_TRIANGLES, 0, res.triangle_vertex_count());
+      }
+    }
+    glDisable(GL_DEPTH_TEST);
+    glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
+    key_ = res.shadow_key();
+    gl_check("direct pass: shadow maps");
+  }
+
+  ProgramPair program_;
+  ProgramPair shadow_;
+  std::string key_;  // the SceneResources::shadow_key the maps are for
+  GlTexture cubes_;  // depth cube-map array, 6 layers per direct point
+  int size_ = 0;
+  float far_ = 1.0f;
+};
+
 // Photon splatting: one instanced draw of camera-facing quads, one per
 // photon; the fragment shader reads the G-buffer and adds the photon's
 // reflected radiance (shaders/photon_splat.frag), additively into hdr.
@@ -389,6 +534,8 @@ std::unique_ptr<Pass> make_pass(PassId id) {
     case PassId::kSurfaces:
     case PassId::kGbuffer:
       return std::make_unique<SurfacePass>();
+    case PassId::kDirect:
+      return std::make_unique<DirectPass>();
     case PassId::kPhotons:
       return std::make_unique<PhotonPass>();
     case PassId::kBeams:

@@ -145,8 +145,11 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
   if (plan.uploads_group("occluders")) upload_occluders();
   if (plan.uploads_group("photons")) {
     if (!photons) throw GlError("the plan splats photons but the renderer has no photon cache");
-    upload_photons(*photons);
+    // Photons straight from a light are left out when the direct pass
+    // carries direct light.
+    upload_photons(*photons, plan.uploads_group("shadows"));
   }
+  if (plan.uploads_group("shadows")) upload_direct();
   GLuint id = 0;
   glCreateBuffers(1, &id);
   camera_ubo_ = GlBuffer(id);
@@ -215,7 +218,7 @@ void SceneResources::upload_beams(TableCache& tables) {
 // Both maps in one buffer (the splat pass draws them alike), positions
 // relative to the centre of their bounds; photons straight from the lights
 // are marked (position.w = 1).
-void SceneResources::upload_photons(PhotonCache& cache) {
+void SceneResources::upload_photons(PhotonCache& cache, bool skip_direct) {
   const auto t0 = std::chrono::steady_clock::now();
   bool traced = false;
   maps_ = cache.get(scene_, &traced);
@@ -234,6 +237,7 @@ void SceneResources::upload_photons(PhotonCache& cache) {
   data.reserve(maps_->global.size() + maps_->caustic.size());
   for (const auto* map : {&maps_->global, &maps_->caustic}) {
     for (const Photon& p : *map) {
+      if (skip_direct && p.bounces == 0) continue;
       PhotonData d{};
       for (int k = 0; k < 3; ++k) {
         d.position[k] = static_cast<float>(p.p[k] - photon_anchor_[static_cast<std::size_t>(k)]);
@@ -257,6 +261,50 @@ void SceneResources::upload_photons(PhotonCache& cache) {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() -
       photon_trace_ms_;
   gl_check("upload photons");
+}
+
+void SceneResources::upload_direct() {
+  Aabb box;
+  for (const Light& l : scene_.lights) {
+    std::vector<DirectPoint> points = std::visit(
+        [&](const auto& kind) { return kind.direct_points(scene_.gi.direct_samples); }, l.shape);
+    for (DirectPoint& p : points) {
+      box.grow(p.position);
+      direct_points_.push_back(p);
+      direct_flux_.push_back(l.flux);
+    }
+  }
+  direct_anchor_ = box.empty() ? Vec3{0.0, 0.0, 0.0} : box.centre();
+  // std430 record of shaders/direct_light.frag.
+  struct PointData {
+    float position[4];  // xyz: relative to direct_anchor(); w: DirectPoint::Mode
+    float axis[4];      // xyz: unit axis; w: cos_outer
+    float flux[4];      // rgb: the light's flux x scale; w: cos_inner
+  };
+  std::vector<PointData> data;
+  for (std::size_t i = 0; i < direct_points_.size(); ++i) {
+    const DirectPoint& p = direct_points_[i];
+    PointData d{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      d.position[k] = static_cast<float>(p.position[k] - direct_anchor_[k]);
+      d.axis[k] = static_cast<float>(p.axis[k]);
+      d.flux[k] = static_cast<float>(direct_flux_[i][k] * p.scale);
+    }
+    d.position[3] = static_cast<float>(static_cast<int>(p.mode));
+    d.axis[3] = static_cast<float>(p.cos_outer);
+    d.flux[3] = static_cast<float>(p.cos_inner);
+    data.push_back(d);
+  }
+  if (!data.empty()) {
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    direct_ssbo_ = GlBuffer(id);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(PointData)), data.data(),
+                         0);
+  }
+  shadow_key_ = photon_key(scene_) + "|" + std::to_string(scene_.gi.direct_samples) + "|" +
+                std::to_string(scene_.gi.shadow_size);
+  gl_check("upload direct points");
 }
 
 void SceneResources::upload_occluders() {
@@ -291,6 +339,7 @@ void SceneResources::upload_occluders() {
     }
   }
   std::vector<Vertex> verts;
+  mesh_bounds_ = bounds;
   if (!bounds.empty()) {
     mesh_anchor_ = bounds.centre();
     VertexSink sink(mesh_anchor_, &verts);

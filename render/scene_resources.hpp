@@ -70,6 +70,16 @@ class SceneResources {
   GLsizei photon_count() const { return photon_count_; }
   const Vec3& photon_anchor() const { return photon_anchor_; }
   double photon_radius() const { return photon_radius_; }
+  // Direct light (group "shadows"): the lights' DirectPoints, each with its
+  // light's flux folded in, positions relative to direct_anchor(); the key
+  // names the geometry and points the shadow maps are rendered for.
+  GLuint direct_buffer() const { return direct_ssbo_.get(); }
+  const std::vector<DirectPoint>& direct_points() const { return direct_points_; }
+  const Vec3& direct_anchor() const { return direct_anchor_; }
+  const std::string& shadow_key() const { return shadow_key_; }
+  // The triangle vertices' anchor (positions in triangle_vao() are relative to it).
+  const Vec3& mesh_anchor() const { return mesh_anchor_; }
+  const Aabb& mesh_bounds() const { return mesh_bounds_; }
   // Time spent tracing the maps for this render (0 when they came from the
   // cache) and uploading them.
   double photon_trace_ms() const { return photon_trace_ms_; }
@@ -84,6 +94,7 @@ class SceneResources {
   GlVertexArray tri_vao_;
   GLsizei tri_vertices_ = 0;
   Vec3 mesh_anchor_{};
+  Aabb mesh_bounds_;
   std::vector<const Occluder*> analytic_;  // planes and spheres
   bool views_ = false;  // bind_views was last
   GlBuffer views_camera_ubo_, views_beam_ssbo_, views_analytic_ssbo_;
@@ -91,7 +102,13 @@ class SceneResources {
 
   void upload_beams(TableCache& tables);
   void upload_occluders();
-  void upload_photons(PhotonCache& cache);
+  void upload_photons(PhotonCache& cache, bool skip_direct);
+  void upload_direct();
+  GlBuffer direct_ssbo_;
+  std::vector<DirectPoint> direct_points_;
+  std::vector<Color> direct_flux_;  // each point's light's flux
+  Vec3 direct_anchor_{};
+  std::string shadow_key_;
   std::shared_ptr<const PhotonMaps> maps_;
   GlBuffer photon_ssbo_;
   GLsizei photon_count_ = 0;

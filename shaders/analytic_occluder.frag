@@ -2,13 +2,6 @@
 // hit writes colour, view depth and window depth, so the depth test merges it
 // with the rasterized occluders.
 
-struct AnalyticOccluder {
-  vec4 a;       // plane: point; sphere: centre (camera-relative); w: sphere radius
-  vec4 b;       // plane: unit normal; w: 0 plane, 1 sphere
-  vec4 albedo;  // rgb; w: MaterialType (0 diffuse, 1 mirror, 2 glass)
-};
-layout(std430, binding = 2) readonly buffer Analytic { AnalyticOccluder occ[]; };
-uniform int u_count;  // per view; view v's occluders start at v * u_count
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_view_depth;

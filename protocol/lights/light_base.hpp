@@ -10,6 +10,8 @@
 //   LightSample sample(x, u) const;            next-event estimation towards x
 //   std::optional<double> hit(o, v, t_max) const;   rays that see the emitter
 //   double radiance_scale() const;             emitted radiance per unit flux
+//   std::vector<DirectPoint> direct_points(n) const;  the points the raster
+//                                              direct-light pass shades from
 // Dispatch over the kinds is std::visit over LightShape (lights.hpp).
 // Radiometry: flux in watts per channel; a point light's intensity is
 // flux / 4 pi; a spot's falls from the inner to the outer cone and its
@@ -19,6 +21,7 @@
 
 #include <array>
 #include <optional>
+#include <vector>
 
 #include "protocol/vec.hpp"
 
@@ -47,6 +50,24 @@ struct LightSample {
   Vec3 dir{};
   double dist = 0.0;
   double g = 0.0;  // 0: the light does not shine towards x
+};
+
+// One point the GPU's direct-light pass (shadow-mapped, render/passes.cpp)
+// treats as a point emitter: the irradiance at x from it, per unit flux of
+// its light, is scale * angular(c) / d^2 * max(0, n_x . l), with c the cosine
+// between `axis` and the direction from the point to x and angular(c):
+//   kIsotropic: 1;  kCosine: max(0, c) (one-sided area-light patch);
+//   kCone: the spot's smoothstep falloff between cos_outer and cos_inner.
+// A light's points together give its irradiance exactly for a point light or
+// a spot, and as a stratified quadrature over the area for a quad.
+struct DirectPoint {
+  enum class Mode { kIsotropic = 0, kCosine = 1, kCone = 2 };
+  Vec3 position{};
+  Vec3 axis{0.0, 0.0, 0.0};
+  Mode mode = Mode::kIsotropic;
+  double scale = 0.0;
+  double cos_inner = 1.0;
+  double cos_outer = 1.0;
 };
 
 }  // namespace beamcast

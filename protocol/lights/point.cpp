@@ -34,4 +34,11 @@ std::optional<double> PointLight::hit(const Vec3&, const Vec3&, double) const {
   return std::nullopt;  // a point is never seen
 }
 
+std::vector<DirectPoint> PointLight::direct_points(int /*samples*/) const {
+  DirectPoint p;
+  p.position = position;
+  p.scale = 1.0 / (4.0 * std::numbers::pi);
+  return {p};
+}
+
 }  // namespace beamcast

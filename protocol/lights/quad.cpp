@@ -1,5 +1,7 @@
 #include "protocol/lights/quad.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <numbers>
 
 #include "protocol/lights/light_parse.hpp"
@@ -50,5 +52,31 @@ std::optional<double> QuadLight::hit(const Vec3& o, const Vec3& v, double t_max)
 }
 
 double QuadLight::radiance_scale() const { return 1.0 / (std::numbers::pi * area); }
+
+std::vector<DirectPoint> QuadLight::direct_points(int samples) const {
+  // The centres of a k_u x k_v grid of equal cells (k_u k_v close to
+  // `samples`, cells near square): the midpoint rule over the area, each
+  // point a cosine emitter with 1/(k_u k_v) of the radiance x area.
+  const double lu = length(edge_u), lv = length(edge_v);
+  const int n = std::max(1, samples);
+  const int ku = std::clamp(static_cast<int>(std::lround(std::sqrt(n * lu / lv))), 1, n);
+  const int kv = std::max(1, static_cast<int>(std::lround(static_cast<double>(n) / ku)));
+  // A hair in front of the emitting face, so a shadow map rendered from the
+  // point sees the quad's own plane behind it.
+  const Vec3 lift = (1e-5 * std::max(lu, lv)) * normal;
+  std::vector<DirectPoint> out;
+  out.reserve(static_cast<std::size_t>(ku) * static_cast<std::size_t>(kv));
+  for (int j = 0; j < kv; ++j) {
+    for (int i = 0; i < ku; ++i) {
+      DirectPoint p;
+      p.position = corner + ((i + 0.5) / ku) * edge_u + ((j + 0.5) / kv) * edge_v + lift;
+      p.axis = normal;
+      p.mode = DirectPoint::Mode::kCosine;
+      p.scale = 1.0 / (std::numbers::pi * ku * kv);
+      out.push_back(p);
+    }
+  }
+  return out;
+}
 
 }  // namespace beamcast

@@ -25,6 +25,7 @@ struct QuadLight {
   Emission emit(const LightRandom& u) const;
   LightSample sample(const Vec3& x, const LightRandom& u) const;
   std::optional<double> hit(const Vec3& o, const Vec3& v, double t_max) const;
+  std::vector<DirectPoint> direct_points(int samples) const;
   double radiance_scale() const;
 };
 

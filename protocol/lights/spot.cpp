@@ -75,4 +75,15 @@ std::optional<double> SpotLight::hit(const Vec3&, const Vec3&, double) const {
   return std::nullopt;
 }
 
+std::vector<DirectPoint> SpotLight::direct_points(int /*samples*/) const {
+  DirectPoint p;
+  p.position = position;
+  p.axis = direction;
+  p.mode = DirectPoint::Mode::kCone;
+  p.scale = 1.0 / solid_angle_weight;
+  p.cos_inner = cos_inner;
+  p.cos_outer = cos_outer;
+  return {p};
+}
+
 }  // namespace beamcast

@@ -176,5 +176,48 @@ TEST(Lights, PhotonCountsAreLimited) {
   EXPECT_EQ(e.path, "/lights");
 }
 
+// The direct pass's settings: the method by name, the knobs in range, and
+// its shadow maps within max_shadow_texels (16 quad points x 6 faces x
+// 256^2 = 6 291 456 texels by default; one point light x 6 x 64^2 = 24 576).
+TEST(Lights, DirectLightSettingsAndTheShadowBudget) {
+  const json quad = {{"type", "quad"}, {"corner", {0, 2, 0}}, {"edge_u", {1, 0, 0}},
+                     {"edge_v", {0, 0, 1}}};
+  auto gi = [&](json g) { return lit({quad}, {{"gi", g}}); };
+  const Scene s = parse_scene(gi({{"direct", "photons"}, {"direct_samples", 9}, {"shadow_size", 64}}),
+                              {});
+  EXPECT_EQ(s.gi.direct, DirectLightMethod::kPhotons);
+  EXPECT_EQ(s.gi.direct_samples, 9);
+  EXPECT_EQ(s.gi.shadow_size, 64);
+  EXPECT_EQ(parse_scene(gi(json::object()), {}).gi.direct, DirectLightMethod::kShadowMaps);
+  EXPECT_REJECTED(gi({{"direct", "rays"}}), "invalid_value", "/gi/direct");
+  EXPECT_REJECTED(gi({{"direct_samples", 0}}), "out_of_range", "/gi/direct_samples");
+  EXPECT_REJECTED(gi({{"shadow_size", 8}}), "out_of_range", "/gi/shadow_size");
+  SceneLimits limits;
+  limits.max_shadow_texels = 6 * 256 * 256 * 16 - 1;
+  ErrorInfo e = error_of(gi(json::object()), limits);
+  EXPECT_EQ(e.code, "limit_exceeded");
+  EXPECT_EQ(e.path, "/gi");
+  EXPECT_NE(e.message.find("max_shadow_texels"), std::string::npos) << e.message;
+  // Without a gi object the error points at the lights; with direct light
+  // from photons there are no shadow maps to limit.
+  limits.max_shadow_texels = 1000;
+  EXPECT_EQ(error_of(lit({quad}), limits).path, "/lights");
+  SceneLoadOptions o;
+  o.limits = limits;
+  EXPECT_NO_THROW(parse_scene(gi({{"direct", "photons"}}), o));
+  // Each light kind's points: a point light is one isotropic point of
+  // 1 / (4 pi) per unit flux, a quad's points share its flux evenly.
+  const Scene q = parse_scene(lit({quad}), {});
+  const auto points = std::get<QuadLight>(q.lights[0].shape).direct_points(16);
+  ASSERT_EQ(points.size(), 16u);
+  double total = 0.0;
+  for (const DirectPoint& p : points) {
+    EXPECT_EQ(p.mode, DirectPoint::Mode::kCosine);
+    EXPECT_NEAR(p.position[1], 2.0, 1e-4);
+    total += p.scale;
+  }
+  EXPECT_NEAR(total, 1.0 / std::numbers::pi, 1e-12);
+}
+
 }  // namespace
 }  // namespace beamcast

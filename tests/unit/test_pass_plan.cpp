@@ -109,11 +109,19 @@ TEST(PassPlan, ReadingATargetNobodyWritesFailsAtPlanTime) {
   EXPECT_TRUE(plan.uses("gbuffer.normal"));
 }
 
-// A lit scene (lights) runs the G-buffer and photon splatting in place of
-// the directional-light surfaces; without occluders there is nothing to light.
+// A lit scene (lights) runs the G-buffer, direct light and photon splatting
+// in place of the directional-light surfaces; without occluders there is
+// nothing to light. With gi.direct "photons" the direct pass does not run.
 TEST(PassPlan, LitScenesSplatPhotonsOverAGbuffer) {
   const FramePlan plan = make_plan(PlanInput{scene_with(true, true, true)});
-  EXPECT_EQ(plan.names(), (std::vector<std::string>{"gbuffer", "photons", "beams", "tonemap"}));
+  EXPECT_EQ(plan.names(),
+            (std::vector<std::string>{"gbuffer", "direct", "photons", "beams", "tonemap"}));
+  EXPECT_TRUE(plan.uploads_group("shadows"));
+  Scene photons_only = scene_with(true, true, true);
+  photons_only.gi.direct = DirectLightMethod::kPhotons;
+  EXPECT_EQ(make_plan(PlanInput{photons_only}).names(),
+            (std::vector<std::string>{"gbuffer", "photons", "beams", "tonemap"}));
+  EXPECT_FALSE(make_plan(PlanInput{photons_only}).uploads_group("shadows"));
   EXPECT_EQ(target_names(plan), (std::vector<std::string>{"depth", "gb_albedo", "gb_normal", "hdr",
                                                            "output", "view_depth"}));
   EXPECT_TRUE(plan.uploads_group("photons"));
@@ -127,7 +135,7 @@ TEST(PassPlan, LitScenesSplatPhotonsOverAGbuffer) {
 TEST(PassPlan, UnknownTargetsAndRepeatedIdsFail) {
   std::vector<PassDecl> catalog = pass_catalog();
   // The tonemap pass (planned for every frame) names a target that does not exist.
-  catalog[4].writes = {"outptu"};
+  catalog[5].writes = {"outptu"};
   EXPECT_THROW(make_plan(PlanInput{scene_with(false, false)}, catalog), PlanError);
   catalog = pass_catalog();
   catalog[1].id = PassId::kSurfaces;

@@ -1,0 +1,91 @@
+// Direct light of a lit scene (pass "direct", gi.direct "shadow_maps"): each
+// light is a few point emitters (DirectPoint in protocol/lights/light_base.hpp);
+// a diffuse G-buffer point x with normal n (facing the camera) reflects
+//   L = albedo / pi * sum_i flux_i * angular_i(c) * max(0, n.l) * V_i / d^2,
+// V_i from point i's cube shadow map of the triangles (distance compared,
+// bilinear percentage-closer filtering) and from shadow rays to the analytic
+// occluders. Mirrors, glass, emitters and the background are left alone.
+struct DirectPoint {
+  vec4 position;  // xyz: relative to the direct anchor; w: mode (0 isotropic, 1 cosine, 2 cone)
+  vec4 axis;      // xyz: unit axis; w: cos_outer
+  vec4 flux;      // rgb: flux x scale; w: cos_inner
+};
+layout(std430, binding = 4) readonly buffer DirectPoints { DirectPoint points[]; };
+layout(binding = 0) uniform VIEW_SAMPLER u_view_depth;
+layout(binding = 1) uniform VIEW_SAMPLER u_gb_normal;
+layout(binding = 2) uniform VIEW_SAMPLER u_gb_albedo;
+layout(binding = 3) uniform samplerCubeArrayShadow u_shadows;
+uniform vec3 u_point_offset;  // direct anchor minus eye
+uniform int u_point_count;
+uniform float u_far;    // shadow-map distances are stored over this
+uniform float u_texel;  // a texel's angular size at a face centre (2 / size)
+
+layout(location = 0) out vec4 out_color;
+
+const float kPi = 3.14159265358979;
+
+// True if an analytic occluder cuts the open segment o + t d, t in (0, len).
+bool analytic_blocked(vec3 o, vec3 d, float len) {
+  int first = view_index() * u_count;
+  float lo = 1e-4 * len, hi = len * (1.0 - 1e-4);
+  for (int i = 0; i < u_count; ++i) {
+    AnalyticOccluder a = occ[first + i];
+    if (a.b.w < 0.5) {
+      float denom = dot(a.b.xyz, d);
+      if (denom == 0.0) continue;
+      float t = dot(a.a.xyz - o, a.b.xyz) / denom;
+      if (t > lo && t < hi) return true;
+    } else {
+      vec3 to_c = a.a.xyz - o;
+      float tc = dot(to_c, d);
+      vec3 perp = to_c - tc * d;
+      float h2 = a.a.w * a.a.w - dot(perp, perp);
+      if (h2 < 0.0) continue;
+      float h = sqrt(h2);
+      if ((tc - h > lo && tc - h < hi) || (tc + h > lo && tc + h < hi)) return true;
+    }
+  }
+  return false;
+}
+
+void main() {
+  select_view(view_index());
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  float z = VIEW_TEXEL(u_view_depth, px).r;
+  if (z >= 1e29) discard;  // no surface on this pixel
+  vec4 albedo = VIEW_TEXEL(u_gb_albedo, px);
+  if (albedo.w > 0.5) discard;  // mirrors, glass and emitters
+  vec3 n = VIEW_TEXEL(u_gb_normal, px).xyz;
+  ViewRay ray = view_ray(gl_FragCoord.xy);
+  vec3 x = ray.origin + (z / ray.cos_axis) * ray.dir;
+  vec3 e = vec3(0.0);
+  for (int i = 0; i < u_point_count; ++i) {
+    DirectPoint p = points[i];
+    vec3 to = p.position.xyz + u_point_offset - x;
+    float d2 = dot(to, to);
+    float dist = sqrt(d2);
+    vec3 l = to / dist;
+    float cos_x = dot(n, l);
+    if (cos_x <= 0.0) continue;
+    float c = -dot(p.axis.xyz, l);
+    int mode = int(p.position.w + 0.5);
+    float angular = 1.0;
+    if (mode == 1) {
+      angular = max(c, 0.0);
+    } else if (mode == 2) {
+      angular = c >= p.flux.w ? 1.0 : (c <= p.axis.w ? 0.0 : smoothstep(p.axis.w, p.flux.w, c));
+    }
+    if (angular <= 0.0) continue;
+    // Normal-offset lookup: x moved off its surface by about a texel's
+    // footprint (more where the light grazes it), compared half a texel
+    // short, so a lit surface does not shadow itself (acne).
+    float foot = dist * u_texel;
+    float sin_x = sqrt(max(0.0, 1.0 - cos_x * cos_x));
+    vec3 v = x + (foot * (0.5 + 1.5 * sin_x)) * n - (p.position.xyz + u_point_offset);
+    float visible = texture(u_shadows, vec4(v, float(i)), (length(v) - 0.5 * foot) / u_far);
+    if (visible <= 0.0) continue;
+    if (u_count > 0 && analytic_blocked(x + (1e-4 * dist) * n, l, dist)) continue;
+    e += p.flux.rgb * (angular * cos_x * visible / d2);
+  }
+  out_color = vec4(albedo.rgb / kPi * e, 0.0);
+}
