@@ -75,8 +75,9 @@ TEST_P(ExampleImage, GpuMatchesCpuReference) {
   const std::string& example = GetParam();
   const Tolerance tol = kDefault;
   Scene scene = load_example(example);
-  // The GPU path does not draw with `lights` yet (issue 14) and shades every
-  // surface by the directional light; compare that, without the path tracer.
+  // This compares the directional-light path (pass "surfaces") with the
+  // beam reference; lit examples are compared with the path tracer in
+  // test_gi.cpp and by `beamcast bench gi`, so their lights are removed here.
   scene.lights.clear();
   const auto frames = shared_renderer().render(scene, FrameOptions{.read_hdr = true});
   ASSERT_EQ(frames.size(), scene.cameras.size());
