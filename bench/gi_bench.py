@@ -12,7 +12,8 @@ Runs `beamcast render` (this build) on the Cornell box (examples/cornell_box.jso
     1e6 (default kernel and radius), each kernel at 1e5, the radius at 0.5x
     and 2x its default at 1e5; at 1e5 also direct light from photons (the
     seed's way) in place of the direct pass, and the direct pass's knobs
-    (points per quad light 4 and 64, shadow maps of 128 and 512 texels).
+    (points per quad light 4 and 64, shadow maps of 128 and 512 texels), the
+    splats' edge correction off, and splatting at 1/2 and 1/4 of the size.
 Per photon count also the CPU photon gather on the same photons
 (`beamcast render --gather radius`: the splat estimator in double, with the
 direct pass's term from the same points with exact visibility; and
@@ -116,7 +117,8 @@ def rel_l1(img, ref, mask=None):
 
 
 def default_radius(scene, photons):
-    """gi/photon_map.cpp default_photon_radius: 50 photons per disk at 1e5, r ~ photons^(-1/6)."""
+    """gi/photon_map.cpp default_photon_radius: 50 photons per disk at 1e5 (200 with the
+    direct pass carrying direct light), r ~ photons^(-1/6)."""
     pts = []
     for q in scene["occluders"]:
         c, u, v = (np.array(q[k], float) for k in ("corner", "edge_u", "edge_v"))
@@ -128,7 +130,8 @@ def default_radius(scene, photons):
     pts = np.array(pts)
     s = pts.max(axis=0) - pts.min(axis=0)
     area = 2 * (s[0] * s[1] + s[1] * s[2] + s[2] * s[0])
-    k = 50 * (photons / 1e5) ** (2 / 3)
+    k0 = 50 if scene.get("gi", {}).get("direct") == "photons" else 200
+    k = k0 * (photons / 1e5) ** (2 / 3)
     return math.sqrt(k * area / (math.pi * photons))
 
 
@@ -196,12 +199,17 @@ def main():
                  for k in (4, 64)]
     settings += [("direct", mid, "epanechnikov", 1.0, {"shadow_size": k}, f"shadow {k}")
                  for k in (128, 512)]
+    # The splats' edge correction off, and splatting at 1/2 and 1/4 size.
+    settings += [("splat", mid, "epanechnikov", 1.0, {"edge_correction": False}, "no edge corr.")]
+    settings += [("splat", mid, "epanechnikov", 1.0, {"splat_scale": k}, f"splat 1/{k}")
+                 for k in (2, 4)]
     regions = sorted(set(CORNELL_LABELS)) if len(base["occluders"]) == len(CORNELL_LABELS) else []
 
     rows = []
     for knob, n, kernel, rscale, extra, varied in settings:
-        r = default_radius(base, n) * rscale
-        s = dict(base, gi=dict(base.get("gi", {}), photons=n, kernel=kernel, radius=r, **extra))
+        s = dict(base, gi=dict(base.get("gi", {}), photons=n, kernel=kernel, **extra))
+        r = default_radius(s, n) * rscale
+        s["gi"]["radius"] = r
         # Copies of the camera, each nudged by a hair so no two frames are
         # the same work: the maps are traced once, the frames time a
         # camera-only change.
@@ -290,7 +298,8 @@ def main():
         ax[0].set_xlabel("photons emitted")
         ax[0].set_ylabel("relative L1 error")
         ax[0].legend(fontsize=7)
-        for knob, mk in (("photons", "o"), ("kernel", "s"), ("radius", "^"), ("direct", "d")):
+        for knob, mk in (("photons", "o"), ("kernel", "s"), ("radius", "^"), ("direct", "d"),
+                         ("splat", "v")):
             pts = [r for r in rows if r["knob"] == knob]
             ax[1].loglog([r["frame_ms"] for r in pts], [r["rel_l1"] for r in pts], mk, label=knob)
         pts = [r for r in rows if r["knob"] == "path_tracer"]

@@ -202,12 +202,16 @@ double default_photon_radius(const Scene& scene, std::int64_t photons) {
   const Vec3 s = box.hi - box.lo;
   const double area = 2.0 * (s[0] * s[1] + s[1] * s[2] + s[2] * s[0]);
   if (!(area > 0.0)) return 1.0;
-  // k photons in pi r^2 of `area` spread over `photons`, k = 50 at 1e5 and
+  // k photons in pi r^2 of `area` spread over `photons`, k = k0 at 1e5 and
   // growing as photons^(2/3): r ~ photons^(-1/6), the radius that balances a
   // density estimate's bias (~ r^2) against its noise (~ 1 / sqrt(N r^2)), so
   // the error falls as photons^(-1/3). A fixed k would keep the noise fixed.
+  // k0 = 50 where photons carry direct light (sharp: shadows, the light's
+  // falloff); 200 (twice the radius) where they carry only the later
+  // bounces, which vary slowly: measured on the Cornell box (docs/gi.md).
+  const double k0 = scene.gi.direct == DirectLightMethod::kShadowMaps ? 200.0 : 50.0;
   const double n = static_cast<double>(photons);
-  const double k = 50.0 * std::cbrt((n / 1e5) * (n / 1e5));
+  const double k = k0 * std::cbrt((n / 1e5) * (n / 1e5));
   return std::sqrt(k * area / (std::numbers::pi * n));
 }
 

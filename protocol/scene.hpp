@@ -76,6 +76,14 @@ struct GiSettings {
   DirectLightMethod direct = DirectLightMethod::kShadowMaps;
   int direct_samples = 16;  // points per area light in the direct pass
   int shadow_size = 256;    // texels per cube-map face of a direct point's shadow map
+  // Divide each pixel's photon estimate by the share of its disk on its own
+  // surface (the splats' edge bias at corners and edges; pass gi_resolve).
+  bool edge_correction = true;
+  // Photons are splatted at 1/splat_scale of the render size per side, then
+  // brought back by a surface-aware upsampling (pass gi_resolve): faster,
+  // but the upsampling pulls values from further inside a surface, which the
+  // edge correction (made per render pixel) then over-corrects at edges.
+  int splat_scale = 1;
 };
 
 // One directional light for Lambert shading of occluders.

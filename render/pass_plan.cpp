@@ -24,6 +24,9 @@ const std::vector<TargetDecl>& target_catalog() {
       // facing the camera, and albedo with the material code (w).
       {"gb_normal", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kNone},
       {"gb_albedo", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kNone},
+      // What the photon splats add up, before the edge correction (gi_resolve).
+      // At gi.splat_scale times fewer pixels per side (indirect light is smooth).
+      {"gi_indirect", TargetFormat::kRgba32f, TargetSize::kSplat, TargetClear::kZero},
   };
   return kTargets;
 }
@@ -57,7 +60,14 @@ const std::vector<PassDecl>& pass_catalog() {
       // direct pass carries that light).
       {PassId::kPhotons, "photons",
        [](const PlanInput& in) { return !in.scene.occluders.empty() && in.scene.has_gi(); },
-       {"hdr", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {"photons"}},
+       {"view_depth", "gb_normal", "gb_albedo"}, {}, {"gi_indirect"}, {"photons"}},
+      // The splats' sum to hdr, divided by the share of each pixel's disk
+      // that its surface covers (found in the G-buffer), so a surface's
+      // edges and the room's corners are not darkened by the disk hanging
+      // over them (gi.edge_correction; shaders/gi_resolve.frag).
+      {PassId::kGiResolve, "gi_resolve",
+       [](const PlanInput& in) { return !in.scene.occluders.empty() && in.scene.has_gi(); },
+       {"hdr", "gi_indirect", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {}},
       // Beams: energy added to hdr; a ray ends at the nearest surface if
       // anything wrote view_depth.
       {PassId::kBeams, "beams", [](const PlanInput& in) { return !in.scene.beams.empty(); },
@@ -93,6 +103,7 @@ std::vector<std::string> FramePlan::names() const {
 FramePlan make_plan(const PlanInput& in, const std::vector<PassDecl>& catalog,
                     const std::vector<TargetDecl>& targets) {
   FramePlan plan;
+  plan.splat_scale = in.scene.gi.splat_scale;
   auto target = [&](const PassDecl& pass, const std::string& name) -> const TargetDecl* {
     for (const TargetDecl& t : targets) {
       if (t.name == name) return &t;

@@ -20,8 +20,17 @@ namespace beamcast {
 // make_pass (render/passes.cpp), whose switch over this enum has no default:
 // a new id without an executor does not compile (-Wswitch) and fails the
 // renderer's construction check.
-enum class PassId { kSurfaces, kGbuffer, kDirect, kPhotons, kBeams, kTonemap, kUpscale };
-inline constexpr std::size_t kPassCount = 7;
+enum class PassId {
+  kSurfaces,
+  kGbuffer,
+  kDirect,
+  kPhotons,
+  kGiResolve,
+  kBeams,
+  kTonemap,
+  kUpscale
+};
+inline constexpr std::size_t kPassCount = 8;
 
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {
@@ -36,10 +45,12 @@ enum class TargetClear {
   kBackground,  // the scene's background colour
   kNoSurface,   // FrameTargets' kNoSurface view depth ("no surface on this ray")
   kFarDepth,    // reversed-Z far plane (0)
+  kZero,        // zero (accumulation targets)
 };
 enum class TargetSize {
   kRender,  // the render size (camera size times the resolution scale)
   kCamera,  // the camera's own size (what the client asked for)
+  kSplat,   // the render size over FramePlan::splat_scale (rounded up)
 };
 
 struct TargetDecl {
@@ -80,6 +91,7 @@ struct FramePlan {
   std::vector<const TargetDecl*> targets;  // read or written by a planned pass, allocated
   std::vector<std::string> uploads;        // union of the planned passes' uploads
   std::string final_target;                // the last pass's first write: what is read back
+  int splat_scale = 1;  // kSplat targets' divisor: the scene's gi.splat_scale
 
   // True if a planned pass (not just the frame-start clear) writes `target`.
   bool written(std::string_view target) const;

@@ -31,7 +31,8 @@ GLenum internal_format(TargetFormat f, int bits) {
 void FrameTargets::ensure(const FramePlan& plan, int render_w, int render_h, int camera_w,
                           int camera_h, int bits, int layer_count) {
   if (render_w != render_w_ || render_h != render_h_ || camera_w != camera_w_ ||
-      camera_h != camera_h_ || bits != bits_ || layer_count != layers_) {
+      camera_h != camera_h_ || bits != bits_ || layer_count != layers_ ||
+      plan.splat_scale != splat_scale_) {
     targets_.clear();
     for (PassFbos& f : fbos_) f = PassFbos{};
     render_w_ = render_w;
@@ -40,12 +41,17 @@ void FrameTargets::ensure(const FramePlan& plan, int render_w, int render_h, int
     camera_h_ = camera_h;
     bits_ = bits;
     layers_ = layer_count;
+    splat_scale_ = plan.splat_scale;
   }
   for (const TargetDecl* decl : plan.targets) {
     if (find(decl->name)) continue;
     const bool camera_size = decl->size == TargetSize::kCamera;
-    const int w = camera_size ? camera_w : render_w;
-    const int h = camera_size ? camera_h : render_h;
+    int w = camera_size ? camera_w : render_w;
+    int h = camera_size ? camera_h : render_h;
+    if (decl->size == TargetSize::kSplat) {
+      w = splat_size(render_w, plan.splat_scale);
+      h = splat_size(render_h, plan.splat_scale);
+    }
     const GLenum format = internal_format(decl->format, bits);
     Target t{decl, {}};
     if (layer_count == 0) {
@@ -90,6 +96,11 @@ void FrameTargets::clear(const FramePlan& plan, const Color& background) {
       case TargetClear::kNoSurface: {
         const float v = kNoSurface;
         glClearTexImage(tex, 0, GL_RED, GL_FLOAT, &v);
+        break;
+      }
+      case TargetClear::kZero: {
+        const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        glClearTexImage(tex, 0, GL_RGBA, GL_FLOAT, zero);
         break;
       }
       case TargetClear::kFarDepth: {
@@ -376,6 +387,48 @@ class DirectPass final : public Pass {
   float far_ = 1.0f;
 };
 
+// The photon splats' tests (shaders/photon_splat.frag, gi_resolve.frag; the
+// CPU's SplatTests): a photon lights a surface point whose normal is within
+// 25 degrees of its own (curved surfaces turn within a radius; a thin wall's
+// other side is 180 degrees off) and that lies within a tenth of the radius
+// of its plane (a parallel surface nearby: a slab's top over its floor).
+constexpr float kSplatMinCos = 0.906f;
+constexpr float kSplatMaxPlane = 0.1f;
+
+// The splats' sum (gi_indirect) into hdr, each pixel divided by the
+// kernel-weighted share of its disk that lies on its own surface
+// (shaders/gi_resolve.frag), or passed through with gi.edge_correction off.
+class GiResolvePass final : public Pass {
+ public:
+  GiResolvePass() : program_("gi_resolve") {}
+  void execute(FrameContext& ctx, const PassDecl& self) override {
+    const bool multi = ctx.views > 0;
+    glUseProgram(program_.get(multi));
+    glUniform1f(program_.uniform(multi, "u_radius"),
+                static_cast<float>(ctx.resources.photon_radius()));
+    glUniform1i(program_.uniform(multi, "u_kernel"), static_cast<int>(ctx.scene.gi.kernel));
+    glUniform1f(program_.uniform(multi, "u_min_cos"), kSplatMinCos);
+    glUniform1f(program_.uniform(multi, "u_max_plane"), kSplatMaxPlane);
+    glUniform1i(program_.uniform(multi, "u_correct"), ctx.scene.gi.edge_correction ? 1 : 0);
+    glUniform1i(program_.uniform(multi, "u_splat_scale"), ctx.plan.splat_scale);
+    glBindTextureUnit(0, ctx.targets.texture("view_depth"));
+    glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
+    glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
+    glBindTextureUnit(3, ctx.targets.texture("gi_indirect"));
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_DEPTH_TEST);
+    glBindVertexArray(ctx.empty_vao);
+    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    glDisable(GL_BLEND);
+    gl_check("gi_resolve pass");
+  }
+
+ private:
+  ProgramPair program_;
+};
+
 // Photon splatting: one instanced draw of camera-facing quads, one per
 // photon; the fragment shader reads the G-buffer and adds the photon's
 // reflected radiance (shaders/photon_splat.frag), additively into hdr.
@@ -389,12 +442,8 @@ class PhotonPass final : public Pass {
     const float radius = static_cast<float>(ctx.resources.photon_radius());
     glUniform1f(program_.uniform(multi, "u_radius"), radius);
     glUniform1i(program_.uniform(multi, "u_kernel"), static_cast<int>(ctx.scene.gi.kernel));
-    // A photon lights a surface point whose normal is within 25 degrees of
-    // its own (curved surfaces turn within a radius; a thin wall's other
-    // side is 180 degrees off) and that lies within a tenth of the radius of
-    // its plane (a parallel surface nearby: a slab's top over its floor).
-    glUniform1f(program_.uniform(multi, "u_min_cos"), 0.906f);
-    glUniform1f(program_.uniform(multi, "u_max_plane"), 0.1f);
+    glUniform1f(program_.uniform(multi, "u_min_cos"), kSplatMinCos);
+    glUniform1f(program_.uniform(multi, "u_max_plane"), kSplatMaxPlane);
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
     glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
@@ -405,6 +454,12 @@ class PhotonPass final : public Pass {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glBindVertexArray(ctx.empty_vao);
+    // Splatted at the kSplat size: the viewport shrinks for this pass.
+    const int scale = ctx.plan.splat_scale;
+    glUniform1i(program_.uniform(multi, "u_splat_scale"), scale);
+    GLint viewport[4];
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    glViewport(0, 0, splat_size(viewport[2], scale), splat_size(viewport[3], scale));
     const GLint offset = program_.uniform(multi, "u_photon_offset");
     const GLint view = multi ? program_.uniform(true, "u_view") : -1;
     const int views = multi ? ctx.views : 1;
@@ -418,6 +473,7 @@ class PhotonPass final : public Pass {
                   static_cast<float>(off[2]));
       glDrawArraysInstanced(GL_TRIANGLES, 0, 6, ctx.resources.photon_count());
     }
+    glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
     glDisable(GL_BLEND);
     gl_check("photons pass");
   }
@@ -538,6 +594,8 @@ std::unique_ptr<Pass> make_pass(PassId id) {
       return std::make_unique<DirectPass>();
     case PassId::kPhotons:
       return std::make_unique<PhotonPass>();
+    case PassId::kGiResolve:
+      return std::make_unique<GiResolvePass>();
     case PassId::kBeams:
       return std::make_unique<BeamPass>();
     case PassId::kTonemap:

@@ -49,6 +49,7 @@ class FrameTargets {
     std::vector<GlFramebuffer> per_layer;
   };
   int render_w_ = 0, render_h_ = 0, camera_w_ = 0, camera_h_ = 0, bits_ = 0, layers_ = 0;
+  int splat_scale_ = 1;
   std::vector<Target> targets_;
   std::array<PassFbos, kPassCount> fbos_;
   const Target* find(std::string_view name) const;
@@ -81,6 +82,9 @@ struct FrameContext {
 // (BEAMCAST_MAX_VIEWS in shaders/multiview*.glsl; 64 blocks of 176 bytes fit
 // the 16 KiB every GL 4.5 driver must allow a uniform block).
 inline constexpr int kMaxBatchViews = 64;
+
+// The size of a TargetSize::kSplat target for a render size.
+inline int splat_size(int render_size, int scale) { return (render_size + scale - 1) / scale; }
 
 // How a declared pass (PassDecl) executes. `self` is its declaration (its
 // targets' framebuffers come from ctx.targets.fbo(self, view)).

@@ -1,6 +1,7 @@
 // A photon's reflected radiance at the G-buffer's surface point x (seed 001,
 // eq. 4.2): L += (albedo / pi) * power * w(|x - p|) with the kernel w
-// normalized over the disk of radius r. The photon's power is already what
+// normalized over the disk of radius r; this pass sums power * w / pi (the
+// albedo is applied per pixel by gi_resolve, after upsampling). The photon's power is already what
 // crossed the surface (cosine-weighted by the tracing): no n.l factor here.
 // Photons do not light surfaces facing another way (normal test: a thin
 // wall's other side) or off their plane (plane-distance test: a parallel
@@ -12,6 +13,7 @@ uniform float u_radius;
 uniform int u_kernel;      // SplatKernel: 0 box, 1 cone, 2 epanechnikov
 uniform float u_min_cos;   // normal test: cos of the largest angle between the normals
 uniform float u_max_plane; // plane test: largest distance off the surface's plane, x radius
+uniform int u_splat_scale; // this target has 1/u_splat_scale of the G-buffer's pixels per side
 
 flat in vec3 v_center;
 flat in vec3 v_power;
@@ -23,13 +25,16 @@ const float kPi = 3.14159265358979;
 
 void main() {
   select_view(view_index());
-  ivec2 px = ivec2(gl_FragCoord.xy);
+  // The G-buffer pixel this (splat-size) pixel stands for (gi_resolve.frag
+  // uses the same one).
+  ivec2 px = min(ivec2(gl_FragCoord.xy) * u_splat_scale + u_splat_scale / 2,
+                 ivec2(cam.viewport.xy) - 1);
   float z = VIEW_TEXEL(u_view_depth, px).r;
   if (z >= 1e29) discard;  // no surface on this pixel
   vec4 albedo = VIEW_TEXEL(u_gb_albedo, px);
   if (albedo.w > 0.5) discard;  // mirrors and glass store no photons
   vec3 n = VIEW_TEXEL(u_gb_normal, px).xyz;
-  ViewRay ray = view_ray(gl_FragCoord.xy);
+  ViewRay ray = view_ray(vec2(px) + 0.5);
   vec3 x = ray.origin + (z / ray.cos_axis) * ray.dir;
   vec3 d = x - v_center;
   float r2 = u_radius * u_radius;
@@ -45,5 +50,6 @@ void main() {
   } else {
     w = 2.0 / (kPi * r2) * (1.0 - d2 / r2);
   }
-  out_color = vec4(albedo.rgb / kPi * v_power * w, 0.0);
+  // Irradiance / pi: gi_resolve multiplies by the albedo of each pixel.
+  out_color = vec4(v_power * (w / kPi), 0.0);
 }

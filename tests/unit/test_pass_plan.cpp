@@ -115,15 +115,16 @@ TEST(PassPlan, ReadingATargetNobodyWritesFailsAtPlanTime) {
 TEST(PassPlan, LitScenesSplatPhotonsOverAGbuffer) {
   const FramePlan plan = make_plan(PlanInput{scene_with(true, true, true)});
   EXPECT_EQ(plan.names(),
-            (std::vector<std::string>{"gbuffer", "direct", "photons", "beams", "tonemap"}));
+            (std::vector<std::string>{"gbuffer", "direct", "photons", "gi_resolve", "beams", "tonemap"}));
   EXPECT_TRUE(plan.uploads_group("shadows"));
   Scene photons_only = scene_with(true, true, true);
   photons_only.gi.direct = DirectLightMethod::kPhotons;
   EXPECT_EQ(make_plan(PlanInput{photons_only}).names(),
-            (std::vector<std::string>{"gbuffer", "photons", "beams", "tonemap"}));
+            (std::vector<std::string>{"gbuffer", "photons", "gi_resolve", "beams", "tonemap"}));
   EXPECT_FALSE(make_plan(PlanInput{photons_only}).uploads_group("shadows"));
-  EXPECT_EQ(target_names(plan), (std::vector<std::string>{"depth", "gb_albedo", "gb_normal", "hdr",
-                                                           "output", "view_depth"}));
+  EXPECT_EQ(target_names(plan),
+            (std::vector<std::string>{"depth", "gb_albedo", "gb_normal", "gi_indirect", "hdr",
+                                      "output", "view_depth"}));
   EXPECT_TRUE(plan.uploads_group("photons"));
   EXPECT_TRUE(plan.written("view_depth"));
   EXPECT_EQ(make_plan(PlanInput{scene_with(true, false, true)}).names(),
@@ -135,7 +136,7 @@ TEST(PassPlan, LitScenesSplatPhotonsOverAGbuffer) {
 TEST(PassPlan, UnknownTargetsAndRepeatedIdsFail) {
   std::vector<PassDecl> catalog = pass_catalog();
   // The tonemap pass (planned for every frame) names a target that does not exist.
-  catalog[5].writes = {"outptu"};
+  catalog[6].writes = {"outptu"};
   EXPECT_THROW(make_plan(PlanInput{scene_with(false, false)}, catalog), PlanError);
   catalog = pass_catalog();
   catalog[1].id = PassId::kSurfaces;
