@@ -316,8 +316,10 @@ TEST(Gi, TheEdgeCorrectionRemovesTheSplatsBiasAtASurfacesEdge) {
          {{{"type", "quad"}, {"corner", {-kHalf, 0, kHalf}}, {"edge_u", {2 * kHalf, 0, 0}},
            {"edge_v", {0, 0, -2 * kHalf}}, {"albedo", {kRho, kRho, kRho}}}}},
         {"lights", {{{"type", "point"}, {"position", {light[0], light[1], light[2]}}, {"power", kPhi}}}},
+        // At the full size: the correction itself, without the upsampling's
+        // pull from inside the floor (the band reads 1.08 at splat_scale 2).
         {"gi", {{"photons", 200000}, {"caustic_photons", 0}, {"radius", kRadius},
-                {"direct", "photons"}, {"edge_correction", correct}}},
+                {"direct", "photons"}, {"edge_correction", correct}, {"splat_scale", 1}}},
         {"cameras", {{{"position", {0, 3, 0.001}}, {"target", {0, 0, 0}}, {"fov_y", 45},
                       {"width", 128}, {"height", 128}}}}};
   };
