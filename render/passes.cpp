@@ -196,6 +196,23 @@ void for_each_view(FrameContext& ctx, const PassDecl& self, ProgramPair& program
   }
 }
 
+// for_each_view for draws of world-anchored data: before each view's draw
+// the uniform `offset_uniform` gets `anchor` minus that view's eye (in
+// double, then float).
+template <class Draw>
+void for_each_view_offset(FrameContext& ctx, const PassDecl& self, ProgramPair& program,
+                          const char* offset_uniform, const Vec3& anchor, Draw draw) {
+  const bool multi = ctx.views > 0;
+  const GLint offset = program.uniform(multi, offset_uniform);
+  std::size_t v = 0;
+  for_each_view(ctx, self, program, [&] {
+    const Vec3 off = anchor - (multi ? ctx.view_eyes[v++] : ctx.basis.eye);
+    glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
+                static_cast<float>(off[2]));
+    draw();
+  });
+}
+
 // Occluders: rasterized triangles (boxes, meshes) and ray-traced planes and
 // spheres, depth-tested together; writes shaded colour and view depth.
 class SurfacePass final : public Pass {
@@ -297,18 +314,8 @@ class DirectPass final : public Pass {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glBindVertexArray(ctx.empty_vao);
-    const GLint offset = program_.uniform(multi, "u_point_offset");
-    const GLint view = multi ? program_.uniform(true, "u_view") : -1;
-    const int views = multi ? ctx.views : 1;
-    for (int v = 0; v < views; ++v) {
-      glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, multi ? v : -1));
-      if (multi) glUniform1i(view, v);
-      const Vec3 eye = multi ? ctx.view_eyes[static_cast<std::size_t>(v)] : ctx.basis.eye;
-      const Vec3 off = res.direct_anchor() - eye;
-      glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
-                  static_cast<float>(off[2]));
-      glDrawArrays(GL_TRIANGLES, 0, 3);
-    }
+    for_each_view_offset(ctx, self, program_, "u_point_offset", res.direct_anchor(),
+                         [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
     glDisable(GL_BLEND);
     gl_check("direct pass");
   }
@@ -460,19 +467,9 @@ class PhotonPass final : public Pass {
     GLint viewport[4];
     glGetIntegerv(GL_VIEWPORT, viewport);
     glViewport(0, 0, splat_size(viewport[2], scale), splat_size(viewport[3], scale));
-    const GLint offset = program_.uniform(multi, "u_photon_offset");
-    const GLint view = multi ? program_.uniform(true, "u_view") : -1;
-    const int views = multi ? ctx.views : 1;
-    for (int v = 0; v < views; ++v) {
-      glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, multi ? v : -1));
-      if (multi) glUniform1i(view, v);
-      // Photon anchor minus this view's eye, in double.
-      const Vec3 eye = multi ? ctx.view_eyes[static_cast<std::size_t>(v)] : ctx.basis.eye;
-      const Vec3 off = ctx.resources.photon_anchor() - eye;
-      glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
-                  static_cast<float>(off[2]));
+    for_each_view_offset(ctx, self, program_, "u_photon_offset", ctx.resources.photon_anchor(), [&] {
       glDrawArraysInstanced(GL_TRIANGLES, 0, 6, ctx.resources.photon_count());
-    }
+    });
     glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
     glDisable(GL_BLEND);
     gl_check("photons pass");

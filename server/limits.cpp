@@ -52,6 +52,9 @@ const std::vector<LimitEntry>& limit_table() {
       BEAMCAST_LIMIT("max_lights", scene_limits.max_lights, 0, kI32, "Most lights in a scene"),
       BEAMCAST_LIMIT("max_photons", scene_limits.max_photons, 0, kI64,
                      "Most photons a scene may ask for (gi.photons + gi.caustic_photons)"),
+      BEAMCAST_LIMIT("max_shadow_texels", scene_limits.max_shadow_texels, 0, kI64,
+                     "Most shadow-map texels of a lit scene's direct light (points x 6 x "
+                     "gi.shadow_size^2)"),
       BEAMCAST_LIMIT("max_mesh_triangles", scene_limits.max_mesh_triangles, 0, kI64,
                      "Most mesh triangles in a scene, all meshes together"),
       BEAMCAST_LIMIT("max_inflight_per_connection", max_inflight_per_connection, 1, 1 << 20,
