@@ -44,7 +44,9 @@ struct Context {
   Vec3 user_n{};
 };
 
-constexpr float kHuge = 1e20f;  // bounds of unbounded elements (planes)
+// Bounds of unbounded elements (planes): Embree drops primitives whose
+// bounds reach past its FLT_LARGE (1.844e18) as invalid.
+constexpr float kHuge = 1e17f;
 
 float clamp_bound(double x) {
   return static_cast<float>(std::clamp(x, -static_cast<double>(kHuge), static_cast<double>(kHuge)));

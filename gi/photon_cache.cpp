@@ -26,6 +26,7 @@ class KeyWriter final : public TriangleSink {
     put(c);
     put(one_sided);
   }
+  void text(std::string_view s) { bytes_.append(s); }
   std::string digest() const {
     // 64-bit hash and length: a false match needs a collision of both.
     const std::size_t h = std::hash<std::string_view>{}(bytes_);
@@ -73,6 +74,19 @@ std::string photon_key(const Scene& scene) {
             k.put(kind.direction);
             k.put(kind.inner_deg);
             k.put(kind.outer_deg);
+          } else if constexpr (std::is_same_v<Kind, BeamEmitter>) {
+            std::visit(
+                [&](const auto& beam) {
+                  const BeamGpu g = beam.gpu(Vec3{0.0, 0.0, 0.0});
+                  k.put(g.p0);
+                  k.put(g.axis);
+                  k.put(g.length);
+                  k.put(g.caps_kind);
+                },
+                kind.shape);
+            k.put(kind.radius);
+            k.put(kind.density_key.size());
+            k.text(kind.density_key);
           } else {
             static_assert(std::is_same_v<Kind, QuadLight>, "a light kind missing from photon_key");
             k.put(kind.corner);

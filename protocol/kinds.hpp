@@ -3,7 +3,7 @@
 // its "type" in scene JSON. Included by the kinds' registries (.cpp files).
 #pragma once
 
-#include <optional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -14,6 +14,18 @@
 #include "protocol/json_reader.hpp"
 
 namespace beamcast {
+
+// A kind the service makes itself and clients never write (a light kind with
+// `static constexpr bool kDerived = true`: the light of an emitting beam):
+// left out of the "type" lists and of parsing.
+template <class K>
+constexpr bool is_derived_kind() {
+  if constexpr (requires { K::kDerived; }) {
+    return K::kDerived;
+  } else {
+    return false;
+  }
+}
 
 // Calls f(std::type_identity<K>{}) for every alternative K of Variant, in order.
 template <class Variant, class F>
@@ -27,7 +39,10 @@ void each_kind(F&& f) {
 template <class Variant>
 std::vector<std::string_view> kind_types() {
   std::vector<std::string_view> types;
-  each_kind<Variant>([&](auto kind) { types.push_back(decltype(kind)::type::kType); });
+  each_kind<Variant>([&](auto kind) {
+    using K = typename decltype(kind)::type;
+    if constexpr (!is_derived_kind<K>()) types.push_back(K::kType);
+  });
   return types;
 }
 
@@ -37,9 +52,14 @@ std::vector<std::string_view> kind_types() {
 template <class Variant, class Make>
 Variant parse_kind(const json_read::Node& type, Make&& make) {
   const std::string name = json_read::read_string(type);
-  std::optional<Variant> shape;
+  // On the heap: GCC 12 cannot see that a std::optional<Variant> holding a
+  // kind it never emplaces is set before the move (-Wmaybe-uninitialized).
+  std::unique_ptr<Variant> shape;
   each_kind<Variant>([&](auto kind) {
-    if (!shape && name == decltype(kind)::type::kType) shape.emplace(make(kind));
+    using K = typename decltype(kind)::type;
+    if constexpr (!is_derived_kind<K>()) {
+      if (!shape && name == K::kType) shape = std::make_unique<Variant>(make(kind));
+    }
   });
   if (shape) return std::move(*shape);
   std::string allowed;

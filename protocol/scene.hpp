@@ -29,6 +29,10 @@ struct Beam {
   Color color{1.0, 1.0, 1.0};
   double intensity = 1.0;
   Density density;
+  // Whether the beam also lights the scene (issue 14): the parser then adds
+  // its light (a BeamEmitter, flux 4 pi x color x intensity x the volume
+  // integral of f) to Scene::lights.
+  bool emit = false;
 };
 
 // One module per kind in protocol/occluders/ (parsing, bounds, GPU form, CPU

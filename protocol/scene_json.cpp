@@ -138,7 +138,8 @@ Density parse_density(const Node& n, const SceneLimits& limits) {
 
 // The fields every beam has; the kind's own (protocol/beams/) come after
 // "type" in the allowed list and are read by its parse function.
-constexpr std::array<std::string_view, 4> kBeamFields{"radius", "color", "intensity", "density"};
+constexpr std::array<std::string_view, 5> kBeamFields{"radius", "color", "intensity", "density",
+                                                     "emit"};
 
 Beam parse_beam(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "a beam");
@@ -150,6 +151,7 @@ Beam parse_beam(const Node& n, const SceneLimits& limits) {
     if (auto c = o.optional("color")) b.color = read_color(*c);
     if (auto i = o.optional("intensity")) b.intensity = check_non_negative(*i, read_number(*i));
     if (auto d = o.optional("density")) b.density = parse_density(*d, limits);
+    if (auto e = o.optional("emit")) b.emit = read_bool(*e);
     return Kind::parse(BeamParse{o, limits, b.radius});
   });
   return b;
@@ -246,6 +248,22 @@ Light parse_gi_light(const Node& n, const SceneLimits& limits) {
     }
   }
   return l;
+}
+
+// The light of each beam with "emit": true, after the scene's own lights.
+void add_beam_lights(Scene* scene) {
+  for (std::size_t i = 0; i < scene->beams.size(); ++i) {
+    const Beam& b = scene->beams[i];
+    if (!b.emit) continue;
+    Light l{BeamEmitter::from_beam(b.shape, b.radius, b.density, static_cast<int>(i)), {}};
+    const double m = std::get<BeamEmitter>(l.shape).volume_mass();
+    // The glow is measured in radii (docs/scene-format.md, Units): per world
+    // length it is color x intensity x f / radius.
+    for (std::size_t k = 0; k < 3; ++k) {
+      l.flux[k] = 4.0 * std::numbers::pi * b.color[k] * b.intensity * m / b.radius;
+    }
+    scene->lights.push_back(std::move(l));
+  }
 }
 
 // The direct-light pass's shadow maps, checked against max_shadow_texels
@@ -785,13 +803,14 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
     scene.gi.photons = std::min(scene.gi.photons, limits.max_photons);
     scene.gi.caustic_photons = std::min(scene.gi.caustic_photons, limits.max_photons - scene.gi.photons);
   }
-  check_shadow_budget(scene, limits, gi_path);
 
   if (auto v = o.optional("beams")) {
     for (const Node& b : read_array(*v, limits.max_beams, "max_beams")) {
       scene.beams.push_back(parse_beam(b, limits));
     }
   }
+  add_beam_lights(&scene);
+  check_shadow_budget(scene, limits, gi_path);
   if (auto v = o.optional("occluders")) {
     std::int64_t mesh_triangles = 0;
     for (const Node& occ : read_array(*v, limits.max_occluders, "max_occluders")) {
@@ -840,7 +859,10 @@ Scene load_scene_file(const std::filesystem::path& file, const SceneLoadOptions&
 nlohmann::json scene_capabilities() {
   json densities = density_names();
   densities.push_back("table");
+  json beam_fields = json::array();
+  for (std::string_view f : kBeamFields) beam_fields.push_back(f);
   return {{"beam_types", beam_types()},
+          {"beam_fields", beam_fields},
           {"densities", densities},
           {"occluder_types", occluder_types()},
           {"light_types", light_types()},

@@ -215,6 +215,19 @@ def main():
         {"type": "sphere", "center": [175.0, 100.0, 200.0], "radius": 100.0,
          "material": {"type": "glass", "ior": 1.5}},
     ]))
+    # The room alone, lit only by two glowing beams (issue 14: beams that emit).
+    room = cornell(cornell_block(CORNELL_SHORT))
+    del room["lights"]
+    write("beam_lit_room.json", dict(
+        room,
+        beams=[
+            {"type": "capsule", "p0": [300.0, 90.0, 330.0], "p1": [300.0, 430.0, 330.0],
+             "radius": 28.0, "color": [1.0, 0.55, 0.2], "intensity": 1.5, "density": "quadratic",
+             "emit": True},
+            {"type": "sphere", "center": [130.0, 380.0, 230.0], "radius": 50.0,
+             "color": [0.3, 0.55, 1.0], "intensity": 3.0,
+             "density": {"type": "gaussian", "sigma": 0.4}, "emit": True},
+        ]))
 
 
 if __name__ == "__main__":

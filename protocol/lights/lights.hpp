@@ -6,13 +6,16 @@
 #include <variant>
 #include <vector>
 
+#include "protocol/lights/beam_emitter.hpp"
 #include "protocol/lights/point.hpp"
 #include "protocol/lights/quad.hpp"
 #include "protocol/lights/spot.hpp"
 
 namespace beamcast {
 
-using LightShape = std::variant<PointLight, SpotLight, QuadLight>;
+// BeamEmitter is derived (the light of a beam with "emit": true): never
+// parsed from "lights", listed in no "type" list.
+using LightShape = std::variant<PointLight, SpotLight, QuadLight, BeamEmitter>;
 
 // The "type" strings of the kinds (hello's light_types).
 std::vector<std::string_view> light_types();
