@@ -83,6 +83,10 @@ struct GiSettings {
   // Divide each pixel's photon estimate by the share of its disk on its own
   // surface (the splats' edge bias at corners and edges; pass gi_resolve).
   bool edge_correction = true;
+  // Give the pixels on a quad light's outline the share of the pixel that
+  // sees it (pass gi_resolve; the first 8 quad lights): without it the
+  // light's aliased edge is most of the Cornell box's error (docs/gi.md).
+  bool light_antialias = true;
   // Photons are splatted at 1/splat_scale of the render size per side, then
   // brought back by a surface-aware upsampling (pass gi_resolve): near edges
   // the upsampling pulls values from further inside a surface, which the

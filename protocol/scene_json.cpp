@@ -292,7 +292,8 @@ void check_shadow_budget(const Scene& scene, const SceneLimits& limits, const st
 GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "gi settings");
   o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth", "direct",
-                "direct_samples", "shadow_size", "edge_correction", "splat_scale"});
+                "direct_samples", "shadow_size", "edge_correction", "splat_scale",
+                "light_antialias"});
   GiSettings g;
   std::int64_t total = 0;
   auto count = [&](const Node& v) {
@@ -343,6 +344,7 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   if (auto v = o.optional("direct_samples")) g.direct_samples = read_int_in(*v, 1, 256);
   if (auto v = o.optional("shadow_size")) g.shadow_size = read_int_in(*v, 16, 2048);
   if (auto v = o.optional("edge_correction")) g.edge_correction = read_bool(*v);
+  if (auto v = o.optional("light_antialias")) g.light_antialias = read_bool(*v);
   if (auto v = o.optional("splat_scale")) g.splat_scale = read_int_in(*v, 1, 8);
   return g;
 }

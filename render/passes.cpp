@@ -406,6 +406,8 @@ constexpr float kSplatMaxPlane = 0.1f;
 // kernel-weighted share of its disk that lies on its own surface
 // (shaders/gi_resolve.frag), or passed through with gi.edge_correction off.
 class GiResolvePass final : public Pass {
+  static constexpr std::size_t kMaxAaLights = 8;  // shaders/gi_resolve.frag
+
  public:
   GiResolvePass() : program_("gi_resolve") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
@@ -427,7 +429,33 @@ class GiResolvePass final : public Pass {
     glBlendEquation(GL_FUNC_ADD);
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(ctx.empty_vao);
-    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    // Quad lights whose outlines are antialiased: corners relative to the
+    // first one's (in double, then float).
+    std::vector<const Light*> quads;
+    if (ctx.scene.gi.light_antialias) {
+      for (const Light& l : ctx.scene.lights) {
+        if (std::holds_alternative<QuadLight>(l.shape) && quads.size() < kMaxAaLights) {
+          quads.push_back(&l);
+        }
+      }
+    }
+    const Vec3 anchor = quads.empty() ? Vec3{} : std::get<QuadLight>(quads[0]->shape).corner;
+    glUniform1i(program_.uniform(multi, "u_aa_lights"), static_cast<GLint>(quads.size()));
+    for (std::size_t k = 0; k < quads.size(); ++k) {
+      const auto& q = std::get<QuadLight>(quads[k]->shape);
+      const Color radiance = q.radiance_scale() * quads[k]->flux;
+      const std::string i = "[" + std::to_string(k) + "]";
+      auto set = [&](const char* name, const Vec3& v) {
+        glUniform3f(program_.uniform(multi, (name + i).c_str()), static_cast<float>(v[0]),
+                    static_cast<float>(v[1]), static_cast<float>(v[2]));
+      };
+      set("u_light_corner", q.corner - anchor);
+      set("u_light_u", q.edge_u);
+      set("u_light_v", q.edge_v);
+      set("u_light_radiance", Vec3{radiance[0], radiance[1], radiance[2]});
+    }
+    for_each_view_offset(ctx, self, program_, "u_light_offset", anchor,
+                         [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
     glDisable(GL_BLEND);
     gl_check("gi_resolve pass");
   }
