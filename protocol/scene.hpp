@@ -74,6 +74,8 @@ struct GiSettings {
   std::int64_t photons = 100000;          // emitted for the global map
   std::int64_t caustic_photons = 100000;  // emitted for the caustic map (with specular surfaces)
   double radius = 0.0;                    // splat / gather radius; 0: from the scene size
+  // The caustic map's splat radius; 0: default_caustic_radius (gi/photon_map.hpp).
+  double caustic_radius = 0.0;
   SplatKernel kernel = SplatKernel::kEpanechnikov;
   std::uint64_t seed = 1;
   int max_depth = 16;  // bounces a photon may take
@@ -94,6 +96,27 @@ struct GiSettings {
   // on the Cornell box 2 costs no error over 1 at 0.5x the frame time
   // (docs/gi.md).
   int splat_scale = 2;
+  // Not in JSON: the share of each cached map the photon pass draws (the
+  // first photons in storage order, i.e. whole paths of the first chunks,
+  // their power scaled by 1 / share, the default radii taken at the drawn
+  // count). Set by the preview's accuracy controller for moving frames
+  // (server/accuracy_controller.hpp): the maps stay cached, nothing is
+  // traced again.
+  double display_fraction = 1.0;
+};
+
+// SLIM point sampling ("slim" in JSON; issue 16): the accuracy knobs of the
+// GPU pass (docs/slim.md measures each against time).
+struct SlimSettings {
+  // S: the (u, v) grid step is n = S r / N, N the sphere's projected width
+  // (diameter) in pixels, so S = 2 puts samples about one pixel apart.
+  double sampling = 2.0;
+  // t: a point joins a pixel's blend if it lies within t x (its sphere's
+  // radius) behind the nearest point there (the seed's t = r is 1).
+  double depth_threshold = 0.25;
+  // The seed's second stage: more samples where neighbours project more
+  // than a pixel apart.
+  bool fill_holes = true;
 };
 
 // One directional light for Lambert shading of occluders.
@@ -182,6 +205,7 @@ struct Scene {
   OutputSettings output;
   RenderSettings render;
   GiSettings gi;
+  SlimSettings slim;
 
   // Global illumination runs when a light of "lights" lights the scene;
   // otherwise the directional light shades it.

@@ -30,7 +30,8 @@ bool ray_box(const Vec3& o, const Vec3& v, const Aabb& box, double* t_near, doub
 
 // How the GPU path draws a kind: as triangles, rasterized (shaders/surface.*),
 // or ray-traced per pixel (shaders/analytic_occluder.frag: planes and spheres).
-enum class GpuForm { kTriangles, kAnalytic };
+// kPoints: sampled as points by its own pass (SLIM surfaces, render/slim_pass.cpp).
+enum class GpuForm { kTriangles, kAnalytic, kPoints };
 
 // Takes a triangles kind's world-space triangles. One-sided triangles are
 // visible (and occlude) only from the side their normal cross(b - a, c - a)
