@@ -53,10 +53,15 @@ bool passes(const Photon& p, const Vec3& x, const Vec3& n, double r, const Splat
 }  // namespace
 
 struct PhotonGather::Index {
+  std::vector<Photon> points;  // the global map's index keeps its own copy
   Cloud cloud;
   Tree tree;
   explicit Index(const std::vector<Photon>* photons)
       : cloud{photons}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+    tree.buildIndex();
+  }
+  explicit Index(std::vector<Photon> own)
+      : points(std::move(own)), cloud{&points}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
     tree.buildIndex();
   }
 };
@@ -64,29 +69,43 @@ struct PhotonGather::Index {
 PhotonGather::PhotonGather(const PhotonMaps& maps, bool skip_direct) {
   for (const auto* map : {&maps.global, &maps.caustic}) {
     for (const Photon& p : *map) {
-      if (!skip_direct || p.bounces != 0) photons_.push_back(p);
+      if (skip_direct && p.bounces == 0) continue;
+      photons_.push_back(p);
+      if (map == &maps.caustic) caustic_.push_back(p);
     }
+    if (map == &maps.global) global_count_ = photons_.size();
   }
   index_ = std::make_unique<Index>(&photons_);
+  global_index_ = std::make_unique<Index>(
+      std::vector<Photon>(photons_.begin(), photons_.begin() + static_cast<std::ptrdiff_t>(global_count_)));
+  caustic_index_ = std::make_unique<Index>(&caustic_);
 }
 
 PhotonGather::~PhotonGather() = default;
 
-Color PhotonGather::fixed_radius(const Vec3& x, const Vec3& n, const Color& albedo, double r,
-                                 SplatKernel kernel, const SplatTests& tests) const {
+Color PhotonGather::within(const Index& index, const std::vector<Photon>& photons, const Vec3& x,
+                           const Vec3& n, double r, SplatKernel kernel, const SplatTests& tests) const {
+  Color sum{0.0, 0.0, 0.0};
+  if (photons.empty() || !(r > 0.0)) return sum;
   const float q[3] = {static_cast<float>(x[0]), static_cast<float>(x[1]), static_cast<float>(x[2])};
   std::vector<std::pair<std::uint32_t, float>> found;
   nanoflann::SearchParams params;
   params.sorted = false;
-  index_->tree.radiusSearch(q, static_cast<float>(r * r) * 1.0001f, found, params);
-  Color sum{0.0, 0.0, 0.0};
+  index.tree.radiusSearch(q, static_cast<float>(r * r) * 1.0001f, found, params);
   for (const auto& [i, d2] : found) {
-    const Photon& p = photons_[i];
+    const Photon& p = photons[i];
     const double d = length(x - pos(p));
     const double w = splat_kernel(kernel, d, r);
     if (w == 0.0 || !passes(p, x, n, r, tests)) continue;
     for (int k = 0; k < 3; ++k) sum[k] += w * p.power[k];
   }
+  return sum;
+}
+
+Color PhotonGather::fixed_radius(const Vec3& x, const Vec3& n, const Color& albedo, const SplatRadii& radii,
+                                 SplatKernel kernel, const SplatTests& tests) const {
+  const Color sum = within(*global_index_, global_index_->points, x, n, radii.global, kernel, tests) +
+                    within(*caustic_index_, caustic_, x, n, radii.caustic, kernel, tests);
   return {albedo[0] / std::numbers::pi * sum[0], albedo[1] / std::numbers::pi * sum[1],
           albedo[2] / std::numbers::pi * sum[2]};
 }
@@ -171,8 +190,7 @@ HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonG
   img.height = cam.height;
   img.rgb.assign(3 * static_cast<std::size_t>(cam.width) * cam.height, 0.0f);
   const CameraBasis basis = camera_basis(cam);
-  const double r = scene.gi.radius > 0.0 ? scene.gi.radius
-                                         : default_photon_radius(scene, scene.gi.photons);
+  const SplatRadii r = splat_radii(scene);
   auto row = [&](int y) {
     const int py = cam.height - 1 - y;  // GL pixel rows count from the bottom
     for (int x = 0; x < cam.width; ++x) {

@@ -31,17 +31,24 @@ class PhotonGather {
   // direct light comes from the direct pass, gi.direct "shadow_maps").
   explicit PhotonGather(const PhotonMaps& maps, bool skip_direct = false);
   ~PhotonGather();
-  // Fixed radius r with `kernel`: what the splat pass computes at x.
-  Color fixed_radius(const Vec3& x, const Vec3& n, const Color& albedo, double r, SplatKernel kernel,
-                     const SplatTests& tests = {}) const;
+  // Fixed radii with `kernel`: what the splat pass computes at x (the
+  // global map's photons within radii.global, the caustic map's within
+  // radii.caustic).
+  Color fixed_radius(const Vec3& x, const Vec3& n, const Color& albedo, const SplatRadii& radii,
+                     SplatKernel kernel, const SplatTests& tests = {}) const;
   // The k nearest photons (with the normal test), r = the k-th distance.
   Color nearest(const Vec3& x, const Vec3& n, const Color& albedo, int k,
                 const SplatTests& tests = {}) const;
 
  private:
   struct Index;
-  std::vector<Photon> photons_;
+  std::vector<Photon> photons_;  // both maps (nearest)
   std::unique_ptr<Index> index_;
+  std::size_t global_count_ = 0;  // photons_[0, global_count_) are the global map's
+  std::vector<Photon> caustic_;   // the caustic map's, for its own radius
+  std::unique_ptr<Index> global_index_, caustic_index_;
+  Color within(const Index& index, const std::vector<Photon>& photons, const Vec3& x, const Vec3& n,
+               double r, SplatKernel kernel, const SplatTests& tests) const;
 };
 
 enum class GatherMethod { kFixedRadius, kNearest };

@@ -215,4 +215,19 @@ double default_photon_radius(const Scene& scene, std::int64_t photons) {
   return std::sqrt(k * area / (std::numbers::pi * n));
 }
 
+double default_caustic_radius(const Scene& scene, std::int64_t caustic_photons) {
+  return kCausticRadiusScale *
+         default_photon_radius(scene, std::max<std::int64_t>(caustic_photons, 1));
+}
+
+SplatRadii splat_radii(const Scene& scene, double drawn) {
+  const double share = std::clamp(drawn, 1e-3, 1.0);
+  auto count = [&](std::int64_t n) {
+    return std::max<std::int64_t>(1, std::llround(share * static_cast<double>(n)));
+  };
+  return {scene.gi.radius > 0.0 ? scene.gi.radius : default_photon_radius(scene, count(scene.gi.photons)),
+          scene.gi.caustic_radius > 0.0 ? scene.gi.caustic_radius
+                                        : default_caustic_radius(scene, count(scene.gi.caustic_photons))};
+}
+
 }  // namespace beamcast

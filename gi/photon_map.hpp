@@ -56,4 +56,22 @@ bool has_specular(const Scene& scene);
 // (the bias-variance balance of a 2D density estimate).
 double default_photon_radius(const Scene& scene, std::int64_t photons);
 
+// The caustic map's splat radius when gi.caustic_radius is 0: the same rule
+// at the caustic photon count (gi.caustic_photons, or the share drawn), times
+// kCausticRadiusScale. Caustic photons
+// crowd into the small regions light is focused on, far denser than the
+// global map's even spread, so a smaller disk holds as many; and the
+// focus is sharp, so a disk the global map's size blurs it (docs/gi.md).
+inline constexpr double kCausticRadiusScale = 0.25;
+double default_caustic_radius(const Scene& scene, std::int64_t caustic_photons);
+
+// The radii the splat pass uses for the global and the caustic map: the
+// scene's gi.radius / gi.caustic_radius, or the defaults at the photon
+// counts drawn (a share `drawn` of each map, gi.display_fraction).
+struct SplatRadii {
+  double global = 0.0;
+  double caustic = 0.0;
+};
+SplatRadii splat_radii(const Scene& scene, double drawn = 1.0);
+
 }  // namespace beamcast

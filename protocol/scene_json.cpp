@@ -293,7 +293,7 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "gi settings");
   o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth", "direct",
                 "direct_samples", "shadow_size", "edge_correction", "splat_scale",
-                "light_antialias"});
+                "light_antialias", "caustic_radius"});
   GiSettings g;
   std::int64_t total = 0;
   auto count = [&](const Node& v) {
@@ -324,6 +324,14 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
     if (!(g.radius >= 0.0 && g.radius <= limits.max_abs_coordinate)) {
       fail("out_of_range", v->path,
            "radius must be >= 0 (0: chosen from the scene size), got " + format_number(g.radius));
+    }
+  }
+  if (auto v = o.optional("caustic_radius")) {
+    g.caustic_radius = read_number(*v);
+    if (!(g.caustic_radius >= 0.0 && g.caustic_radius <= limits.max_abs_coordinate)) {
+      fail("out_of_range", v->path,
+           "caustic_radius must be >= 0 (0: from the caustic photon count), got " +
+               format_number(g.caustic_radius));
     }
   }
   if (auto v = o.optional("kernel")) {

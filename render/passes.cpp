@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -495,8 +496,32 @@ class PhotonPass final : public Pass {
     GLint viewport[4];
     glGetIntegerv(GL_VIEWPORT, viewport);
     glViewport(0, 0, splat_size(viewport[2], scale), splat_size(viewport[3], scale));
+    // Two draws: the global map's photons, then the caustic map's with their
+    // own (smaller) radius.
+    const GLint first_uniform = program_.uniform(multi, "u_first");
+    const GLint radius_uniform = program_.uniform(multi, "u_radius");
+    const GLsizei split_all = ctx.resources.photon_caustic_first();
+    const GLsizei total_all = ctx.resources.photon_count();
+    // gi.display_fraction: the first share of each map, power scaled up.
+    const double share = std::clamp(ctx.scene.gi.display_fraction, 1e-3, 1.0);
+    auto part = [&](GLsizei n) {
+      return static_cast<GLsizei>(std::llround(share * static_cast<double>(n)));
+    };
+    const GLsizei split = part(split_all);
+    const GLsizei caustic = part(total_all - split_all);
+    glUniform1f(program_.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
+    const float caustic_radius = static_cast<float>(ctx.resources.caustic_radius());
     for_each_view_offset(ctx, self, program_, "u_photon_offset", ctx.resources.photon_anchor(), [&] {
-      glDrawArraysInstanced(GL_TRIANGLES, 0, 6, ctx.resources.photon_count());
+      if (split > 0) {
+        glUniform1i(first_uniform, 0);
+        glUniform1f(radius_uniform, radius);
+        glDrawArraysInstanced(GL_TRIANGLES, 0, 6, split);
+      }
+      if (caustic > 0) {
+        glUniform1i(first_uniform, split_all);
+        glUniform1f(radius_uniform, caustic_radius);
+        glDrawArraysInstanced(GL_TRIANGLES, 0, 6, caustic);
+      }
     });
     glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
     glDisable(GL_BLEND);

@@ -236,6 +236,7 @@ void SceneResources::upload_photons(PhotonCache& cache, bool skip_direct) {
   std::vector<PhotonData> data;
   data.reserve(maps_->global.size() + maps_->caustic.size());
   for (const auto* map : {&maps_->global, &maps_->caustic}) {
+    if (map == &maps_->caustic) photon_caustic_first_ = static_cast<GLsizei>(data.size());
     for (const Photon& p : *map) {
       if (skip_direct && p.bounces == 0) continue;
       PhotonData d{};
@@ -255,8 +256,11 @@ void SceneResources::upload_photons(PhotonCache& cache, bool skip_direct) {
     photon_ssbo_ = GlBuffer(id);
     glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(PhotonData)), data.data(), 0);
   }
-  photon_radius_ = scene_.gi.radius > 0.0 ? scene_.gi.radius
-                                          : default_photon_radius(scene_, scene_.gi.photons);
+  // A share of the maps drawn (gi.display_fraction): the default radii at
+  // the drawn photon counts.
+  const SplatRadii radii = splat_radii(scene_, scene_.gi.display_fraction);
+  photon_radius_ = radii.global;
+  caustic_radius_ = radii.caustic;
   photon_upload_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() -
       photon_trace_ms_;
@@ -319,9 +323,9 @@ void SceneResources::upload_occluders() {
           using Kind = std::decay_t<decltype(shape)>;
           if constexpr (Kind::kGpu == GpuForm::kTriangles) {
             bounds.grow(shape.bounds());
-          } else {
+          } else if constexpr (Kind::kGpu == GpuForm::kAnalytic) {
             analytic_.push_back(&occ);
-          }
+          }  // kPoints: the slim pass's own data
         },
         occ.shape);
   }

@@ -70,6 +70,10 @@ class SceneResources {
   GLsizei photon_count() const { return photon_count_; }
   const Vec3& photon_anchor() const { return photon_anchor_; }
   double photon_radius() const { return photon_radius_; }
+  // The photon buffer holds the global map's photons, then from this index
+  // the caustic map's, splatted with caustic_radius().
+  GLsizei photon_caustic_first() const { return photon_caustic_first_; }
+  double caustic_radius() const { return caustic_radius_; }
   // Direct light (group "shadows"): the lights' DirectPoints, each with its
   // light's flux folded in, positions relative to direct_anchor(); the key
   // names the geometry and points the shadow maps are rendered for.
@@ -114,6 +118,8 @@ class SceneResources {
   GLsizei photon_count_ = 0;
   Vec3 photon_anchor_{};
   double photon_radius_ = 1.0;
+  GLsizei photon_caustic_first_ = 0;
+  double caustic_radius_ = 1.0;
   double photon_trace_ms_ = 0.0;
   double photon_upload_ms_ = 0.0;
   // The per-camera data of bind_camera, written to `out` (for bind_views).

@@ -9,6 +9,8 @@ struct PhotonData {
 layout(std430, binding = 3) readonly buffer Photons { PhotonData photons[]; };
 uniform vec3 u_photon_offset;  // photon anchor minus eye
 uniform float u_radius;
+uniform int u_first;
+uniform float u_power_scale;  // 1 / the share of the maps drawn (gi.display_fraction)  // the draw's first photon (the caustic map's follow the global map's)
 
 flat out vec3 v_center;  // camera-relative
 flat out vec3 v_power;
@@ -16,10 +18,10 @@ flat out vec3 v_normal;
 
 void main() {
   select_view(view_index());
-  PhotonData p = photons[gl_InstanceID];
+  PhotonData p = photons[gl_InstanceID + u_first];
   vec3 c = p.position.xyz + u_photon_offset;
   v_center = c;
-  v_power = p.power.rgb;
+  v_power = p.power.rgb * u_power_scale;
   v_normal = p.normal.xyz;
   // Corner of two triangles: (-1,-1) (1,-1) (1,1) / (-1,-1) (1,1) (-1,1).
   const vec2 corners[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1), vec2(1, 1),

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "gi/photon_map.hpp"
 #include "protocol/errors.hpp"
 #include "protocol/scene_json.hpp"
 
@@ -80,7 +81,7 @@ TEST(Lights, SpotFalloffIntegratesToItsFlux) {
 TEST(Lights, MaterialsAndGiSettingsParse) {
   json j = lit({{{"type", "point"}, {"position", {0, 2, 0}}}},
                {{"gi", {{"photons", 5000}, {"caustic_photons", 7}, {"radius", 0.25}, {"kernel", "box"},
-                        {"seed", 9}, {"max_depth", 3}}}});
+                        {"seed", 9}, {"max_depth", 3}, {"caustic_radius", 0.05}}}});
   j["occluders"].push_back({{"type", "sphere"}, {"center", {3, 0, 0}}, {"radius", 1.0},
                             {"material", {{"type", "glass"}, {"ior", 1.33}, {"tint", {1, 0.9, 0.8}}}}});
   j["occluders"].push_back({{"type", "sphere"}, {"center", {-3, 0, 0}}, {"radius", 1.0},
@@ -98,6 +99,17 @@ TEST(Lights, MaterialsAndGiSettingsParse) {
   EXPECT_EQ(s.gi.kernel, SplatKernel::kBox);
   EXPECT_EQ(s.gi.seed, 9u);
   EXPECT_EQ(s.gi.max_depth, 3);
+  EXPECT_DOUBLE_EQ(s.gi.caustic_radius, 0.05);
+  // The caustic map's own radius; 0 takes a quarter of the default rule at
+  // the caustic photon count.
+  EXPECT_DOUBLE_EQ(splat_radii(s).caustic, 0.05);
+  EXPECT_DOUBLE_EQ(splat_radii(s).global, 0.25);
+  json d = lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"caustic_photons", 5000}}}});
+  const Scene s0 = parse_scene(d, {});
+  EXPECT_DOUBLE_EQ(splat_radii(s0).caustic, kCausticRadiusScale * default_photon_radius(s0, 5000));
+  // A share of the maps drawn: the radii at the drawn counts (larger).
+  EXPECT_DOUBLE_EQ(splat_radii(s0, 0.1).caustic, kCausticRadiusScale * default_photon_radius(s0, 500));
+  EXPECT_GT(splat_radii(s0, 0.1).global, splat_radii(s0).global);
 }
 
 TEST(Lights, WithoutLightsTheSceneHasNoGi) {
@@ -125,6 +137,10 @@ TEST(Lights, BadFieldsAreRefusedWithTheirPath) {
                   "invalid_value", "/lights/0/radiance");
   EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}, {"radiance", {1, 1, 1}}}}),
                   "unknown_field", "/lights/0/radiance");
+  EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"caustic_radius", -0.1}}}}),
+                  "out_of_range", "/gi/caustic_radius");
+  EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"caustic_radius", "big"}}}}),
+                  "wrong_type", "/gi/caustic_radius");
 }
 
 TEST(Lights, BadMaterialsAreRefusedWithTheirPath) {

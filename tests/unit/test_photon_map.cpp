@@ -170,7 +170,7 @@ TEST(PhotonMap, GatherEstimatesMatchTheClosedSphere) {
       const double s = std::sqrt(1.0 - z * z);
       const Vec3 x{s * std::cos(phi), s * std::sin(phi), z};
       const Vec3 n = -1.0 * x;  // facing the centre
-      sum += gather.fixed_radius(x, n, {kRho, kRho, kRho}, 0.1, kernel)[0];
+      sum += gather.fixed_radius(x, n, {kRho, kRho, kRho}, SplatRadii{0.1, 0.1}, kernel)[0];
       // k = 400 photons: r_k is biased low by about 1/(2k) in area for a
       // smooth density; the same 2% holds.
       knn += gather.nearest(x, n, {kRho, kRho, kRho}, 400)[0];
