@@ -59,7 +59,7 @@ std::optional<OccluderHit> user_hit(const Element& e, const Context& c, double l
     return std::visit(
         [&](const auto& kind) -> std::optional<OccluderHit> {
           using Kind = std::decay_t<decltype(kind)>;
-          if constexpr (Kind::kGpu == GpuForm::kAnalytic) {
+          if constexpr (Kind::kGpu != GpuForm::kTriangles) {  // analytic kinds, SLIM
             auto h = kind.intersect(c.o, c.v, lo, hi);
             if (h && h->t <= lo) h.reset();
             return h;

@@ -53,10 +53,21 @@ std::string photon_key(const Scene& scene) {
           using Kind = std::decay_t<decltype(kind)>;
           if constexpr (Kind::kGpu == GpuForm::kTriangles) {
             kind.gpu_triangles(k);
-          } else {
+          } else if constexpr (Kind::kGpu == GpuForm::kAnalytic) {
             const AnalyticGpu g = kind.analytic(Vec3{0.0, 0.0, 0.0});
             k.put(g.a);
             k.put(g.b);
+          } else {
+            static_assert(std::is_same_v<Kind, SlimOccluder>, "an occluder kind missing from photon_key");
+            k.put(kind.spheres().size());
+            for (const SlimSphere& s : kind.spheres()) {
+              k.put(s.center);
+              k.put(s.radius);
+              k.put(s.rotation);
+              k.put(s.poly.c);
+              k.put(s.poly2.c);
+              k.put(static_cast<int>(s.crease));
+            }
           }
         },
         o.shape);

@@ -203,6 +203,7 @@ std::array<double, N> read_numbers(const Node& n) {
 template std::array<double, 2> read_numbers<2>(const Node&);
 template std::array<double, 3> read_numbers<3>(const Node&);
 template std::array<double, 4> read_numbers<4>(const Node&);
+template std::array<double, 6> read_numbers<6>(const Node&);
 
 Vec3 read_vec3(const Node& n) { return read_numbers<3>(n); }
 

@@ -200,11 +200,12 @@ Material parse_material(const Node& n, bool albedo_given, Color* albedo) {
 
 // The kind's own parse function (protocol/occluders/) reads its fields;
 // "albedo" and "material" are common to every kind.
-Occluder parse_occluder(const Node& n, const SceneLoadOptions& opts, std::int64_t* mesh_triangles) {
+Occluder parse_occluder(const Node& n, const SceneLoadOptions& opts, std::int64_t* mesh_triangles,
+                        std::int64_t* slim_spheres) {
   ObjectReader o(n, "an occluder");
   const Node type = o.required("type");
   Occluder occ;
-  occ.shape = parse_occluder_shape(type, OccluderParse{o, opts, mesh_triangles});
+  occ.shape = parse_occluder_shape(type, OccluderParse{o, opts, mesh_triangles, slim_spheres});
   const auto albedo = o.optional("albedo");
   if (albedo) occ.albedo = read_albedo(*albedo);
   if (auto m = o.optional("material")) occ.material = parse_material(*m, albedo.has_value(), &occ.albedo);
@@ -781,13 +782,28 @@ void check_method_fits_densities(const Scene& scene) {
   }
 }
 
+// The SLIM point sampling knobs (issue 16; docs/slim.md).
+SlimSettings parse_slim_settings(const Node& n) {
+  ObjectReader o(n, "slim settings");
+  o.allow_only({"sampling", "depth_threshold", "fill_holes"});
+  SlimSettings s;
+  // S above 16 leaves 8-pixel gaps that no threshold closes; below 0.25
+  // every sphere emits 64 points per pixel it covers.
+  if (auto v = o.optional("sampling")) s.sampling = check_closed(*v, read_number(*v), 0.25, 16.0);
+  if (auto v = o.optional("depth_threshold")) {
+    s.depth_threshold = check_closed(*v, read_number(*v), 0.0, 4.0);
+  }
+  if (auto v = o.optional("fill_holes")) s.fill_holes = read_bool(*v);
+  return s;
+}
+
 Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   const SceneLimits& limits = opts.limits;
   const Node root{&j, ""};
   ObjectReader o(root, "a scene");
   o.allow_only(
       {"version", "background", "light", "lights", "gi", "beams", "occluders", "cameras", "output",
-       "render"});
+       "render", "slim"});
   Scene scene;
   if (auto v = o.optional("version")) {
     const std::int64_t version = read_integer(*v);
@@ -800,6 +816,7 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   if (auto v = o.optional("light")) scene.light = parse_light(*v);
   if (auto v = o.optional("output")) scene.output = parse_output(*v);
   if (auto v = o.optional("render")) scene.render = parse_render(*v, limits);
+  if (auto v = o.optional("slim")) scene.slim = parse_slim_settings(*v);
   if (auto v = o.optional("lights")) {
     for (const Node& l : read_array(*v, limits.max_lights, "max_lights")) {
       scene.lights.push_back(parse_gi_light(l, limits));
@@ -822,9 +839,9 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   add_beam_lights(&scene);
   check_shadow_budget(scene, limits, gi_path);
   if (auto v = o.optional("occluders")) {
-    std::int64_t mesh_triangles = 0;
+    std::int64_t mesh_triangles = 0, slim_spheres = 0;
     for (const Node& occ : read_array(*v, limits.max_occluders, "max_occluders")) {
-      scene.occluders.push_back(parse_occluder(occ, opts, &mesh_triangles));
+      scene.occluders.push_back(parse_occluder(occ, opts, &mesh_triangles, &slim_spheres));
     }
   }
 

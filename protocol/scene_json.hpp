@@ -26,6 +26,7 @@ struct SceneLimits {
   int max_height = 8192;
   std::int64_t max_pixels = 8192LL * 8192LL;  // per camera
   std::int64_t max_mesh_triangles = 2000000;  // summed over the scene
+  std::int64_t max_slim_spheres = 1000000;    // SLIM support spheres, summed over the scene
   int max_density_samples = 4096;
   int min_table = 8;
   int max_table = 1024;
@@ -47,6 +48,7 @@ inline constexpr SceneLimits kServerSceneLimits{.max_beams = 10000,
                                                 .max_height = 4096,
                                                 .max_pixels = 4096LL * 4096LL,
                                                 .max_mesh_triangles = 1000000,
+                                                .max_slim_spheres = 200000,
                                                 .max_lights = 64,
                                                 .max_photons = 4000000,
                                                 .max_shadow_texels = 32LL << 20};

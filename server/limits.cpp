@@ -57,6 +57,8 @@ const std::vector<LimitEntry>& limit_table() {
                      "gi.shadow_size^2)"),
       BEAMCAST_LIMIT("max_mesh_triangles", scene_limits.max_mesh_triangles, 0, kI64,
                      "Most mesh triangles in a scene, all meshes together"),
+      BEAMCAST_LIMIT("max_slim_spheres", scene_limits.max_slim_spheres, 0, kI64,
+                     "Most SLIM support spheres in a scene, all slim occluders together"),
       BEAMCAST_LIMIT("max_inflight_per_connection", max_inflight_per_connection, 1, 1 << 20,
                      "Unanswered requests one connection may have: busy"),
       BEAMCAST_LIMIT("max_inflight_total", max_inflight_total, 1, 1 << 20,

@@ -1,6 +1,6 @@
 // What an occluder kind's parse function reads from: the occluder's JSON
 // object, the load options (limits, assets directory) and the scene's running
-// mesh triangle count. Included by the kinds' .cpp files only.
+// mesh triangle and SLIM sphere counts. Included by the kinds' .cpp files only.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +17,7 @@ struct OccluderParse {
   const json_read::ObjectReader& fields;
   const SceneLoadOptions& opts;
   std::int64_t* mesh_triangles;  // triangles of the scene's meshes so far
+  std::int64_t* slim_spheres;    // support spheres of the scene's SLIM surfaces so far
 
   const SceneLimits& limits() const { return opts.limits; }
   // Refuses keys other than the kind's `fields`, "type" and "albedo" (read by

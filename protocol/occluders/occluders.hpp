@@ -13,6 +13,7 @@
 #include "protocol/occluders/mesh.hpp"
 #include "protocol/occluders/plane.hpp"
 #include "protocol/occluders/quad.hpp"
+#include "protocol/occluders/slim.hpp"
 #include "protocol/occluders/sphere.hpp"
 
 namespace beamcast {
@@ -22,7 +23,8 @@ struct Node;
 }
 
 using OccluderShape =
-    std::variant<PlaneOccluder, BoxOccluder, SphereOccluder, MeshOccluder, QuadOccluder>;
+    std::variant<PlaneOccluder, BoxOccluder, SphereOccluder, MeshOccluder, QuadOccluder,
+                 SlimOccluder>;
 
 // The "type" strings of every kind, in OccluderShape's order.
 std::vector<std::string_view> occluder_types();
