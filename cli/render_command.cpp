@@ -146,6 +146,7 @@ int run_render(const RenderArgs& args) {
       jf["gpu_ms"] = fr.gpu_ms;
       jf["readback_ms"] = fr.readback_ms;
       for (const PassTiming& p : fr.passes) jf["passes"].push_back({{"name", p.name}, {"gpu_ms", p.gpu_ms}});
+      if (fr.slim_points > 0) jf["slim_points"] = fr.slim_points;
       if (scene.has_gi()) {
         jf["photons"] = {{"count", fr.photons},
                          {"trace_ms", fr.photon_trace_ms},

@@ -209,6 +209,11 @@ Occluder parse_occluder(const Node& n, const SceneLoadOptions& opts, std::int64_
   const auto albedo = o.optional("albedo");
   if (albedo) occ.albedo = read_albedo(*albedo);
   if (auto m = o.optional("material")) occ.material = parse_material(*m, albedo.has_value(), &occ.albedo);
+  if (std::holds_alternative<SlimOccluder>(occ.shape) && occ.material.type != MaterialType::kDiffuse) {
+    // The slim passes blend points of one pixel into one diffuse G-buffer
+    // texel; a mirror or glass SLIM surface has no GPU form yet.
+    fail("invalid_value", o.path_of("material"), "slim surfaces are diffuse (material \"diffuse\")");
+  }
   return occ;
 }
 

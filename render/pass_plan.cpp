@@ -1,5 +1,7 @@
 #include "render/pass_plan.hpp"
 
+#include "protocol/occluders/slim.hpp"
+
 #include <algorithm>
 
 namespace beamcast {
@@ -27,6 +29,12 @@ const std::vector<TargetDecl>& target_catalog() {
       // What the photon splats add up, before the edge correction (gi_resolve).
       // At gi.splat_scale times fewer pixels per side (indirect light is smooth).
       {"gi_indirect", TargetFormat::kRgba32f, TargetSize::kSplat, TargetClear::kZero},
+      // SLIM point sampling (render/slim_pass.cpp): the nearest point's view
+      // depth per pixel, then the weighted sums of the points within the
+      // depth threshold behind it: (w n, w) and (w albedo, w view depth).
+      {"slim_near", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
+      {"slim_sum_normal", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
+      {"slim_sum_albedo", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
   };
   return kTargets;
 }
@@ -44,6 +52,24 @@ const std::vector<PassDecl>& pass_catalog() {
       {PassId::kGbuffer, "gbuffer",
        [](const PlanInput& in) { return !in.scene.occluders.empty() && in.scene.has_gi(); }, {}, {},
        {"hdr", "view_depth", "gb_normal", "gb_albedo", "depth"}, {"occluders"}},
+      // SLIM surfaces (seed 003; render/slim_pass.cpp): points sampled on each
+      // support sphere's local height field, drawn three times: the nearest
+      // point per pixel, the weighted sums of the points within the depth
+      // threshold behind it, and their normalization into the surfaces'
+      // targets (before the lighting passes, which shade them like any
+      // occluder). Points behind a nearer occluder are dropped.
+      {PassId::kSlimDepth, "slim_depth", [](const PlanInput& in) { return has_slim(in.scene); },
+       {"view_depth"}, {}, {"slim_near"}, {"slim"}},
+      {PassId::kSlimAccumulate, "slim_accumulate",
+       [](const PlanInput& in) { return has_slim(in.scene); }, {"view_depth", "slim_near"}, {},
+       {"slim_sum_normal", "slim_sum_albedo"}, {"slim"}},
+      {PassId::kSlimResolve, "slim_resolve",
+       [](const PlanInput& in) { return has_slim(in.scene) && !in.scene.has_gi(); },
+       {"slim_sum_normal", "slim_sum_albedo"}, {}, {"hdr", "view_depth"}, {}},
+      {PassId::kSlimGbuffer, "slim_gbuffer",
+       [](const PlanInput& in) { return has_slim(in.scene) && in.scene.has_gi(); },
+       {"slim_sum_normal", "slim_sum_albedo"}, {}, {"hdr", "view_depth", "gb_normal", "gb_albedo"},
+       {}},
       // Direct light of a lit scene (gi.direct "shadow_maps"): every light as
       // a few point emitters (DirectPoint), each with a cube shadow map of
       // the triangles (rendered once per scene and kept) and shadow rays to

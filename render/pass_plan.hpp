@@ -23,6 +23,10 @@ namespace beamcast {
 enum class PassId {
   kSurfaces,
   kGbuffer,
+  kSlimDepth,
+  kSlimAccumulate,
+  kSlimResolve,
+  kSlimGbuffer,
   kDirect,
   kPhotons,
   kGiResolve,
@@ -30,7 +34,7 @@ enum class PassId {
   kTonemap,
   kUpscale
 };
-inline constexpr std::size_t kPassCount = 8;
+inline constexpr std::size_t kPassCount = 12;
 
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "render/slim_pass.hpp"
 #include "shaders/shader_sources.hpp"
 
 namespace beamcast {
@@ -155,64 +156,6 @@ GLuint FrameTargets::make_fbo(const PassDecl& pass, int layer) {
 }
 
 namespace {
-
-// A program of shaders/programs.txt in its per-camera and its multi-view
-// variant (the latter built on first use; see shaders/multiview.glsl).
-class ProgramPair {
- public:
-  explicit ProgramPair(std::string name) : name_(std::move(name)) {
-    single_ = build(shader_program(name_));
-  }
-  GLuint get(bool multiview) {
-    if (!multiview) return single_.get();
-    if (!multi_) multi_ = build(shader_program(name_ + "_multiview"));
-    return multi_.get();
-  }
-  GLint uniform(bool multiview, const char* name) {
-    return glGetUniformLocation(get(multiview), name);
-  }
-
- private:
-  static GlProgram build(const ShaderProgramSpec& spec) {
-    return build_program(spec.name, assemble_shader(spec.vertex), assemble_shader(spec.fragment));
-  }
-  std::string name_;
-  GlProgram single_, multi_;
-};
-
-// Issues `draw` into `fbo(view)` once per view of a multi-view batch (with
-// u_view = the view), or once into the plain framebuffer for a single camera.
-template <class Draw>
-void for_each_view(FrameContext& ctx, const PassDecl& self, ProgramPair& program, Draw draw) {
-  if (ctx.views == 0) {
-    glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, -1));
-    draw();
-    return;
-  }
-  const GLint loc = program.uniform(true, "u_view");
-  for (int v = 0; v < ctx.views; ++v) {
-    glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, v));
-    glUniform1i(loc, v);
-    draw();
-  }
-}
-
-// for_each_view for draws of world-anchored data: before each view's draw
-// the uniform `offset_uniform` gets `anchor` minus that view's eye (in
-// double, then float).
-template <class Draw>
-void for_each_view_offset(FrameContext& ctx, const PassDecl& self, ProgramPair& program,
-                          const char* offset_uniform, const Vec3& anchor, Draw draw) {
-  const bool multi = ctx.views > 0;
-  const GLint offset = program.uniform(multi, offset_uniform);
-  std::size_t v = 0;
-  for_each_view(ctx, self, program, [&] {
-    const Vec3 off = anchor - (multi ? ctx.view_eyes[v++] : ctx.basis.eye);
-    glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
-                static_cast<float>(off[2]));
-    draw();
-  });
-}
 
 // Occluders: rasterized triangles (boxes, meshes) and ray-traced planes and
 // spheres, depth-tested together; writes shaded colour and view depth.
@@ -640,6 +583,11 @@ std::unique_ptr<Pass> make_pass(PassId id) {
     case PassId::kSurfaces:
     case PassId::kGbuffer:
       return std::make_unique<SurfacePass>();
+    case PassId::kSlimDepth:
+    case PassId::kSlimAccumulate:
+    case PassId::kSlimResolve:
+    case PassId::kSlimGbuffer:
+      return make_slim_pass(id);
     case PassId::kDirect:
       return std::make_unique<DirectPass>();
     case PassId::kPhotons:

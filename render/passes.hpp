@@ -15,6 +15,7 @@
 #include "render/gl_util.hpp"
 #include "render/pass_plan.hpp"
 #include "render/scene_resources.hpp"
+#include "shaders/shader_sources.hpp"
 
 namespace beamcast {
 
@@ -76,6 +77,9 @@ struct FrameContext {
   // Multi-view: each view's eye (world, double), for passes that place
   // world-anchored data relative to it.
   std::vector<Vec3> view_eyes;
+  // Multi-view: each view's camera and basis (at the render size).
+  const std::vector<Camera>* view_cameras = nullptr;
+  const std::vector<CameraBasis>* view_bases = nullptr;
 };
 
 // Views in one multi-view batch: the size of the shaders' camera array
@@ -93,6 +97,64 @@ class Pass {
   virtual ~Pass() = default;
   virtual void execute(FrameContext& ctx, const PassDecl& self) = 0;
 };
+
+// A program of shaders/programs.txt in its per-camera and its multi-view
+// variant (the latter built on first use; see shaders/multiview.glsl).
+class ProgramPair {
+ public:
+  explicit ProgramPair(std::string name) : name_(std::move(name)) {
+    single_ = build(shader_program(name_));
+  }
+  GLuint get(bool multiview) {
+    if (!multiview) return single_.get();
+    if (!multi_) multi_ = build(shader_program(name_ + "_multiview"));
+    return multi_.get();
+  }
+  GLint uniform(bool multiview, const char* name) {
+    return glGetUniformLocation(get(multiview), name);
+  }
+
+ private:
+  static GlProgram build(const ShaderProgramSpec& spec) {
+    return build_program(spec.name, assemble_shader(spec.vertex), assemble_shader(spec.fragment));
+  }
+  std::string name_;
+  GlProgram single_, multi_;
+};
+
+// Issues `draw` into `fbo(view)` once per view of a multi-view batch (with
+// u_view = the view), or once into the plain framebuffer for a single camera.
+template <class Draw>
+void for_each_view(FrameContext& ctx, const PassDecl& self, ProgramPair& program, Draw draw) {
+  if (ctx.views == 0) {
+    glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, -1));
+    draw();
+    return;
+  }
+  const GLint loc = program.uniform(true, "u_view");
+  for (int v = 0; v < ctx.views; ++v) {
+    glBindFramebuffer(GL_FRAMEBUFFER, ctx.targets.fbo(self, v));
+    glUniform1i(loc, v);
+    draw();
+  }
+}
+
+// for_each_view for draws of world-anchored data: before each view's draw
+// the uniform `offset_uniform` gets `anchor` minus that view's eye (in
+// double, then float).
+template <class Draw>
+void for_each_view_offset(FrameContext& ctx, const PassDecl& self, ProgramPair& program,
+                          const char* offset_uniform, const Vec3& anchor, Draw draw) {
+  const bool multi = ctx.views > 0;
+  const GLint offset = program.uniform(multi, offset_uniform);
+  std::size_t v = 0;
+  for_each_view(ctx, self, program, [&] {
+    const Vec3 off = anchor - (multi ? ctx.view_eyes[v++] : ctx.basis.eye);
+    glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
+                static_cast<float>(off[2]));
+    draw();
+  });
+}
 
 // The executor of a catalog pass; programs are compiled here, so a GL context
 // must be current. Multi-view programs are compiled on first use.

@@ -155,6 +155,7 @@ struct Renderer::Impl {
     FrameContext ctx{scene,           plan, cam, basis, res, targets, empty_vao.get(), 0,
                      full_cam.width, full_cam.height, {}};
     run_passes(scene, ctx, query_sets[0]);
+    if (res.slim() && !res.slim()->slots().empty()) result.slim_points = res.slim()->slots()[0];
     const double submit_ms = ms_since(wall0);
 
     // Read-back (synchronous: it waits for the GPU to finish the frame).
@@ -200,6 +201,22 @@ struct Renderer::Impl {
       }
     }
 
+    for (const std::string& name : opts.read_targets) {
+      // Debug and bench read-back of named targets (RGBA float, top-down).
+      const GLuint tex = targets.texture(name);
+      if (tex == 0) continue;  // not in this frame's plan
+      const int tw = cam.width, th = cam.height;
+      const std::size_t trow = 4 * static_cast<std::size_t>(tw);
+      std::vector<float> buf(trow * th);
+      glGetTextureImage(tex, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(buf.size() * sizeof(float)),
+                        buf.data());
+      gl_check("glGetTextureImage(read_targets)");
+      std::vector<float>& out = result.targets[name];
+      out.resize(buf.size());
+      for (int y = 0; y < th; ++y) {
+        std::memcpy(&out[y * trow], &buf[(th - 1 - y) * trow], trow * sizeof(float));
+      }
+    }
     result.batch = read_timings(plan, query_sets[0]);
     result.batch.submit_ms = submit_ms;
     result.passes = result.batch.passes;
@@ -238,6 +255,8 @@ struct Renderer::Impl {
     FrameContext ctx{scene, plan, cams[0], bases[0], res, layered, empty_vao.get(),
                      static_cast<int>(k), w, h, {}};
     for (const CameraBasis& b : bases) ctx.view_eyes.push_back(b.eye);
+    ctx.view_cameras = &cams;
+    ctx.view_bases = &bases;
     run_passes(scene, ctx, query_sets[static_cast<std::size_t>(slot)]);
 
     const bool wide = scene.output.bit_depth == 16;

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,10 @@ struct FrameOptions {
   // native (no extra pass). The HDR buffer, if read, stays at the render size.
   // Scaled frames take the per-camera path (no multi-view batches).
   double resolution_scale = 1.0;
+  // Single-camera frames (batch off): also read back these targets of the
+  // plan (render size, RGBA float, rows top-down) into FrameResult::targets;
+  // names the plan does not use are skipped. For tests and benches.
+  std::vector<std::string> read_targets;
 };
 
 // The GPU work a frame was part of: a multi-view batch of `views` cameras, or
@@ -101,6 +106,11 @@ struct FrameResult {
   std::int64_t photons = 0;
   double photon_trace_ms = 0.0;
   double photon_upload_ms = 0.0;
+  // FrameOptions::read_targets: width x height x 4 floats each.
+  std::map<std::string, std::vector<float>> targets;
+  // SLIM surfaces: the sample slots the point passes processed (single-camera
+  // frames; 0 in multi-view batches).
+  std::int64_t slim_points = 0;
 };
 
 // The cameras' indices in the batches Renderer::render draws them in: cameras

@@ -150,6 +150,7 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
     upload_photons(*photons, plan.uploads_group("shadows"));
   }
   if (plan.uploads_group("shadows")) upload_direct();
+  if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene);
   GLuint id = 0;
   glCreateBuffers(1, &id);
   camera_ubo_ = GlBuffer(id);

@@ -17,6 +17,7 @@
 #include "render/gl_util.hpp"
 #include "render/lut.hpp"
 #include "render/pass_plan.hpp"
+#include "render/slim_pass.hpp"
 
 namespace beamcast {
 
@@ -84,6 +85,8 @@ class SceneResources {
   // The triangle vertices' anchor (positions in triangle_vao() are relative to it).
   const Vec3& mesh_anchor() const { return mesh_anchor_; }
   const Aabb& mesh_bounds() const { return mesh_bounds_; }
+  // SLIM surfaces (group "slim"); null without them.
+  SlimResources* slim() const { return slim_.get(); }
   // Time spent tracing the maps for this render (0 when they came from the
   // cache) and uploading them.
   double photon_trace_ms() const { return photon_trace_ms_; }
@@ -122,6 +125,7 @@ class SceneResources {
   double caustic_radius_ = 1.0;
   double photon_trace_ms_ = 0.0;
   double photon_upload_ms_ = 0.0;
+  std::unique_ptr<SlimResources> slim_;
   // The per-camera data of bind_camera, written to `out` (for bind_views).
   void fill_camera(const Camera& cam, const CameraBasis& basis, void* block) const;
   void fill_beams(const Vec3& eye, void* beams) const;

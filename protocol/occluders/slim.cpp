@@ -1,10 +1,12 @@
 #include "protocol/occluders/slim.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 
 #include "protocol/mesh_obj.hpp"
+#include "protocol/scene.hpp"
 #include "protocol/occluders/occluder_parse.hpp"
 #include "protocol/slim_io.hpp"
 
@@ -94,6 +96,12 @@ SlimOccluder SlimOccluder::parse(const OccluderParse& in) {
   SlimOccluder out = from_spheres(std::move(spheres));
   out.file = name;
   return out;
+}
+
+bool has_slim(const Scene& scene) {
+  return std::any_of(scene.occluders.begin(), scene.occluders.end(), [](const Occluder& o) {
+    return std::holds_alternative<SlimOccluder>(o.shape);
+  });
 }
 
 std::optional<OccluderHit> SlimOccluder::intersect(const Vec3& o, const Vec3& v, double t_min,

@@ -43,4 +43,8 @@ struct SlimOccluder {
                                        double t_max) const;
 };
 
+struct Scene;
+// True if the scene has a slim occluder (the slim passes run).
+bool has_slim(const Scene& scene);
+
 }  // namespace beamcast

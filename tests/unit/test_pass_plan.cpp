@@ -11,11 +11,14 @@
 namespace beamcast {
 namespace {
 
-Scene scene_with(bool beams, bool occluders, bool lit = false) {
+Scene scene_with(bool beams, bool occluders, bool lit = false, bool slim = false) {
   Scene s;
   if (beams) s.beams.emplace_back();
   if (occluders) s.occluders.push_back(Occluder{SphereOccluder{}, {0.5, 0.5, 0.5}, {}});
   if (lit) s.lights.push_back(Light{PointLight{}, {1.0, 1.0, 1.0}});
+  if (slim) {
+    s.occluders.push_back(Occluder{SlimOccluder::from_spheres({SlimSphere{}}), {0.5, 0.5, 0.5}, {}});
+  }
   return s;
 }
 
@@ -68,9 +71,11 @@ TEST(PassPlan, EveryCatalogPassIsReachable) {
   for (bool b : {false, true}) {
     for (bool o : {false, true}) {
       for (bool lit : {false, true}) {
-        for (double scale : {1.0, 0.5}) {
-          for (const auto& n : make_plan(PlanInput{scene_with(b, o, lit), scale}).names()) {
-            seen.push_back(n);
+        for (bool slim : {false, true}) {
+          for (double scale : {1.0, 0.5}) {
+            for (const auto& n : make_plan(PlanInput{scene_with(b, o, lit, slim), scale}).names()) {
+              seen.push_back(n);
+            }
           }
         }
       }
@@ -133,10 +138,31 @@ TEST(PassPlan, LitScenesSplatPhotonsOverAGbuffer) {
   EXPECT_FALSE(make_plan(PlanInput{scene_with(true, true)}).uploads_group("photons"));
 }
 
+// SLIM surfaces run their three point passes after the other occluders'
+// (whose view depth hides points behind them) and before the lighting
+// passes, which shade them through the G-buffer; no other scene runs them.
+TEST(PassPlan, SlimSurfacesRunThePointPasses) {
+  EXPECT_EQ(make_plan(PlanInput{scene_with(true, false, false, true)}).names(),
+            (std::vector<std::string>{"surfaces", "slim_depth", "slim_accumulate", "slim_resolve",
+                                      "beams", "tonemap"}));
+  const FramePlan lit = make_plan(PlanInput{scene_with(false, true, true, true)});
+  EXPECT_EQ(lit.names(), (std::vector<std::string>{"gbuffer", "slim_depth", "slim_accumulate",
+                                                   "slim_gbuffer", "direct", "photons", "gi_resolve",
+                                                   "tonemap"}));
+  EXPECT_TRUE(lit.uploads_group("slim"));
+  for (bool lit_scene : {false, true}) {
+    const FramePlan plan = make_plan(PlanInput{scene_with(true, true, lit_scene)});
+    EXPECT_FALSE(plan.uploads_group("slim"));
+    EXPECT_FALSE(plan.uses("slim_near"));
+  }
+}
+
 TEST(PassPlan, UnknownTargetsAndRepeatedIdsFail) {
   std::vector<PassDecl> catalog = pass_catalog();
   // The tonemap pass (planned for every frame) names a target that does not exist.
-  catalog[6].writes = {"outptu"};
+  for (PassDecl& p : catalog) {
+    if (p.id == PassId::kTonemap) p.writes = {"outptu"};
+  }
   EXPECT_THROW(make_plan(PlanInput{scene_with(false, false)}, catalog), PlanError);
   catalog = pass_catalog();
   catalog[1].id = PassId::kSurfaces;

@@ -1,0 +1,131 @@
+#include "render/slim_compare.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <variant>
+
+#include "gi/parallel.hpp"
+#include "protocol/camera.hpp"
+#include "protocol/occluders/slim.hpp"
+
+namespace beamcast {
+
+SlimPixels slim_reference(const Scene& scene, const Camera& cam, int threads) {
+  SlimPixels out;
+  out.width = cam.width;
+  out.height = cam.height;
+  const std::size_t n = static_cast<std::size_t>(cam.width) * cam.height;
+  out.covered.assign(n, 0);
+  out.depth.assign(n, 0.0f);
+  out.normal.assign(n, Vec3{0.0, 0.0, 0.0});
+  std::vector<const SlimOccluder*> slims;
+  for (const Occluder& o : scene.occluders) {
+    if (const auto* s = std::get_if<SlimOccluder>(&o.shape)) slims.push_back(s);
+  }
+  const CameraBasis basis = camera_basis(cam);
+  parallel_items(cam.height, threads, [&](int y) {
+    const int py = cam.height - 1 - y;  // GL rows count from the bottom
+    for (int x = 0; x < cam.width; ++x) {
+      const Ray ray = camera_ray(cam, basis, x, py);
+      double best = ray.t_max;
+      std::optional<OccluderHit> hit;
+      for (const SlimOccluder* s : slims) {
+        if (auto h = s->intersect(ray.origin, ray.dir, ray.t_min, best)) {
+          best = h->t;
+          hit = h;
+        }
+      }
+      if (!hit) continue;
+      const std::size_t i = static_cast<std::size_t>(y) * cam.width + x;
+      out.covered[i] = 1;
+      out.depth[i] = static_cast<float>(dot(ray.origin + hit->t * ray.dir - basis.eye, basis.forward));
+      out.normal[i] = hit->n;
+    }
+  });
+  return out;
+}
+
+SlimPixels slim_from_sums(const std::vector<float>& sum_normal, const std::vector<float>& sum_albedo,
+                          int width, int height) {
+  SlimPixels out;
+  out.width = width;
+  out.height = height;
+  const std::size_t n = static_cast<std::size_t>(width) * height;
+  out.covered.assign(n, 0);
+  out.depth.assign(n, 0.0f);
+  out.normal.assign(n, Vec3{0.0, 0.0, 0.0});
+  if (sum_normal.size() < 4 * n || sum_albedo.size() < 4 * n) return out;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float w = sum_normal[4 * i + 3];
+    if (!(w > 0.0f)) continue;
+    out.covered[i] = 1;
+    out.depth[i] = sum_albedo[4 * i + 3] / w;
+    const Vec3 v{sum_normal[4 * i], sum_normal[4 * i + 1], sum_normal[4 * i + 2]};
+    const double len = length(v);
+    out.normal[i] = len > 0.0 ? (1.0 / len) * v : v;
+  }
+  return out;
+}
+
+SlimErrors compare_slim(const SlimPixels& gpu, const SlimPixels& ref, double size) {
+  SlimErrors e;
+  const int w = ref.width, h = ref.height;
+  const double to10 = 10.0 / size;
+  std::vector<double> angles;
+  double depth_sum = 0.0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const bool r = ref.covered[i] != 0, g = gpu.covered[i] != 0;
+      if (r) ++e.reference_pixels;
+      // How many of the 3x3 neighbourhood the reference covers (off-image: not).
+      auto neighbours = [&] {
+        int n = 0;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx >= 0 && yy >= 0 && xx < w && yy < h && ref.covered[static_cast<std::size_t>(yy) * w + xx]) {
+              ++n;
+            }
+          }
+        }
+        return n;
+      };
+      if (r && !g) {
+        ++e.holes;
+        if (neighbours() == 9) ++e.interior_holes;
+      }
+      if (g && !r) {
+        ++e.spurious;
+        if (neighbours() == 0) ++e.spurious_far;
+      }
+      if (!(r && g)) continue;
+      const double dz = std::abs(static_cast<double>(gpu.depth[i]) - ref.depth[i]);
+      // A different layer of the surface (the points' nearest layer is not
+      // the reference's): counted apart, not as a depth error.
+      if (dz > 0.1 * size) {
+        ++e.occluded;
+        continue;
+      }
+      ++e.compared;
+      depth_sum += dz * to10;
+      e.depth_max = std::max(e.depth_max, dz * to10);
+      const double c = std::clamp(dot(gpu.normal[i], ref.normal[i]), -1.0, 1.0);
+      angles.push_back(std::acos(c) * 180.0 / std::numbers::pi);
+    }
+  }
+  if (e.compared > 0) {
+    e.depth_mean = depth_sum / static_cast<double>(e.compared);
+    double sum = 0.0;
+    for (double a : angles) sum += a;
+    e.normal_mean_deg = sum / static_cast<double>(angles.size());
+    std::sort(angles.begin(), angles.end());
+    e.normal_max_deg = angles.back();
+    e.normal_p99_deg = angles[static_cast<std::size_t>(0.99 * static_cast<double>(angles.size() - 1))];
+  }
+  return e;
+}
+
+}  // namespace beamcast

@@ -1,0 +1,281 @@
+#include "render/slim_pass.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <variant>
+
+#include "protocol/occluders/slim.hpp"
+#include "render/passes.hpp"
+
+namespace beamcast {
+
+namespace {
+
+// One sphere as slim_points.vert reads it (std430: nine vec4).
+struct SlimGpu {
+  float center[4];
+  float axis_u[4];
+  float axis_v[4];
+  float axis_w[4];
+  float p1[4];
+  float p2[4];
+  float q1[4];
+  float q2[4];
+  float albedo[4];
+};
+static_assert(sizeof(SlimGpu) == 144);
+
+struct DrawCommand {  // DrawArraysIndirectCommand
+  std::uint32_t count, instance_count, first, base_instance;
+};
+
+// The largest slope |grad f| of either polynomial over |u|, |v| <= r.
+double max_slope(const SlimSphere& s) {
+  auto bound = [&](const SlimPoly& p) {
+    const auto& c = p.c;
+    const double du = 2.0 * std::abs(c[0]) * s.radius + std::abs(c[1]) * s.radius + std::abs(c[3]);
+    const double dv = std::abs(c[1]) * s.radius + 2.0 * std::abs(c[2]) * s.radius + std::abs(c[4]);
+    return std::hypot(du, dv);
+  };
+  const double a = bound(s.poly);
+  return s.crease == SlimCrease::kNone ? a : std::max(a, bound(s.poly2));
+}
+
+}  // namespace
+
+SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasis& basis,
+                   const SlimSettings& settings) {
+  const Vec3 p = sphere.center - basis.eye;
+  const double r = sphere.radius;
+  const double x = dot(p, basis.right), y = dot(p, basis.up), z = dot(p, basis.forward);
+  if (z + r < cam.near_plane || z - r > cam.far_plane) return {};
+  const bool ortho = cam.projection == Projection::kOrthographic;
+  const double th = ortho ? basis.half_height : basis.tan_half_fov;
+  const double tw = th * basis.aspect;
+  // Pixels per world unit at the sphere's nearest depth (a bound over it),
+  // and how much more an off-axis segment may project (perspective).
+  double ppw = 0.0, ppw_centre = 0.0, oblique = 1.0;
+  if (ortho) {
+    if (std::abs(x) > tw + r || std::abs(y) > th + r) return {};
+    ppw = ppw_centre = cam.height / (2.0 * th);
+  } else {
+    // Outside a side plane of the frustum by more than r: culled.
+    if ((std::abs(x) - tw * z) / std::sqrt(1.0 + tw * tw) > r ||
+        (std::abs(y) - th * z) / std::sqrt(1.0 + th * th) > r) {
+      return {};
+    }
+    const double z_near = std::max(z - r, cam.near_plane);
+    ppw = cam.height / (2.0 * th * z_near);
+    ppw_centre = cam.height / (2.0 * th * std::max(z, z_near));
+    oblique = std::sqrt(1.0 + tw * tw + th * th);
+  }
+  // N: the sphere's projected width, at its centre's depth (the seed's);
+  // nearer parts project wider, which the second stage fills.
+  const double n_px = 2.0 * r * ppw_centre;
+  SlimGrid g;
+  g.m = static_cast<std::uint32_t>(
+      std::clamp(std::ceil(2.0 * n_px / settings.sampling), 1.0, static_cast<double>(kSlimMaxGrid)));
+  if (settings.fill_holes) {
+    // A cell's diagonal: sqrt 2 steps of the grid, stretched by the height
+    // field's slope, at most ppw x oblique pixels per unit.
+    const double step = 2.0 * r / g.m;
+    const double diag = std::sqrt(2.0) * step * std::sqrt(1.0 + std::pow(max_slope(sphere), 2)) *
+                        ppw * oblique;
+    g.s = static_cast<std::uint32_t>(
+        std::clamp(std::ceil(diag / (std::sqrt(3.0) / 2.0)), 1.0, static_cast<double>(kSlimMaxFill)));
+  }
+  return g;
+}
+
+SlimResources::SlimResources(const Scene& scene) {
+  Aabb box;
+  for (std::size_t o = 0; o < scene.occluders.size(); ++o) {
+    if (const auto* slim = std::get_if<SlimOccluder>(&scene.occluders[o].shape)) {
+      for (const SlimSphere& s : slim->spheres()) {
+        spheres_.push_back(&s);
+        occluder_of_.push_back(static_cast<std::uint32_t>(o));
+      }
+      box.grow(slim->bounds());
+    }
+  }
+  if (!box.empty()) anchor_ = 0.5 * (box.lo + box.hi);
+  std::vector<SlimGpu> data(spheres_.size());
+  std::vector<std::uint32_t> index(spheres_.size());
+  for (std::size_t i = 0; i < spheres_.size(); ++i) {
+    const SlimSphere& s = *spheres_[i];
+    const Occluder& occ = scene.occluders[occluder_of_[i]];
+    SlimGpu& d = data[i];
+    auto put = [](float* out, const Vec3& v, double w) {
+      for (int k = 0; k < 3; ++k) out[k] = static_cast<float>(v[k]);
+      out[3] = static_cast<float>(w);
+    };
+    put(d.center, s.center - anchor_, s.radius);
+    put(d.axis_u, s.to_world({1.0, 0.0, 0.0}) - s.center, 0.0);
+    put(d.axis_v, s.to_world({0.0, 1.0, 0.0}) - s.center, 0.0);
+    put(d.axis_w, s.to_world({0.0, 0.0, 1.0}) - s.center, 0.0);
+    for (int k = 0; k < 4; ++k) {
+      d.p1[k] = static_cast<float>(s.poly.c[k]);
+      d.q1[k] = static_cast<float>(s.poly2.c[k]);
+    }
+    d.p2[0] = static_cast<float>(s.poly.c[4]);
+    d.p2[1] = static_cast<float>(s.poly.c[5]);
+    d.p2[2] = static_cast<float>(s.crease);
+    d.q2[0] = static_cast<float>(s.poly2.c[4]);
+    d.q2[1] = static_cast<float>(s.poly2.c[5]);
+    put(d.albedo, occ.albedo, static_cast<double>(occ.material.type));
+    index[i] = static_cast<std::uint32_t>(i);
+  }
+  if (spheres_.empty()) return;
+  GLuint id = 0;
+  glCreateBuffers(1, &id);
+  sphere_ssbo_ = GlBuffer(id);
+  glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(SlimGpu)), data.data(), 0);
+  glCreateBuffers(1, &id);
+  index_vbo_ = GlBuffer(id);
+  glNamedBufferStorage(id, static_cast<GLsizeiptr>(index.size() * sizeof(std::uint32_t)), index.data(), 0);
+  glCreateVertexArrays(1, &id);
+  vao_ = GlVertexArray(id);
+  glVertexArrayVertexBuffer(id, 0, index_vbo_.get(), 0, sizeof(std::uint32_t));
+  glEnableVertexArrayAttrib(id, 0);
+  glVertexArrayAttribIFormat(id, 0, 1, GL_UNSIGNED_INT, 0);
+  glVertexArrayAttribBinding(id, 0, 0);
+  glVertexArrayBindingDivisor(id, 0, 1);  // one sphere per instance: the command's base instance
+  gl_check("SlimResources");
+}
+
+void SlimResources::plan_views(const std::vector<Camera>& cams, const std::vector<CameraBasis>& bases,
+                               const SlimSettings& settings) {
+  const std::size_t n = spheres_.size();
+  const std::size_t views = cams.size();
+  std::vector<DrawCommand> commands(n * views);
+  std::vector<std::uint32_t> grids(2 * n * views);
+  slots_.assign(views, 0);
+  for (std::size_t v = 0; v < views; ++v) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const SlimGrid g = slim_grid(*spheres_[i], cams[v], bases[v], settings);
+      const std::uint64_t count = std::uint64_t{g.m} * g.m * g.s * g.s;
+      commands[v * n + i] = {static_cast<std::uint32_t>(count), g.m > 0 ? 1u : 0u, 0,
+                             static_cast<std::uint32_t>(i)};
+      grids[2 * (v * n + i)] = g.m;
+      grids[2 * (v * n + i) + 1] = g.s;
+      slots_[v] += g.m > 0 ? static_cast<std::int64_t>(count) : 0;
+    }
+  }
+  if (n == 0) return;
+  if (views > capacity_views_) {
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    command_buffer_ = GlBuffer(id);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(commands.size() * sizeof(DrawCommand)), nullptr,
+                         GL_DYNAMIC_STORAGE_BIT);
+    glCreateBuffers(1, &id);
+    grid_ssbo_ = GlBuffer(id);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(grids.size() * sizeof(std::uint32_t)), nullptr,
+                         GL_DYNAMIC_STORAGE_BIT);
+    capacity_views_ = views;
+  }
+  glNamedBufferSubData(command_buffer_.get(), 0,
+                       static_cast<GLsizeiptr>(commands.size() * sizeof(DrawCommand)), commands.data());
+  glNamedBufferSubData(grid_ssbo_.get(), 0, static_cast<GLsizeiptr>(grids.size() * sizeof(std::uint32_t)),
+                       grids.data());
+  gl_check("SlimResources::plan_views");
+}
+
+namespace {
+
+// Passes 1 and 2: every sphere's points, one indirect command each, per view.
+class SlimPointsPass final : public Pass {
+ public:
+  explicit SlimPointsPass(bool depth)
+      : depth_(depth), program_(depth ? "slim_depth" : "slim_accumulate") {}
+  void execute(FrameContext& ctx, const PassDecl& self) override {
+    SlimResources* slim = ctx.resources.slim();
+    if (!slim || slim->sphere_count() == 0) return;
+    const bool multi = ctx.views > 0;
+    if (depth_) {  // the first of the slim passes plans the frame's samples
+      if (multi) {
+        slim->plan_views(*ctx.view_cameras, *ctx.view_bases, ctx.scene.slim);
+      } else {
+        slim->plan_views({ctx.camera}, {ctx.basis}, ctx.scene.slim);
+      }
+    }
+    glUseProgram(program_.get(multi));
+    glBindTextureUnit(0, ctx.targets.texture("view_depth"));
+    if (!depth_) {
+      glBindTextureUnit(1, ctx.targets.texture("slim_near"));
+      glUniform1f(program_.uniform(multi, "u_threshold"),
+                  static_cast<float>(ctx.scene.slim.depth_threshold));
+    }
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, slim->sphere_buffer());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, slim->grid_buffer());
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, slim->command_buffer());
+    glBindVertexArray(slim->instance_vao());
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_PROGRAM_POINT_SIZE);
+    glPointSize(1.0f);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(depth_ ? GL_MIN : GL_FUNC_ADD);
+    const auto n = static_cast<GLsizei>(slim->sphere_count());
+    const GLint grid_base = program_.uniform(multi, "u_grid_base");
+    int view = 0;
+    for_each_view_offset(ctx, self, program_, "u_offset", slim->anchor(), [&] {
+      glUniform1i(grid_base, view * n);
+      const auto offset = static_cast<std::intptr_t>(view) * n * 16;
+      glMultiDrawArraysIndirect(GL_POINTS, reinterpret_cast<const void*>(offset), n, 0);
+      ++view;
+    });
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_BLEND);
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+    gl_check(depth_ ? "slim_depth pass" : "slim_accumulate pass");
+  }
+
+ private:
+  bool depth_;
+  ProgramPair program_;
+};
+
+// Pass 3: normalization into the surfaces' targets.
+class SlimResolvePass final : public Pass {
+ public:
+  SlimResolvePass() : program_("slim_resolve") {}
+  void execute(FrameContext& ctx, const PassDecl& self) override {
+    if (!ctx.resources.slim() || ctx.resources.slim()->sphere_count() == 0) return;
+    const bool multi = ctx.views > 0;
+    glUseProgram(program_.get(multi));
+    glUniform1i(program_.uniform(multi, "u_gi"), self.id == PassId::kSlimGbuffer ? 1 : 0);
+    glBindTextureUnit(0, ctx.targets.texture("slim_sum_normal"));
+    glBindTextureUnit(1, ctx.targets.texture("slim_sum_albedo"));
+    glDisable(GL_BLEND);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glBindVertexArray(ctx.empty_vao);
+    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    gl_check("slim_resolve pass");
+  }
+
+ private:
+  ProgramPair program_;
+};
+
+}  // namespace
+
+std::unique_ptr<Pass> make_slim_pass(PassId id) {
+  switch (id) {
+    case PassId::kSlimDepth:
+      return std::make_unique<SlimPointsPass>(true);
+    case PassId::kSlimAccumulate:
+      return std::make_unique<SlimPointsPass>(false);
+    case PassId::kSlimResolve:
+    case PassId::kSlimGbuffer:
+      return std::make_unique<SlimResolvePass>();
+    default:
+      break;
+  }
+  throw GlError("make_slim_pass: not a slim pass");
+}
+
+}  // namespace beamcast

@@ -1,0 +1,85 @@
+// SLIM surfaces on the GPU (seed 003, issue 16): the support spheres in a
+// buffer, each frame's sampling plan per sphere and view (grid size from the
+// sphere's projected size), and the executors of the four slim passes of the
+// pass graph (render/pass_plan.cpp): slim_depth, slim_accumulate and
+// slim_resolve / slim_gbuffer.
+//
+// Sampling: sphere i of radius r whose projection is N pixels wide (at its
+// centre's depth) is
+// sampled on the (u, v) grid over [-r, r]^2 with step n = S r / N (S =
+// slim.sampling), i.e. m = ceil(2N / S) samples a side, each the point
+// (u, v, f(u, v)) of its local height field; points outside the sphere
+// (weight 0) are dropped. The seed's second stage (slim.fill_holes): a cell
+// whose neighbouring samples project more than a pixel apart gets L x L
+// samples, L = ceil(the cell's longer projected diagonal / (sqrt(3) / 2)),
+// which bounds every pixel centre's distance to a sample by half a pixel
+// within the patch. Points are drawn with glMultiDrawArraysIndirect, one
+// command per sphere (its sample count; 0 when the sphere is culled).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "protocol/camera.hpp"
+#include "protocol/scene.hpp"
+#include "render/gl_util.hpp"
+#include "render/pass_plan.hpp"
+
+namespace beamcast {
+
+class Pass;
+
+// The most samples a side of one sphere's grid, and the most second-stage
+// samples a side of one cell: a sphere crossing the near plane projects
+// without bound, and is sampled at most 2048 x 2048 x 4 x 4.
+inline constexpr int kSlimMaxGrid = 2048;
+inline constexpr int kSlimMaxFill = 4;
+
+// One sphere's sampling in one view: m samples a side, up to s x s per cell
+// (s = 1 without the second stage); m = 0: culled.
+struct SlimGrid {
+  std::uint32_t m = 0;
+  std::uint32_t s = 1;
+};
+
+// The grid of `sphere` for a camera (CPU, double): culled (m = 0) when the
+// sphere lies outside the view frustum; else as described above, with s the
+// bound on any cell's second-stage level from the height field's largest
+// slope over the sphere and the nearest depth.
+SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasis& basis,
+                   const SlimSettings& settings);
+
+// GPU data of a scene's SLIM surfaces (upload group "slim").
+class SlimResources {
+ public:
+  explicit SlimResources(const Scene& scene);
+  std::size_t sphere_count() const { return spheres_.size(); }
+  GLuint sphere_buffer() const { return sphere_ssbo_.get(); }
+  GLuint instance_vao() const { return vao_.get(); }
+  const Vec3& anchor() const { return anchor_; }
+
+  // Plans the samples of `views` cameras (one command and one grid per
+  // sphere and view, view-major) and uploads them; returns the sample slots
+  // of each view (what the draws process; culled slots included).
+  void plan_views(const std::vector<Camera>& cams, const std::vector<CameraBasis>& bases,
+                  const SlimSettings& settings);
+  GLuint command_buffer() const { return command_buffer_.get(); }
+  GLuint grid_buffer() const { return grid_ssbo_.get(); }
+  // Sample slots drawn per frame in the last plan_views (each view's sum).
+  const std::vector<std::int64_t>& slots() const { return slots_; }
+
+ private:
+  std::vector<const SlimSphere*> spheres_;
+  std::vector<std::uint32_t> occluder_of_;
+  Vec3 anchor_{};
+  GlBuffer sphere_ssbo_, index_vbo_, command_buffer_, grid_ssbo_;
+  GlVertexArray vao_;
+  std::size_t capacity_views_ = 0;
+  std::vector<std::int64_t> slots_;
+};
+
+// The executor of a slim pass id.
+std::unique_ptr<Pass> make_slim_pass(PassId id);
+
+}  // namespace beamcast
