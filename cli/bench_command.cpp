@@ -1,5 +1,5 @@
 // `beamcast bench accuracy`: the accuracy/time benchmark of bench/accuracy.hpp;
-// `bench views`; `bench gi` (bench/gi_bench.py, run with this binary).
+// `bench views`; `bench slim` (bench/slim_bench.hpp); `bench gi` (bench/gi_bench.py, run with this binary).
 #include <sys/wait.h>
 
 #include <filesystem>
@@ -10,6 +10,7 @@
 #include "protocol/data_dir.hpp"
 
 #include "bench/accuracy.hpp"
+#include "bench/slim_bench.hpp"
 #include "bench/views.hpp"
 #include "cli/commands.hpp"
 
@@ -37,6 +38,28 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
   acc->callback([opts] {
     const int rc = bench::run_accuracy(*opts);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+
+  auto sopts = std::make_shared<bench::SlimBenchOptions>();
+  CLI::App* slim = bench->add_subcommand(
+      "slim",
+      "SLIM point sampling against the CPU reference: sampling S, depth threshold, the second "
+      "stage, zoom 0.25x-16x, per model; writes slim.csv and slim.md to --out");
+  slim->add_option("--out,-o", sopts->out, "Output directory (created if missing)")->required();
+  slim->add_flag("--quick", sopts->quick, "128x128, fewer settings (about a minute on 2 cores)");
+  slim->add_option("--size", sopts->size, "Frame width and height (default 512, 128 with --quick)")
+      ->check(CLI::Range(16, 4096));
+  slim->add_option("--repeats", sopts->repeats, "GPU frames per row, median reported (default 3)")
+      ->check(CLI::Range(1, 100));
+  slim->add_option("--model", sopts->models,
+                   "A SLIM model file (JSON or binary, e.g. from `beamcast slim fit`; repeatable)")
+      ->check(CLI::ExistingFile);
+  slim->add_option("--device", sopts->egl.device_index, "EGL device index");
+  slim->add_option("--platform", sopts->egl.platform, "EGL platform: auto, device or surfaceless")
+      ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
+  slim->callback([sopts] {
+    const int rc = bench::run_slim_bench(*sopts);
     if (rc != 0) throw CLI::RuntimeError(rc);
   });
 

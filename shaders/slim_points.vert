@@ -82,13 +82,20 @@ void main() {
   if (sub > 0u) {
     // The seed's second stage: as many samples a side as the cell's longer
     // projected diagonal (to the next samples in u and v) is over
-    // sqrt(3)/2 pixels.
-    vec2 p00 = to_pixels(surface(s, x));
-    vec2 p10 = to_pixels(surface(s, x + vec2(h, 0.0)));
-    vec2 p01 = to_pixels(surface(s, x + vec2(0.0, h)));
-    vec2 p11 = to_pixels(surface(s, x + vec2(h, h)));
-    float diag = max(distance(p00, p11), distance(p10, p01));
-    float level = min(ceil(diag / 0.8660254), float(fill));
+    // sqrt(3)/2 pixels, from the projection's derivative at the cell's
+    // first sample (cells are about a pixel: the linearization is close;
+    // 5% margin).
+    vec2 g0;
+    float w0 = height(s, x, g0);
+    vec3 p0 = s.center.xyz + x.x * s.axis_u.xyz + x.y * s.axis_v.xyz + w0 * s.axis_w.xyz + u_offset;
+    vec4 c = cam.view_proj * vec4(p0, 1.0);
+    vec4 cu = cam.view_proj * vec4(s.axis_u.xyz + g0.x * s.axis_w.xyz, 0.0);
+    vec4 cv = cam.view_proj * vec4(s.axis_v.xyz + g0.y * s.axis_w.xyz, 0.0);
+    float iw = 1.0 / max(c.w, 1e-30);
+    vec2 du = 0.5 * cam.viewport.xy * (cu.xy - c.xy * (cu.w * iw)) * iw * h;
+    vec2 dv = 0.5 * cam.viewport.xy * (cv.xy - c.xy * (cv.w * iw)) * iw * h;
+    float diag = max(length(du + dv), length(du - dv));
+    float level = min(ceil(1.05 * diag / 0.8660254), float(fill));
     float a = float(sub % fill), b = float(sub / fill);
     if (a >= level || b >= level) {
       drop();

@@ -1,0 +1,29 @@
+// `beamcast bench slim` (issue 16, item 5): SLIM point sampling against the
+// CPU reference per knob — sampling S, depth threshold t, the second stage
+// on and off — for each model and zoom (0.25x to 16x of the size that fills
+// the frame): sample slots per frame, GPU time, hole and spurious pixels,
+// depth and normal error. Writes slim.csv and slim.md.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "render/egl_context.hpp"
+
+namespace beamcast::bench {
+
+struct SlimBenchOptions {
+  std::filesystem::path out;
+  bool quick = false;  // 128x128, the generated shapes, fewer settings
+  int size = 0;        // 0: 512 (quick: 128)
+  int repeats = 3;     // GPU frames per row (the median is reported)
+  // SLIM model files (JSON or binary, e.g. from `beamcast slim fit`) besides
+  // the generated sphere and torus.
+  std::vector<std::filesystem::path> models;
+  EglOptions egl;
+};
+
+int run_slim_bench(const SlimBenchOptions& opts);
+
+}  // namespace beamcast::bench
