@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <variant>
 
 #include "protocol/occluders/slim.hpp"
@@ -30,18 +31,6 @@ struct DrawCommand {  // DrawArraysIndirectCommand
   std::uint32_t count, instance_count, first, base_instance;
 };
 
-// The largest slope |grad f| of either polynomial over |u|, |v| <= r.
-double max_slope(const SlimSphere& s) {
-  auto bound = [&](const SlimPoly& p) {
-    const auto& c = p.c;
-    const double du = 2.0 * std::abs(c[0]) * s.radius + std::abs(c[1]) * s.radius + std::abs(c[3]);
-    const double dv = std::abs(c[1]) * s.radius + 2.0 * std::abs(c[2]) * s.radius + std::abs(c[4]);
-    return std::hypot(du, dv);
-  };
-  const double a = bound(s.poly);
-  return s.crease == SlimCrease::kNone ? a : std::max(a, bound(s.poly2));
-}
-
 }  // namespace
 
 SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasis& basis,
@@ -53,9 +42,8 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
   const bool ortho = cam.projection == Projection::kOrthographic;
   const double th = ortho ? basis.half_height : basis.tan_half_fov;
   const double tw = th * basis.aspect;
-  // Pixels per world unit at the sphere's nearest depth (a bound over it),
-  // and how much more an off-axis segment may project (perspective).
-  double ppw = 0.0, ppw_centre = 0.0, oblique = 1.0;
+  // Pixels per world unit at the sphere's nearest depth and at its centre's.
+  double ppw = 0.0, ppw_centre = 0.0;
   if (ortho) {
     if (std::abs(x) > tw + r || std::abs(y) > th + r) return {};
     ppw = ppw_centre = cam.height / (2.0 * th);
@@ -68,7 +56,6 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
     const double z_near = std::max(z - r, cam.near_plane);
     ppw = cam.height / (2.0 * th * z_near);
     ppw_centre = cam.height / (2.0 * th * std::max(z, z_near));
-    oblique = std::sqrt(1.0 + tw * tw + th * th);
   }
   // N: the sphere's projected width, at its centre's depth (the seed's);
   // nearer parts project wider, which the second stage fills.
@@ -77,13 +64,42 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
   g.m = static_cast<std::uint32_t>(
       std::clamp(std::ceil(2.0 * n_px / settings.sampling), 1.0, static_cast<double>(kSlimMaxGrid)));
   if (settings.fill_holes) {
-    // A cell's diagonal: sqrt 2 steps of the grid, stretched by the height
-    // field's slope, at most ppw x oblique pixels per unit.
-    const double step = 2.0 * r / g.m;
-    const double diag = std::sqrt(2.0) * step * std::sqrt(1.0 + std::pow(max_slope(sphere), 2)) *
-                        ppw * oblique;
+    // The most any cell needs: its longer projected diagonal (the shader's
+    // rule, slim_points.vert) at 7 x 7 cells spread over the sphere (those inside it), exact
+    // finite differences in double, with a 10% margin over the shader's 5%
+    // for the cells between them (the projection of a quadratic patch
+    // changes slowly across it). Without it every cell would get the
+    // worst case of the whole sphere.
+    const double h = 2.0 * r / g.m;
+    auto pixel = [&](double u, double v, std::array<double, 2>* out) {
+      const Vec3 q = sphere.surface_point(u, v) - basis.eye;
+      const double qz = dot(q, basis.forward);
+      if (!ortho && !(qz > cam.near_plane)) return false;
+      const double scale = ortho ? ppw : cam.height / (2.0 * th * qz);
+      (*out)[0] = dot(q, basis.right) * scale;
+      (*out)[1] = dot(q, basis.up) * scale;
+      return true;
+    };
+    double worst = 0.0;
+    constexpr int kProbes = 7;
+    for (int i = 0; i < kProbes; ++i) {
+      for (int j = 0; j < kProbes; ++j) {
+        const double u = -r + (2.0 * r - h) * i / (kProbes - 1);
+        const double v = -r + (2.0 * r - h) * j / (kProbes - 1);
+        // Only cells that hold points (inside the sphere).
+        if (std::hypot(u + 0.5 * h, v + 0.5 * h, sphere.height(u + 0.5 * h, v + 0.5 * h)) >= r) continue;
+        std::array<double, 2> p00{}, p10{}, p01{}, p11{};
+        if (!pixel(u, v, &p00) || !pixel(u + h, v, &p10) || !pixel(u, v + h, &p01) ||
+            !pixel(u + h, v + h, &p11)) {
+          worst = std::numeric_limits<double>::infinity();  // crosses the near plane
+          continue;
+        }
+        worst = std::max({worst, std::hypot(p11[0] - p00[0], p11[1] - p00[1]),
+                          std::hypot(p10[0] - p01[0], p10[1] - p01[1])});
+      }
+    }
     g.s = static_cast<std::uint32_t>(
-        std::clamp(std::ceil(diag / (std::sqrt(3.0) / 2.0)), 1.0, static_cast<double>(kSlimMaxFill)));
+        std::clamp(std::ceil(1.1 * worst / (std::sqrt(3.0) / 2.0)), 1.0, static_cast<double>(kSlimMaxFill)));
   }
   return g;
 }

@@ -45,8 +45,8 @@ struct SlimGrid {
 
 // The grid of `sphere` for a camera (CPU, double): culled (m = 0) when the
 // sphere lies outside the view frustum; else as described above, with s the
-// bound on any cell's second-stage level from the height field's largest
-// slope over the sphere and the nearest depth.
+// most second-stage samples a side any cell needs, from the projected cells
+// at 7 x 7 places over the sphere (10% margin).
 SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasis& basis,
                    const SlimSettings& settings);
 
