@@ -18,6 +18,9 @@ struct SlimBenchOptions {
   bool quick = false;  // 128x128, the generated shapes, fewer settings
   int size = 0;        // 0: 512 (quick: 128)
   int repeats = 3;     // GPU frames per row (the median is reported)
+  // Coverage pictures of the zoom rows (MODEL_zoomZ_fill|nofill.png): grey
+  // covered by both, red holes, blue spurious pixels.
+  bool images = false;
   // SLIM model files (JSON or binary, e.g. from `beamcast slim fit`) besides
   // the generated sphere and torus.
   std::vector<std::filesystem::path> models;

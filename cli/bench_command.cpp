@@ -52,6 +52,8 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::Range(16, 4096));
   slim->add_option("--repeats", sopts->repeats, "GPU frames per row, median reported (default 3)")
       ->check(CLI::Range(1, 100));
+  slim->add_flag("--images", sopts->images,
+                 "Coverage pictures of the zoom rows (grey: both, red: holes, blue: spurious)");
   slim->add_option("--model", sopts->models,
                    "A SLIM model file (JSON or binary, e.g. from `beamcast slim fit`; repeatable)")
       ->check(CLI::ExistingFile);

@@ -117,6 +117,10 @@ struct SlimSettings {
   // The seed's second stage: more samples where neighbours project more
   // than a pixel apart.
   bool fill_holes = true;
+  // Skip spheres whose every normal faces away from the camera (their
+  // points lie behind the front of a closed surface); false for open
+  // sheets meant to be seen from both sides.
+  bool cull_backfaces = true;
 };
 
 // One directional light for Lambert shading of occluders.

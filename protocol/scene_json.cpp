@@ -790,7 +790,7 @@ void check_method_fits_densities(const Scene& scene) {
 // The SLIM point sampling knobs (issue 16; docs/slim.md).
 SlimSettings parse_slim_settings(const Node& n) {
   ObjectReader o(n, "slim settings");
-  o.allow_only({"sampling", "depth_threshold", "fill_holes"});
+  o.allow_only({"sampling", "depth_threshold", "fill_holes", "cull_backfaces"});
   SlimSettings s;
   // S above 16 leaves 8-pixel gaps that no threshold closes; below 0.25
   // every sphere emits 64 points per pixel it covers.
@@ -799,6 +799,7 @@ SlimSettings parse_slim_settings(const Node& n) {
     s.depth_threshold = check_closed(*v, read_number(*v), 0.0, 4.0);
   }
   if (auto v = o.optional("fill_holes")) s.fill_holes = read_bool(*v);
+  if (auto v = o.optional("cull_backfaces")) s.cull_backfaces = read_bool(*v);
   return s;
 }
 

@@ -65,7 +65,7 @@ struct FrameOptions {
   // Single-camera frames (batch off): also read back these targets of the
   // plan (render size, RGBA float, rows top-down) into FrameResult::targets;
   // names the plan does not use are skipped. For tests and benches.
-  std::vector<std::string> read_targets;
+  std::vector<std::string> read_targets{};
 };
 
 // The GPU work a frame was part of: a multi-view batch of `views` cameras, or
@@ -107,7 +107,7 @@ struct FrameResult {
   double photon_trace_ms = 0.0;
   double photon_upload_ms = 0.0;
   // FrameOptions::read_targets: width x height x 4 floats each.
-  std::map<std::string, std::vector<float>> targets;
+  std::map<std::string, std::vector<float>> targets{};
   // SLIM surfaces: the sample slots the point passes processed (single-camera
   // frames; 0 in multi-view batches).
   std::int64_t slim_points = 0;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <variant>
 
 #include "protocol/occluders/slim.hpp"
@@ -31,6 +32,33 @@ struct DrawCommand {  // DrawArraysIndirectCommand
   std::uint32_t count, instance_count, first, base_instance;
 };
 
+// The largest slope |grad f| of either polynomial over |u|, |v| <= r.
+double max_slope(const SlimSphere& s) {
+  auto bound = [&](const SlimPoly& p) {
+    const auto& c = p.c;
+    const double du = (2.0 * std::abs(c[0]) + std::abs(c[1])) * s.radius + std::abs(c[3]);
+    const double dv = (std::abs(c[1]) + 2.0 * std::abs(c[2])) * s.radius + std::abs(c[4]);
+    return std::hypot(du, dv);
+  };
+  const double a = bound(s.poly);
+  return s.crease == SlimCrease::kNone ? a : std::max(a, bound(s.poly2));
+}
+
+// True if every point of the sphere's patch faces away from the eye: its
+// normals lie within atan(max slope) of the local w axis, the directions
+// from the eye to its points within the sphere's angular radius of the
+// direction to its centre (perspective) or along forward (orthographic).
+bool faces_away(const SlimSphere& sphere, const Vec3& to_centre, double distance, bool ortho,
+                const Vec3& forward) {
+  if (!ortho && distance <= sphere.radius) return false;  // the eye is inside it
+  const Vec3 w = sphere.to_world({0.0, 0.0, 1.0}) - sphere.center;
+  const Vec3 view = ortho ? forward : (1.0 / distance) * to_centre;
+  const double alpha = std::atan(max_slope(sphere));
+  const double beta = ortho ? 0.0 : std::asin(sphere.radius / distance);
+  const double margin = 0.5 * std::numbers::pi - alpha - beta - 1e-3;
+  return margin > 0.0 && dot(w, view) > std::cos(margin);
+}
+
 }  // namespace
 
 SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasis& basis,
@@ -40,6 +68,7 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
   const double x = dot(p, basis.right), y = dot(p, basis.up), z = dot(p, basis.forward);
   if (z + r < cam.near_plane || z - r > cam.far_plane) return {};
   const bool ortho = cam.projection == Projection::kOrthographic;
+  if (settings.cull_backfaces && faces_away(sphere, p, length(p), ortho, basis.forward)) return {};
   const double th = ortho ? basis.half_height : basis.tan_half_fov;
   const double tw = th * basis.aspect;
   // Pixels per world unit at the sphere's nearest depth and at its centre's.

@@ -104,6 +104,44 @@ TEST(Slim, AnOccluderInFrontHidesThePoints) {
   EXPECT_GT(right, 0.0);
 }
 
+// Back-face culling skips the spheres facing away from the camera: a
+// closed surface looks the same with fewer points; an open sheet seen from
+// behind disappears unless culling is off.
+TEST(Slim, BackfaceCullingKeepsClosedSurfacesAndDropsSheetsSeenFromBehind) {
+  FrameOptions opts;
+  opts.batch = false;
+  Scene closed = sphere_scene(64, 4.0, SlimSettings{});
+  closed.slim.cull_backfaces = false;
+  const auto all = renderer().render(closed, opts);
+  closed.slim.cull_backfaces = true;
+  const auto culled = renderer().render(closed, opts);
+  // Culled: the supports whose normal cone (half-angle atan 0.5 = 27 deg
+  // here) and view cone (about 5 deg) both lie within 90 deg of facing
+  // away, a cap of (1 - cos 58 deg) / 2 = 24% of them.
+  EXPECT_LT(culled[0].slim_points, 0.85 * static_cast<double>(all[0].slim_points));
+  EXPECT_EQ(culled[0].image.rgb, all[0].image.rgb);
+
+  Scene sheet;
+  sheet.occluders.push_back(
+      Occluder{SlimOccluder::from_spheres(test::slim_plane(0.0, 1.0, 4)), {0.8, 0.8, 0.8}, {}});
+  Camera below;
+  below.position = {0.3, -3.0, 0.5};  // the side F < 0
+  below.target = Vec3{0.0, 0.0, 0.0};
+  below.width = below.height = 32;
+  sheet.cameras.push_back(below);
+  opts.read_targets = {"slim_sum_normal"};
+  auto covered = [&](const Scene& s) {
+    auto f = renderer().render(s, opts);
+    int n = 0;
+    const auto& sums = f[0].targets["slim_sum_normal"];
+    for (std::size_t i = 3; i < sums.size(); i += 4) n += sums[i] > 0.0f ? 1 : 0;
+    return n;
+  };
+  EXPECT_EQ(covered(sheet), 0);
+  sheet.slim.cull_backfaces = false;
+  EXPECT_GT(covered(sheet), 500);
+}
+
 // A multi-view batch plans each view's samples for its own camera: the
 // frames equal single renders.
 TEST(Slim, MultiViewBatchEqualsSingleRenders) {

@@ -192,6 +192,8 @@ TEST(SlimFormat, BadFieldsAreRefusedWithTheirPath) {
   json settings = slim_scene({{"type", "slim"}, {"spheres", {one_sphere()}}});
   settings["slim"] = {{"sampling", 0.1}};
   EXPECT_REJECTED(settings, "out_of_range", "/slim/sampling");
+  settings["slim"] = {{"cull_backfaces", 1}};
+  EXPECT_REJECTED(settings, "wrong_type", "/slim/cull_backfaces");
   settings["slim"] = {{"holes", true}};
   EXPECT_REJECTED(settings, "unknown_field", "/slim/holes");
 }
