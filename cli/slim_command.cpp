@@ -44,7 +44,7 @@ void add_slim_command(CLI::App& app) {
       ->check(CLI::Range(0.5, 2.0));
   fit->add_option("--fit-points", args->fit.fit_points,
                   "Points sampled on the triangles for the fits (default max(4 x triangles, "
-                  "100000))")
+                  "400000))")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{100000000}));
   fit->add_option("--samples", args->samples,
                   "Points on the mesh the error is measured at (default 200000)")

@@ -161,7 +161,7 @@ FitResult fit_slim(const TriangleMesh& mesh, const FitOptions& o) {
   const std::int64_t target =
       o.fit_points > 0
           ? o.fit_points
-          : std::max<std::int64_t>(4 * static_cast<std::int64_t>(mesh.triangles.size()), 100000);
+          : std::max<std::int64_t>(4 * static_cast<std::int64_t>(mesh.triangles.size()), 400000);
   const std::vector<FitPoint> pts = sample_points(mesh, target);
   result.points = static_cast<std::int64_t>(pts.size());
 

@@ -30,7 +30,7 @@ struct FitOptions {
   double support = 0.75;         // sphere radius / cell diagonal, in [0.5, 2]
   double max_normal_deg = 60.0;  // a wider spread of normals: no single fit
   double crease_deg = 30.0;      // two normal groups this far apart: try a crease
-  std::int64_t fit_points = 0;   // triangle samples (0: max(4 x triangles, 100 000))
+  std::int64_t fit_points = 0;   // triangle samples (0: max(4 x triangles, 400 000))
 };
 
 struct FitResult {

@@ -185,13 +185,13 @@ LocalFit fit_crease(const std::vector<FitPoint>& pts, const std::vector<std::uin
     cb = nb_u;
     if (same) break;
   }
-  // A crease is two tight groups far apart: each group's spread under half
-  // the angle between them (a smoothly curved patch splits into groups as
+  // A crease is two tight groups far apart: each group's spread under the
+  // angle between them (a smoothly curved patch splits into groups about as
   // wide as their distance, and is left to the octree).
   const double between = deg(dot(ca, cb));
   if (between < s.crease_deg) return out;
   const double within = std::max(spread_deg(pts, ga, ca), spread_deg(pts, gb, cb));
-  if (within > s.max_normal_deg || within > 0.5 * between) return out;
+  if (within > s.max_normal_deg || within > between) return out;
   // The bisector frame; both faces then lean at most (180 - angle) / 2 from it.
   const Vec3 bis = ca + cb;
   if (length(bis) < 0.5) return out;  // folded back on itself (over ~150 degrees)

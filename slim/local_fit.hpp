@@ -36,7 +36,7 @@ LocalFit fit_single(const std::vector<FitPoint>& pts, const std::vector<std::uin
                     const Vec3& c, double r, const LocalFitSettings& s, bool force);
 
 // Normals split in two groups (2-means, weighted) more than crease_deg apart,
-// each within max_normal_deg and within half that angle of its own mean: one quadratic per group in
+// each within max_normal_deg and within that angle of its own mean: one quadratic per group in
 // the frame of the groups' bisector; min or max, whichever reproduces the points.
 LocalFit fit_crease(const std::vector<FitPoint>& pts, const std::vector<std::uint32_t>& ball,
                     const Vec3& c, double r, const LocalFitSettings& s);
