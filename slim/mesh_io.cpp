@@ -130,7 +130,7 @@ struct PlyElement {
 // Reads one value of `type` at bytes[*pos] (little-endian host assumed: x86/ARM).
 bool read_binary(const std::string& bytes, std::size_t* pos, PlyType type, double* out) {
   const std::size_t n = ply_size(type);
-  if (bytes.size() - *pos < n) return false;
+  if (*pos > bytes.size() || bytes.size() - *pos < n) return false;
   const char* p = bytes.data() + *pos;
   *pos += n;
   switch (type) {
@@ -382,7 +382,9 @@ TriangleMesh read_ply(const std::string& bytes, const std::string& name) {
 
   TriangleMesh mesh;
   bool have_vertices = false, have_faces = false;
-  TokenStream tokens(std::string_view(bytes).substr(std::min(pos, bytes.size())), line_no + 1);
+  // A header without a newline after end_header leaves pos one past the end.
+  pos = std::min(pos, bytes.size());
+  TokenStream tokens(std::string_view(bytes).substr(pos), line_no + 1);
   std::vector<double> values;
   std::vector<std::int64_t> idx;
   for (const PlyElement& e : elements) {
@@ -402,6 +404,8 @@ TriangleMesh read_ply(const std::string& bytes, const std::string& name) {
     if (is_face && !have_vertices) fail(name, "", "face element before the vertex element");
     have_vertices |= is_vertex;
     have_faces |= is_face;
+    // Nothing to read per instance: a huge count would only spin.
+    if (e.props.empty() && e.count > 0) fail(name, "", "element " + e.name + " has no properties");
     for (std::int64_t i = 0; i < e.count; ++i) {
       const std::string here =
           binary ? "element " + e.name + " " + std::to_string(i) : std::string();
@@ -437,8 +441,11 @@ TriangleMesh read_ply(const std::string& bytes, const std::string& name) {
           if (is_face && static_cast<int>(k) == ilist) {
             idx.clear();
             for (double x : values) {
-              if (x != std::floor(x))
-                fail(name, binary ? here : std::to_string(tok_line), "non-integer vertex index");
+              // Checked before the cast: a double past int64's range would be UB.
+              if (x != std::floor(x) || std::abs(x) > 1e15) {
+                fail(name, binary ? here : std::to_string(tok_line),
+                     "vertex index " + std::to_string(x) + " is not an index");
+              }
               idx.push_back(static_cast<std::int64_t>(x));
             }
             add_polygon(
