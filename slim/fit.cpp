@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -68,8 +69,10 @@ class Fitter {
          FitResult* out)
       : pts_(pts), opt_(opt), error_(error_world), out_(out) {}
 
+  // `parent_ball`: the points inside the parent's sphere (radius
+  // `room` around this cell's centre fits inside it).
   void cell(const Vec3& lo, double side, int depth, const std::vector<std::uint32_t>& cell_pts,
-            const std::vector<std::uint32_t>& parent_ball) {
+            const std::vector<std::uint32_t>& parent_ball, double room) {
     const Vec3 c = lo + Vec3{0.5 * side, 0.5 * side, 0.5 * side};
     double r = opt_.support * side * std::numbers::sqrt3;
     std::vector<std::uint32_t> ball;
@@ -80,11 +83,13 @@ class Fitter {
       }
     };
     gather();
-    // Too few points for a stable quadratic: grow the sphere (within the parent's).
+    // Too few points for a stable quadratic: grow the sphere, within the
+    // parent's (its points are all this sphere can see, and the error check
+    // must see every point the sphere covers).
     for (int g = 0; g < 6 && ball.size() < static_cast<std::size_t>(opt_.min_points) &&
-                    ball.size() < parent_ball.size();
+                    ball.size() < parent_ball.size() && r < room;
          ++g) {
-      r *= 1.25;
+      r = std::min(1.25 * r, room);
       gather();
     }
     if (ball.size() < 6) return;  // nothing to fit; neighbours' spheres cover these points
@@ -98,7 +103,7 @@ class Fitter {
     if (crease.ok && (!best.ok || crease.error < best.error)) best = crease;
 
     if (depth < opt_.max_depth && ball.size() >= 2 * static_cast<std::size_t>(opt_.min_points)) {
-      split(lo, side, depth, cell_pts, ball);
+      split(lo, side, depth, cell_pts, ball, c, r);
       return;
     }
     // At the bottom: the best fit found, else one in the mean normal's frame
@@ -116,7 +121,7 @@ class Fitter {
   }
 
   void split(const Vec3& lo, double side, int depth, const std::vector<std::uint32_t>& cell_pts,
-             const std::vector<std::uint32_t>& ball) {
+             const std::vector<std::uint32_t>& ball, const Vec3& c, double r) {
     const double h = 0.5 * side;
     const Vec3 mid = lo + Vec3{h, h, h};
     std::array<std::vector<std::uint32_t>, 8> child;
@@ -129,7 +134,8 @@ class Fitter {
       if (child[static_cast<std::size_t>(k)].empty()) continue;
       const Vec3 clo{lo[0] + ((k & 1) ? h : 0.0), lo[1] + ((k & 2) ? h : 0.0),
                      lo[2] + ((k & 4) ? h : 0.0)};
-      cell(clo, h, depth + 1, child[static_cast<std::size_t>(k)], ball);
+      const Vec3 cc = clo + Vec3{0.5 * h, 0.5 * h, 0.5 * h};
+      cell(clo, h, depth + 1, child[static_cast<std::size_t>(k)], ball, r - length(cc - c));
     }
   }
 
@@ -173,7 +179,7 @@ FitResult fit_slim(const TriangleMesh& mesh, const FitOptions& o) {
   std::vector<std::uint32_t> all(pts.size());
   for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
   Fitter fitter(pts, o, o.error * size / 10.0, &result);
-  fitter.cell(lo, side, 0, all, all);
+  fitter.cell(lo, side, 0, all, all, std::numeric_limits<double>::infinity());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
 }
