@@ -10,6 +10,7 @@
 #include <random>
 #include <sstream>
 
+#include "protocol/scene_json.hpp"
 #include "protocol/slim_io.hpp"
 #include "slim/fit.hpp"
 #include "slim/local_fit.hpp"
@@ -370,6 +371,64 @@ TEST(SlimFit, ErrorsAreAtSizeTenAndSpheresInTheMeshsUnits) {
   EXPECT_EQ(parse_slim_file_bytes(text.str(), "t.json", "", 1 << 20, 1e12).size(),
             fa.fit.spheres.size());
   fs::remove_all(dir);
+}
+
+// A fitted model is a scene's "slim" occluder: the binary file loads from
+// the assets directory and the CPU reference's rays land on the torus. A
+// hit's distance to the exact torus is at most the mesh's facet depth
+// (0.0017 here: the 32-gon tube's sagitta) plus the fit's 1.5 E (0.0058 at
+// E = 0.01 on this 3.9-unit model); a SLIM surface with stray sheets (a
+// support's quadratic reaching where the mesh is not) would hit farther off.
+// Rays that graze the exact torus may pass outside the mesh's facets: at
+// most 1% of the rays that hit the exact torus miss the fitted one.
+TEST(SlimFit, TheFittedModelLoadsAsAnOccluderAndRaysLandOnTheTorus) {
+  const double R = 1.0, r = 0.35;
+  const TriangleMesh t = test::torus({0.0, 0.0, 0.0}, R, r, 72, 32);
+  slim::FitOptions o;
+  o.error = 0.01;
+  o.fit_points = 100000;
+  const slim::FitResult fit = slim::fit_slim(t, o);
+  const fs::path dir = temp_dir();
+  write_slim_file(dir / "torus.bslm", fit.spheres);
+  SceneLoadOptions opts;
+  opts.assets_dir = dir;
+  const nlohmann::json j = {{"occluders", {{{"type", "slim"}, {"file", "torus.bslm"}}}},
+                            {"cameras", {{{"position", {0, 0, 5}}, {"target", {0, 0, 0}}}}}};
+  const Scene scene = parse_scene(j, opts);
+  const auto& slim_occ = std::get<SlimOccluder>(scene.occluders.at(0).shape);
+  ASSERT_EQ(slim_occ.spheres().size(), fit.spheres.size());
+  fs::remove_all(dir);
+
+  auto torus_distance = [&](const Vec3& p) {
+    const double q = std::sqrt(p[0] * p[0] + p[2] * p[2]) - R;
+    return std::sqrt(q * q + p[1] * p[1]) - r;
+  };
+  const double bound = 0.0017 + kBoundFactor * o.error * slim::model_size(t) / 10.0;
+  std::mt19937 rng(9);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  int exact_hits = 0, holes = 0, hits = 0;
+  double worst = 0.0;
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 d = normalize(Vec3{g(rng), g(rng), g(rng)});
+    const Vec3 origin = -4.0 * d + Vec3{1.4 * uni(rng), 0.4 * uni(rng), 1.4 * uni(rng)};
+    // The exact torus by marching in steps of 2e-4 (its thinnest part is 0.7 across).
+    bool exact = false;
+    for (double s = 0.0; s < 8.0 && !exact; s += 2e-4) exact = torus_distance(origin + s * d) < 0.0;
+    exact_hits += exact ? 1 : 0;
+    const auto hit = slim_occ.intersect(origin, d, 0.0, 10.0);
+    if (!hit) {
+      holes += exact ? 1 : 0;
+      continue;
+    }
+    ++hits;
+    worst = std::max(worst, std::abs(torus_distance(origin + hit->t * d)));
+  }
+  std::printf("rays hitting the torus %d, the fit %d, holes %d, worst distance %.4g (bound %.4g)\n",
+              exact_hits, hits, holes, worst, bound);
+  EXPECT_GT(exact_hits, 500);
+  EXPECT_LE(holes, exact_hits / 100);
+  EXPECT_LT(worst, bound);
 }
 
 // The points of a cube's surface within `band` of an edge, away from the corners.
