@@ -45,10 +45,10 @@ void add_slim_command(CLI::App& app) {
   fit->add_option("--fit-points", args->fit.fit_points,
                   "Points sampled on the triangles for the fits (default max(4 x triangles, "
                   "400000))")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{100000000}));
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{20000000}));
   fit->add_option("--samples", args->samples,
                   "Points on the mesh the error is measured at (default 200000)")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{100000000}));
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{20000000}));
   fit->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
     const slim::TriangleMesh mesh = slim::read_mesh(args->mesh);
