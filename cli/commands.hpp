@@ -15,6 +15,8 @@ void add_server_commands(CLI::App& app);
 void add_bench_command(CLI::App& app);
 // `load`: a load generator against beamcast-server (load_command.cpp).
 void add_load_command(CLI::App& app);
+// `slim fit`: a SLIM surface fitted to a triangle mesh (slim/).
+void add_slim_command(CLI::App& app);
 
 // `beamcast render --server HOST:PORT`: the render happens on the server.
 struct RemoteRenderArgs {

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   beamcast::cli::add_server_commands(app);
   beamcast::cli::add_bench_command(app);
   beamcast::cli::add_load_command(app);
+  beamcast::cli::add_slim_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

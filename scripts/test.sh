@@ -26,7 +26,7 @@ stage "clang-tidy"
 # macros through the analyzer): ~14 more minutes of CPU, more than doubling
 # the stage; the tests run under ASan + UBSan below. Measured: README.md.
 run-clang-tidy-14 -p build -j"$(nproc)" -quiet \
-  "$PWD/(protocol|render|gi|shaders|server|client|cli|bench|fuzz)/" >build/clang-tidy.log 2>&1 || {
+  "$PWD/(protocol|render|gi|slim|shaders|server|client|cli|bench|fuzz)/" >build/clang-tidy.log 2>&1 || {
   grep -E "(error|warning):" build/clang-tidy.log
   echo "clang-tidy: findings above (whole log: build/clang-tidy.log)"
   exit 1
