@@ -73,7 +73,7 @@ SlimErrors compare_slim(const SlimPixels& gpu, const SlimPixels& ref, double siz
   SlimErrors e;
   const int w = ref.width, h = ref.height;
   const double to10 = 10.0 / size;
-  std::vector<double> angles;
+  std::vector<double> angles, depths;
   double depth_sum = 0.0;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -112,6 +112,7 @@ SlimErrors compare_slim(const SlimPixels& gpu, const SlimPixels& ref, double siz
       ++e.compared;
       depth_sum += dz * to10;
       e.depth_max = std::max(e.depth_max, dz * to10);
+      depths.push_back(dz * to10);
       const double c = std::clamp(dot(gpu.normal[i], ref.normal[i]), -1.0, 1.0);
       angles.push_back(std::acos(c) * 180.0 / std::numbers::pi);
     }
@@ -122,6 +123,8 @@ SlimErrors compare_slim(const SlimPixels& gpu, const SlimPixels& ref, double siz
     for (double a : angles) sum += a;
     e.normal_mean_deg = sum / static_cast<double>(angles.size());
     std::sort(angles.begin(), angles.end());
+    std::sort(depths.begin(), depths.end());
+    e.depth_p99 = depths[static_cast<std::size_t>(0.99 * static_cast<double>(depths.size() - 1))];
     e.normal_max_deg = angles.back();
     e.normal_p99_deg = angles[static_cast<std::size_t>(0.99 * static_cast<double>(angles.size() - 1))];
   }

@@ -38,6 +38,7 @@ struct SlimErrors {
   std::int64_t compared = 0;          // covered by both, and the same part of the surface
   std::int64_t occluded = 0;          // covered by both, depths apart more than 10% of the size
   double depth_mean = 0.0;  // |GPU - reference| view depth over `compared`, in units of size / 10
+  double depth_p99 = 0.0;
   double depth_max = 0.0;
   double normal_mean_deg = 0.0;
   double normal_p99_deg = 0.0;
