@@ -1,6 +1,7 @@
 // Integration tests: a real beamcast server (GL render worker on llvmpipe) on
 // an ephemeral port in this process, spoken to over TCP.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
@@ -11,6 +12,7 @@
 
 #include "protocol/base64.hpp"
 #include "protocol/scene_json.hpp"
+#include "protocol/slim_io.hpp"
 #include "render/image.hpp"
 #include "render/pass_plan.hpp"
 #include "render/renderer.hpp"
@@ -48,7 +50,7 @@ class TestServer {
  public:
   explicit TestServer(ServerConfig c = {}) {
     c.port = 0;
-    c.assets_dir = fs::path(BEAMCAST_SOURCE_DIR) / "examples";
+    if (c.assets_dir.empty()) c.assets_dir = fs::path(BEAMCAST_SOURCE_DIR) / "examples";
     server_ = std::make_unique<Server>(c, gl_renderer_factory({}));
     port_ = server_->start();
     thread_ = std::thread([this] { server_->run(false); });
@@ -151,6 +153,51 @@ TEST(Server, LitScenesReportPhotonsAndRefuseBadLightsWithPaths) {
   EXPECT_TRUE(s.healthy());
   r = c.call(render_req(7, scene));
   EXPECT_TRUE(r.json["ok"]) << r.json;
+}
+
+// SLIM surfaces (issue 16): bad spheres and bad model files are refused with
+// their paths, and the server keeps serving; a good one renders the slim
+// passes.
+TEST(Server, SlimSurfacesRenderAndBadOnesAreRefusedWithPaths) {
+  const fs::path dir = fs::temp_directory_path() / ("beamcast_slim_server_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  SlimSphere flat;
+  flat.radius = 1.0;
+  const std::string bin = slim_to_binary({flat, flat});
+  std::ofstream(dir / "ok.bslm", std::ios::binary) << bin;
+  std::ofstream(dir / "cut.bslm", std::ios::binary) << bin.substr(0, bin.size() - 10);
+  ServerConfig config;
+  config.assets_dir = dir;
+  TestServer s(config);
+  Conn c(s.port());
+  json sphere = {{"center", {0, 0, 0}}, {"radius", 1.0}, {"coefficients", {-0.3, 0, -0.3, 0, 0, 0.5}}};
+  json scene = {{"occluders", {{{"type", "slim"}, {"spheres", {sphere}}}}},
+                {"cameras", {{{"position", {0, 3, 0.5}}, {"target", {0, 0, 0}}, {"width", 32}, {"height", 32}}}}};
+  Reply r = c.call(render_req(1, scene));
+  ASSERT_TRUE(r.json["ok"]) << r.json;
+  EXPECT_EQ(r.json["result"]["passes"],
+            json({"surfaces", "slim_depth", "slim_accumulate", "slim_resolve", "tonemap"}));
+  auto refused = [&](json occluder, const std::string& code, const std::string& path) {
+    json bad = scene;
+    bad["occluders"][0] = std::move(occluder);
+    const Reply e = c.call(render_req(2, bad));
+    EXPECT_EQ(error_code(e), code) << e.json;
+    EXPECT_EQ(error_path(e), path) << e.json;
+  };
+  json negative = sphere;
+  negative["radius"] = -1;
+  refused({{"type", "slim"}, {"spheres", {negative}}}, "out_of_range", "/params/scene/occluders/0/spheres/0/radius");
+  json rotation = sphere;
+  rotation["rotation"] = {0, 0, 0, 0};
+  refused({{"type", "slim"}, {"spheres", {rotation}}}, "invalid_value",
+          "/params/scene/occluders/0/spheres/0/rotation");
+  refused({{"type", "slim"}, {"file", "../outside.bslm"}}, "forbidden_path", "/params/scene/occluders/0/file");
+  refused({{"type", "slim"}, {"file", "cut.bslm"}}, "bad_slim", "/params/scene/occluders/0/file");
+  EXPECT_TRUE(s.healthy());
+  scene["occluders"][0] = {{"type", "slim"}, {"file", "ok.bslm"}};
+  r = c.call(render_req(3, scene));
+  EXPECT_TRUE(r.json["ok"]) << r.json;
+  fs::remove_all(dir);
 }
 
 TEST(Server, PipelinedRequestsAnswerWithTheirIds) {
