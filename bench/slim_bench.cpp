@@ -10,10 +10,12 @@
 #include <sstream>
 
 #include "protocol/occluders/slim.hpp"
+#include "protocol/scene_json.hpp"
 #include "protocol/slim_io.hpp"
 #include "render/image.hpp"
 #include "render/renderer.hpp"
 #include "render/slim_compare.hpp"
+#include "slim/mesh_io.hpp"
 // The generated shapes the tests use (header-only).
 #include "tests/common/slim_shapes.hpp"
 
@@ -24,6 +26,7 @@ namespace {
 struct Model {
   std::string name;
   std::vector<SlimSphere> spheres;
+  std::filesystem::path mesh;  // optional: the mesh it was fitted to
 };
 
 struct Setting {
@@ -86,15 +89,18 @@ int run_slim_bench(const SlimBenchOptions& opts) {
   std::vector<Model> models = {
       // Supports 1.2 lattice spacings wide: each surface point in about 4.5
       // of them, as fitted models (the tests use 2, 12x overlap).
-      {"sphere_400", test::slim_sphere({0, 0, 0}, 1.0, 400, 1.2)},
-      {"torus_768", test::slim_torus({0, 0, 0}, 2.0, 0.6, 48, 16, 1.0)},
+      {"sphere_400", test::slim_sphere({0, 0, 0}, 1.0, 400, 1.2), {}},
+      {"torus_768", test::slim_torus({0, 0, 0}, 2.0, 0.6, 48, 16, 1.0), {}},
   };
   for (const auto& path : opts.models) {
     std::ifstream in(path, std::ios::binary);
     std::ostringstream bytes;
     bytes << in.rdbuf();
     models.push_back({path.stem().string(),
-                      parse_slim_file_bytes(bytes.str(), path.string(), "/", 10000000, 1e12)});
+                      parse_slim_file_bytes(bytes.str(), path.string(), "/", 10000000, 1e12), {}});
+  }
+  for (std::size_t i = 0; i < opts.meshes.size() && i < opts.models.size(); ++i) {
+    models[models.size() - opts.models.size() + i].mesh = opts.meshes[i];
   }
   std::vector<Setting> settings;
   auto with = [](double s, double t, bool fill) {
@@ -122,7 +128,8 @@ int run_slim_bench(const SlimBenchOptions& opts) {
   std::ofstream csv(opts.out / "slim.csv");
   csv << "model,spheres,knob,sampling,depth_threshold,fill_holes,zoom,size,points,gpu_ms,slim_ms,"
          "reference_pixels,holes,interior_holes,spurious,spurious_far,other_layer,depth_mean,"
-         "depth_p99,depth_max,normal_mean_deg,normal_p99_deg,normal_max_deg\n";
+         "depth_p99,depth_max,normal_mean_deg,normal_p99_deg,normal_max_deg,interior,interior_depth_p99,"
+         "interior_normal_p99_deg,crease_pixels,crease_normal_mean_deg\n";
   std::ofstream md(opts.out / "slim.md");
   md << "# SLIM point sampling against the CPU reference (" << size << "x" << size << ", "
      << renderer.description() << ")\n\n"
@@ -133,10 +140,12 @@ int run_slim_bench(const SlimBenchOptions& opts) {
         "not (interior: all 8 neighbours covered by the reference); spurious: the reverse (far: "
         "no covered neighbour). Depth: |GPU - reference| view depth at the model scaled to "
         "size 10 (its box diagonal). Normal: angle between the blended point normal and F's "
-        "gradient.\n\n"
+        "gradient. Inner: the pixels whose 3x3 neighbourhood both cover (not the outline). Crease: inner "
+        "pixels where the reference's normal turns by over 30 degrees to a neighbour.\n\n"
      << "| model | spheres | knob | S | t | 2nd stage | zoom | points | GPU ms | slim ms | ref px | "
-        "holes | interior | spurious | far | depth mean | depth p99 | normal mean ° | normal p99 ° |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "holes | interior | spurious | far | depth mean | depth p99 | normal mean ° | normal p99 ° | "
+        "inner depth p99 | inner normal p99 ° | crease px | crease normal ° |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Model& model : models) {
     Scene base;
     base.occluders.push_back(
@@ -183,7 +192,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
       char line[1024];
       std::snprintf(line, sizeof line,
                     "%s,%zu,%s,%g,%g,%d,%g,%d,%lld,%.2f,%.2f,%lld,%lld,%lld,%lld,%lld,%lld,%.5f,%.5f,%.4f,%.4f,"
-                    "%.4f,%.4f\n",
+                    "%.4f,%.4f,%lld,%.5f,%.4f,%lld,%.4f\n",
                     model.name.c_str(), model.spheres.size(), st.knob.c_str(), st.slim.sampling,
                     st.slim.depth_threshold, st.slim.fill_holes ? 1 : 0, st.zoom, size,
                     static_cast<long long>(last.slim_points), median(gpu), median(slim_ms),
@@ -191,21 +200,80 @@ int run_slim_bench(const SlimBenchOptions& opts) {
                     static_cast<long long>(e.interior_holes), static_cast<long long>(e.spurious),
                     static_cast<long long>(e.spurious_far), static_cast<long long>(e.occluded),
                     e.depth_mean, e.depth_p99, e.depth_max, e.normal_mean_deg, e.normal_p99_deg,
-                    e.normal_max_deg);
+                    e.normal_max_deg, static_cast<long long>(e.interior), e.interior_depth_p99,
+                    e.interior_normal_p99_deg, static_cast<long long>(e.crease_pixels),
+                    e.crease_normal_mean_deg);
       csv << line << std::flush;
       std::snprintf(line, sizeof line,
                     "| %s | %zu | %s | %g | %g | %s | %g | %lld | %.1f | %.1f | %lld | %lld | %lld | %lld | "
-                    "%lld | %.4f | %.4f | %.3f | %.2f |\n",
+                    "%lld | %.4f | %.4f | %.3f | %.2f | %.4f | %.2f | %lld | %.1f |\n",
                     model.name.c_str(), model.spheres.size(), st.knob.c_str(), st.slim.sampling,
                     st.slim.depth_threshold, st.slim.fill_holes ? "on" : "off", st.zoom,
                     static_cast<long long>(last.slim_points), median(gpu), median(slim_ms),
                     static_cast<long long>(e.reference_pixels), static_cast<long long>(e.holes),
                     static_cast<long long>(e.interior_holes), static_cast<long long>(e.spurious),
                     static_cast<long long>(e.spurious_far), e.depth_mean, e.depth_p99, e.normal_mean_deg,
-                    e.normal_p99_deg);
+                    e.normal_p99_deg, e.interior_depth_p99, e.interior_normal_p99_deg,
+                    static_cast<long long>(e.crease_pixels), e.crease_normal_mean_deg);
       md << line << std::flush;
       std::fputs(line, stdout);
       std::fflush(stdout);
+    }
+  }
+  // The mesh each model was fitted to, rasterized at zoom 1 and 4 with the
+  // default SLIM settings' frame beside it.
+  std::ofstream mm(opts.out / "slim_mesh.md");
+  mm << "# SLIM point sampling against its source mesh rasterized (" << size << "x" << size << ")\n\n"
+     << "Both drawn by this renderer with the directional light (the mesh with flat triangle "
+        "normals). GPU ms: median of "
+     << opts.repeats << ". Image difference: 8-bit RMS and PSNR of the SLIM frame against the mesh's.\n\n"
+     << "| model | spheres | triangles | zoom | SLIM GPU ms | mesh GPU ms | ratio | RMS | PSNR dB |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const Model& model : models) {
+    if (model.mesh.empty()) continue;
+    const slim::TriangleMesh mesh = slim::read_mesh(model.mesh);
+    const std::filesystem::path obj_dir = opts.out / "meshes";
+    std::filesystem::create_directories(obj_dir);
+    const std::string obj = model.name + ".obj";
+    {
+      std::ofstream o(obj_dir / obj);
+      for (const Vec3& v : mesh.vertices) o << "v " << v[0] << ' ' << v[1] << ' ' << v[2] << '\n';
+      for (const auto& t : mesh.triangles) o << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    }
+    SceneLoadOptions load;
+    load.assets_dir = obj_dir;
+    nlohmann::json mj = {{"occluders", {{{"type", "mesh"}, {"file", obj}, {"albedo", {0.8, 0.7, 0.6}}}}},
+                         {"cameras", {{{"position", {0, 0, 5}}}}}};
+    Scene mesh_scene = parse_scene(mj, load);
+    Scene slim_scene;
+    slim_scene.occluders.push_back(
+        Occluder{SlimOccluder::from_spheres(model.spheres), {0.8, 0.7, 0.6}, {}});
+    const Aabb box = std::get<SlimOccluder>(slim_scene.occluders[0].shape).bounds();
+    for (double zoom : {1.0, 4.0}) {
+      mesh_scene.cameras = slim_scene.cameras = {camera_for(box, zoom, size)};
+      FrameOptions fo;
+      fo.batch = false;
+      std::vector<double> ts, tm;
+      FrameResult fs_last, fm_last;
+      for (int r = 0; r < std::max(1, opts.repeats); ++r) {
+        auto a = renderer.render(slim_scene, fo);
+        auto b = renderer.render(mesh_scene, fo);
+        ts.push_back(a[0].gpu_ms);
+        tm.push_back(b[0].gpu_ms);
+        fs_last = std::move(a[0]);
+        fm_last = std::move(b[0]);
+      }
+      const LevelError le = compare_levels(fs_last.image, fm_last.image);
+      char name[256];
+      std::snprintf(name, sizeof name, "%s_zoom%g", model.name.c_str(), zoom);
+      write_png(opts.out / (std::string(name) + "_slim.png"), fs_last.image);
+      write_png(opts.out / (std::string(name) + "_mesh.png"), fm_last.image);
+      char line[512];
+      std::snprintf(line, sizeof line, "| %s | %zu | %zu | %g | %.1f | %.1f | %.1f | %.2f | %.1f |\n",
+                    model.name.c_str(), model.spheres.size(), mesh.triangles.size(), zoom, median(ts),
+                    median(tm), median(ts) / std::max(median(tm), 1e-9), le.rms, le.psnr_db);
+      mm << line << std::flush;
+      std::fputs(line, stdout);
     }
   }
   std::printf("wrote %s and slim.md\n", (opts.out / "slim.csv").c_str());

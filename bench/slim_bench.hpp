@@ -24,6 +24,11 @@ struct SlimBenchOptions {
   // SLIM model files (JSON or binary, e.g. from `beamcast slim fit`) besides
   // the generated sphere and torus.
   std::vector<std::filesystem::path> models;
+  // The meshes the models were fitted to, in the same order (optional): the
+  // everyday alternative, each rasterized by the same renderer as a mesh
+  // occluder at the same cameras: its GPU time and its image's difference
+  // from the SLIM frame (slim_mesh.md).
+  std::vector<std::filesystem::path> meshes;
   EglOptions egl;
 };
 

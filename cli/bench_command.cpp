@@ -57,6 +57,10 @@ void add_bench_command(CLI::App& app) {
   slim->add_option("--model", sopts->models,
                    "A SLIM model file (JSON or binary, e.g. from `beamcast slim fit`; repeatable)")
       ->check(CLI::ExistingFile);
+  slim->add_option("--mesh", sopts->meshes,
+                   "The mesh the i-th --model was fitted to (OFF, OBJ or PLY; repeatable): rasterized "
+                   "at the same cameras for time and image difference")
+      ->check(CLI::ExistingFile);
   slim->add_option("--device", sopts->egl.device_index, "EGL device index");
   slim->add_option("--platform", sopts->egl.platform, "EGL platform: auto, device or surfaceless")
       ->check(CLI::IsMember({"auto", "device", "surfaceless"}));

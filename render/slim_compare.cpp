@@ -73,8 +73,8 @@ SlimErrors compare_slim(const SlimPixels& gpu, const SlimPixels& ref, double siz
   SlimErrors e;
   const int w = ref.width, h = ref.height;
   const double to10 = 10.0 / size;
-  std::vector<double> angles, depths;
-  double depth_sum = 0.0;
+  std::vector<double> angles, depths, interior_angles, interior_depths;
+  double depth_sum = 0.0, crease_sum = 0.0;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
@@ -114,9 +114,43 @@ SlimErrors compare_slim(const SlimPixels& gpu, const SlimPixels& ref, double siz
       e.depth_max = std::max(e.depth_max, dz * to10);
       depths.push_back(dz * to10);
       const double c = std::clamp(dot(gpu.normal[i], ref.normal[i]), -1.0, 1.0);
-      angles.push_back(std::acos(c) * 180.0 / std::numbers::pi);
+      const double angle = std::acos(c) * 180.0 / std::numbers::pi;
+      angles.push_back(angle);
+      bool interior = true, crease = false;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          if (xx < 0 || yy < 0 || xx >= w || yy >= h) {
+            interior = false;
+            continue;
+          }
+          const std::size_t j = static_cast<std::size_t>(yy) * w + xx;
+          if (!ref.covered[j] || !gpu.covered[j]) {
+            interior = false;
+            continue;
+          }
+          if (dot(ref.normal[j], ref.normal[i]) < std::cos(30.0 * std::numbers::pi / 180.0)) crease = true;
+        }
+      }
+      if (interior) {
+        ++e.interior;
+        interior_angles.push_back(angle);
+        interior_depths.push_back(dz * to10);
+        if (crease) {
+          ++e.crease_pixels;
+          crease_sum += angle;
+        }
+      }
     }
   }
+  auto p99 = [](std::vector<double>& v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v[static_cast<std::size_t>(0.99 * static_cast<double>(v.size() - 1))];
+  };
+  e.interior_normal_p99_deg = p99(interior_angles);
+  e.interior_depth_p99 = p99(interior_depths);
+  if (e.crease_pixels > 0) e.crease_normal_mean_deg = crease_sum / static_cast<double>(e.crease_pixels);
   if (e.compared > 0) {
     e.depth_mean = depth_sum / static_cast<double>(e.compared);
     double sum = 0.0;

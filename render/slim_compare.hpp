@@ -43,6 +43,16 @@ struct SlimErrors {
   double normal_mean_deg = 0.0;
   double normal_p99_deg = 0.0;
   double normal_max_deg = 0.0;
+  // The same over the interior: compared pixels whose 3x3 neighbourhood both
+  // cover (the outline's pixels average a surface turning away within them).
+  std::int64_t interior = 0;
+  double interior_normal_p99_deg = 0.0;
+  double interior_depth_p99 = 0.0;
+  // Creases: compared interior pixels where the reference's normal turns by
+  // more than 30 degrees to a neighbour (fandisk's edges); the normal error
+  // there shows whether the points keep the edge sharp.
+  std::int64_t crease_pixels = 0;
+  double crease_normal_mean_deg = 0.0;
 };
 
 // `size`: the model's size (its bounding box diagonal); depths are reported
