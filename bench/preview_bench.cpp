@@ -39,11 +39,11 @@ double median(std::vector<double> v) {
 constexpr int kPngLevel = 2;
 constexpr int kPngSub = 0x10;
 
-Scene demo_scene() {
+Scene demo_scene(const std::string& name) {
   const auto dir = find_data_dir("examples");
   SceneLoadOptions opts;
   opts.assets_dir = dir;
-  return load_scene_file(dir / "paper_10sets.json", opts);
+  return load_scene_file(dir / (name + ".json"), opts);
 }
 
 void encode_table(Renderer& renderer, const Scene& scene, int rounds) {
@@ -79,10 +79,10 @@ void encode_table(Renderer& renderer, const Scene& scene, int rounds) {
   }
 }
 
-void level_table(Renderer& renderer, const Scene& scene, int rounds) {
+void level_table(Renderer& renderer, const Scene& scene, const std::string& name, int rounds) {
   Camera cam = scene.cameras[0];
   cam.width = cam.height = 512;
-  const auto ladder = make_accuracy_ladder(scene.render);
+  const auto ladder = make_accuracy_ladder(scene.render, scene.has_gi());
   const Image full = renderer.render(scene, {cam})[0].image;
   struct Row {
     std::vector<double> render_ms, encode_ms, readback_ms;
@@ -95,6 +95,7 @@ void level_table(Renderer& renderer, const Scene& scene, int rounds) {
     for (std::size_t l = 0; l < ladder.size(); ++l) {
       Scene s = scene;
       s.render = ladder[l].render;
+      s.gi.display_fraction = ladder[l].photon_fraction;
       FrameOptions fo;
       fo.resolution_scale = ladder[l].scale;
       auto t = Clock::now();
@@ -124,7 +125,7 @@ void level_table(Renderer& renderer, const Scene& scene, int rounds) {
     encode_png(full, kPngLevel, kPngSub);
     still_png.push_back(ms_since(t));
   }
-  std::printf("\n### Controller levels (10-set scene, 512², median of %d interleaved rounds)\n\n", rounds);
+  std::printf("\n### Controller levels (%s, 512², median of %d interleaved rounds)\n\n", name.c_str(), rounds);
   std::printf("| level | label | render ms | JPEG ms | frame ms | frames/s (serial) | RMS error (levels) | max error | PSNR dB | RMS after JPEG | PSNR after JPEG | JPEG bytes |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (std::size_t l = 0; l < ladder.size(); ++l) {
@@ -151,12 +152,16 @@ void level_table(Renderer& renderer, const Scene& scene, int rounds) {
 
 }  // namespace
 
+// beamcast_bench_preview [ROUNDS [EXAMPLE]]: the encoding table and the
+// controller levels of the 10-set scene, or only the levels of EXAMPLE
+// (e.g. cornell_box: a lit scene's ladder splats a quarter of the photons).
 int main(int argc, char** argv) {
   const int rounds = argc > 1 ? std::max(1, std::atoi(argv[1])) : 15;
+  const std::string name = argc > 2 ? argv[2] : "paper_10sets";
   Renderer renderer;
   std::printf("renderer: %s\n", renderer.description().c_str());
-  const Scene scene = demo_scene();
-  encode_table(renderer, scene, rounds);
-  level_table(renderer, scene, rounds);
+  const Scene scene = demo_scene(name);
+  if (name == "paper_10sets") encode_table(renderer, scene, rounds);
+  level_table(renderer, scene, name, rounds);
   return 0;
 }

@@ -27,7 +27,7 @@ std::string settings_label(const RenderSettings& r) {
 
 }  // namespace
 
-std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full) {
+std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full, bool lit) {
   // The cheap integration: a 32x32 table (the paper's size) with the chord and
   // warped layouts, which keep it accurate where g varies fastest
   // (docs/accuracy.md); a scene already at or below that keeps its own.
@@ -45,12 +45,13 @@ std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full) {
 
   std::vector<AccuracyLevel> ladder;
   ladder.push_back({"full", 1.0, full, 92});
-  const std::string fast_name = settings_label(fast);
-  if (!same_settings(fast, full)) ladder.push_back({fast_name, 1.0, fast, 90});
+  const double photons = lit ? kPreviewPhotonFraction : 1.0;
+  const std::string fast_name = settings_label(fast) + (lit ? "+photons1/4" : "");
+  if (lit || !same_settings(fast, full)) ladder.push_back({fast_name, 1.0, fast, 90, photons});
   // Resolution is the knob that pays on any renderer: cost follows pixel count.
-  ladder.push_back({fast_name + "@3/4", 0.75, fast, 85});
-  ladder.push_back({fast_name + "@1/2", 0.5, fast, 80});
-  ladder.push_back({fast_name + "@1/4", 0.25, fast, 75});
+  ladder.push_back({fast_name + "@3/4", 0.75, fast, 85, photons});
+  ladder.push_back({fast_name + "@1/2", 0.5, fast, 80, photons});
+  ladder.push_back({fast_name + "@1/4", 0.25, fast, 75, photons});
   return ladder;
 }
 

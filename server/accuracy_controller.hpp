@@ -22,11 +22,19 @@ struct AccuracyLevel {
   double scale = 1.0;     // resolution scale: render smaller, upscale bilinearly on the GPU
   RenderSettings render;  // integration settings
   int jpeg_quality = 90;  // interactive frames are JPEG at this quality
+  // Lit scenes: the share of the cached photon maps splatted
+  // (GiSettings::display_fraction; nothing is traced again).
+  double photon_fraction = 1.0;
 };
 
 // The ladder for a scene whose full-accuracy settings are `full`, ordered from
-// most accurate (index 0: exactly `full` at scale 1) to cheapest.
-std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full);
+// most accurate (index 0: exactly `full` at scale 1) to cheapest. A lit scene
+// (`lit`: photon splatting, the frame's largest cost) also splats a quarter
+// of its cached photons (at 4x their power and the default radius of that
+// count) on every level below the full one: 4x fewer splats for about 2x
+// the photon noise (docs/gi.md, "Preview").
+inline constexpr double kPreviewPhotonFraction = 0.25;
+std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full, bool lit = false);
 
 struct ControllerConfig {
   double budget_ms = 33.0;  // frame-time budget while the camera moves

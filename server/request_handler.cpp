@@ -168,7 +168,8 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
                             "|" + (rp.output ? text(*rp.output) : "");
     if (!st.controller || st.scene_key != key) {
       ControllerConfig cfg;
-      st.controller = std::make_unique<AccuracyController>(make_accuracy_ladder(scene->render), cfg);
+      st.controller =
+          std::make_unique<AccuracyController>(make_accuracy_ladder(scene->render, scene->has_gi()), cfg);
       st.scene_key = key;
     }
     st.controller->set_budget(q.budget_ms);
@@ -183,6 +184,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     if (decision->level != 0) {
       auto copy = std::make_shared<Scene>(*scene);
       copy->render = level.render;
+      copy->gi.display_fraction = level.photon_fraction;
       scene = std::move(copy);
     }
   }

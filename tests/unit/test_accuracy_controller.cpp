@@ -46,6 +46,24 @@ TEST(AccuracyLadder, SmallTableSceneSkipsTheEqualLevel) {
   EXPECT_EQ(ladder[1].scale, 0.75);
 }
 
+// A lit scene's levels below the full one splat a quarter of the cached
+// photons; an unlit scene's ladder is unchanged (every level all of them).
+TEST(AccuracyLadder, LitScenesSplatAShareOfThePhotonsBelowFull) {
+  const RenderSettings full;
+  const auto lit = make_accuracy_ladder(full, true);
+  ASSERT_GE(lit.size(), 2u);
+  EXPECT_EQ(lit[0].photon_fraction, 1.0);
+  EXPECT_EQ(lit[0].label, "full");
+  for (std::size_t i = 1; i < lit.size(); ++i) {
+    EXPECT_EQ(lit[i].photon_fraction, kPreviewPhotonFraction) << lit[i].label;
+    EXPECT_NE(lit[i].label.find("photons1/4"), std::string::npos) << lit[i].label;
+  }
+  EXPECT_EQ(lit[1].scale, 1.0);
+  const auto unlit = make_accuracy_ladder(full, false);
+  for (const AccuracyLevel& l : unlit) EXPECT_EQ(l.photon_fraction, 1.0) << l.label;
+  EXPECT_EQ(unlit.size(), make_accuracy_ladder(full).size());
+}
+
 TEST(AccuracyController, FirstFrameIsFullAccuracy) {
   AccuracyController c(make_accuracy_ladder({}), {});
   const auto d = c.decide(0.0, pose(0), Motion::kInfer);
