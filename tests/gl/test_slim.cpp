@@ -39,16 +39,28 @@ struct Compared {
   FrameResult frame;
 };
 
-Compared render_and_compare(const Scene& scene, double size) {
+// The first camera's frame with the slim passes' sums read back, and the
+// GPU's surface from them.
+struct SlimFrame {
+  FrameResult frame;
+  SlimPixels gpu;
+};
+SlimFrame render_slim(const Scene& scene, bool hdr = false) {
   FrameOptions opts;
   opts.batch = false;
+  opts.read_hdr = hdr;
   opts.read_targets = {"slim_sum_normal", "slim_sum_albedo"};
   auto frames = renderer().render(scene, opts);
   const Camera& cam = scene.cameras[0];
-  const SlimPixels gpu = slim_from_sums(frames[0].targets["slim_sum_normal"],
-                                        frames[0].targets["slim_sum_albedo"], cam.width, cam.height);
-  const SlimPixels ref = slim_reference(scene, cam);
-  Compared c{compare_slim(gpu, ref, size), std::move(frames[0])};
+  SlimPixels gpu = slim_from_sums(frames[0].targets["slim_sum_normal"], frames[0].targets["slim_sum_albedo"],
+                                  cam.width, cam.height);
+  return {std::move(frames[0]), std::move(gpu)};
+}
+
+Compared render_and_compare(const Scene& scene, double size) {
+  SlimFrame f = render_slim(scene);
+  const SlimPixels ref = slim_reference(scene, scene.cameras[0]);
+  Compared c{compare_slim(f.gpu, ref, size), std::move(f.frame)};
   const SlimErrors& e = c.errors;
   std::printf("  ref %lld px, holes %lld (interior %lld), spurious %lld (far %lld), other layer %lld, depth mean %.4f "
               "max %.4f, normal mean %.3f p99 %.3f max %.3f deg, %lld points\n",
@@ -160,14 +172,9 @@ TEST(Slim, ABeamThroughTheSurfaceIsClippedLikeTheReference) {
       {"cameras", {{{"position", {0.0, 0.6, 4.0}}, {"target", {0, 0, 0}}, {"width", 96}, {"height", 96}}}}};
   Scene scene = parse_scene(j, {});
   scene.occluders = sphere_scene(96, 4.0, SlimSettings{}).occluders;
-  FrameOptions opts;
-  opts.batch = false;
-  opts.read_hdr = true;
-  opts.read_targets = {"slim_sum_normal", "slim_sum_albedo"};
-  auto frames = renderer().render(scene, opts);
+  const SlimFrame f = render_slim(scene, true);
+  const SlimPixels& gpu = f.gpu;
   const Camera& cam = scene.cameras[0];
-  const SlimPixels gpu = slim_from_sums(frames[0].targets["slim_sum_normal"],
-                                        frames[0].targets["slim_sum_albedo"], cam.width, cam.height);
   const SlimPixels cover = slim_reference(scene, cam);
   const HdrImage ref = render_reference(scene, cam);
   Scene no_slim = scene;
@@ -188,7 +195,7 @@ TEST(Slim, ABeamThroughTheSurfaceIsClippedLikeTheReference) {
       ++compared;
       const std::size_t i = static_cast<std::size_t>(y) * cam.width + x;
       for (int k = 0; k < 3; ++k) {
-        diff += std::abs(static_cast<double>(frames[0].hdr.rgb[3 * i + k]) - ref.rgb[3 * i + k]);
+        diff += std::abs(static_cast<double>(f.frame.hdr.rgb[3 * i + k]) - ref.rgb[3 * i + k]);
         unclipped_diff += std::abs(static_cast<double>(unclipped.rgb[3 * i + k]) - ref.rgb[3 * i + k]);
         total += ref.rgb[3 * i + k];
       }
