@@ -133,6 +133,8 @@ int run_slim_bench(const SlimBenchOptions& opts) {
   std::ofstream md(opts.out / "slim.md");
   md << "# SLIM point sampling against the CPU reference (" << size << "x" << size << ", "
      << renderer.description() << ")\n\n"
+     << "Reference: " << opts.reference_samples << " x " << opts.reference_samples
+     << " rays per pixel for depth and normal (coverage: the centre ray).\n\n"
      << "Points: sample slots the point passes process per frame (culled slots included). "
         "GPU ms: the whole frame, median of "
      << opts.repeats
@@ -160,7 +162,9 @@ int run_slim_bench(const SlimBenchOptions& opts) {
       auto ref = references.find(st.zoom);
       if (ref == references.end()) {
         const auto t0 = std::chrono::steady_clock::now();
-        ref = references.emplace(st.zoom, slim_reference(scene, scene.cameras[0])).first;
+        ref = references
+                  .emplace(st.zoom, slim_reference(scene, scene.cameras[0], 0, opts.reference_samples))
+                  .first;
         std::fprintf(stderr, "%s zoom %g: reference %.1f s\n", model.name.c_str(), st.zoom,
                      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       }

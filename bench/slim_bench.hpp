@@ -21,6 +21,9 @@ struct SlimBenchOptions {
   // Coverage pictures of the zoom rows (MODEL_zoomZ_fill|nofill.png): grey
   // covered by both, red holes, blue spurious pixels.
   bool images = false;
+  // The reference's depth and normal averaged over K x K rays per pixel (1:
+  // the centre ray; coverage always from the centre ray).
+  int reference_samples = 1;
   // SLIM model files (JSON or binary, e.g. from `beamcast slim fit`) besides
   // the generated sphere and torus.
   std::vector<std::filesystem::path> models;

@@ -52,6 +52,9 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::Range(16, 4096));
   slim->add_option("--repeats", sopts->repeats, "GPU frames per row, median reported (default 3)")
       ->check(CLI::Range(1, 100));
+  slim->add_option("--reference-samples", sopts->reference_samples,
+                   "Reference depth and normal averaged over K x K rays per pixel (default 1: the centre)")
+      ->check(CLI::Range(1, 8));
   slim->add_flag("--images", sopts->images,
                  "Coverage pictures of the zoom rows (grey: both, red: holes, blue: spurious)");
   slim->add_option("--model", sopts->models,

@@ -12,7 +12,7 @@
 
 namespace beamcast {
 
-SlimPixels slim_reference(const Scene& scene, const Camera& cam, int threads) {
+SlimPixels slim_reference(const Scene& scene, const Camera& cam, int threads, int samples) {
   SlimPixels out;
   out.width = cam.width;
   out.height = cam.height;
@@ -25,23 +25,51 @@ SlimPixels slim_reference(const Scene& scene, const Camera& cam, int threads) {
     if (const auto* s = std::get_if<SlimOccluder>(&o.shape)) slims.push_back(s);
   }
   const CameraBasis basis = camera_basis(cam);
+  // The nearest hit along a ray through window position (wx, wy).
+  auto trace = [&](double wx, double wy, double* depth, Vec3* normal) {
+    const Ray ray = camera_ray_ndc(cam, basis, 2.0 * wx / cam.width - 1.0, 2.0 * wy / cam.height - 1.0);
+    double best = ray.t_max;
+    std::optional<OccluderHit> hit;
+    for (const SlimOccluder* s : slims) {
+      if (auto h = s->intersect(ray.origin, ray.dir, ray.t_min, best)) {
+        best = h->t;
+        hit = h;
+      }
+    }
+    if (!hit) return false;
+    *depth = dot(ray.origin + hit->t * ray.dir - basis.eye, basis.forward);
+    *normal = hit->n;
+    return true;
+  };
   parallel_items(cam.height, threads, [&](int y) {
     const int py = cam.height - 1 - y;  // GL rows count from the bottom
     for (int x = 0; x < cam.width; ++x) {
-      const Ray ray = camera_ray(cam, basis, x, py);
-      double best = ray.t_max;
-      std::optional<OccluderHit> hit;
-      for (const SlimOccluder* s : slims) {
-        if (auto h = s->intersect(ray.origin, ray.dir, ray.t_min, best)) {
-          best = h->t;
-          hit = h;
+      const std::size_t i = static_cast<std::size_t>(y) * cam.width + x;
+      double depth = 0.0;
+      Vec3 normal{};
+      if (!trace(x + 0.5, py + 0.5, &depth, &normal)) continue;
+      out.covered[i] = 1;
+      if (samples > 1) {
+        double sum_depth = 0.0;
+        Vec3 sum_normal{0.0, 0.0, 0.0};
+        int hits = 0;
+        for (int sy = 0; sy < samples; ++sy) {
+          for (int sx = 0; sx < samples; ++sx) {
+            double d = 0.0;
+            Vec3 nn{};
+            if (!trace(x + (sx + 0.5) / samples, py + (sy + 0.5) / samples, &d, &nn)) continue;
+            sum_depth += d;
+            sum_normal = sum_normal + nn;
+            ++hits;
+          }
+        }
+        if (hits > 0) {
+          depth = sum_depth / hits;
+          if (length(sum_normal) > 0.0) normal = normalize(sum_normal);
         }
       }
-      if (!hit) continue;
-      const std::size_t i = static_cast<std::size_t>(y) * cam.width + x;
-      out.covered[i] = 1;
-      out.depth[i] = static_cast<float>(dot(ray.origin + hit->t * ray.dir - basis.eye, basis.forward));
-      out.normal[i] = hit->n;
+      out.depth[i] = static_cast<float>(depth);
+      out.normal[i] = normal;
     }
   });
   return out;

@@ -22,7 +22,10 @@ struct SlimPixels {
 
 // The reference: every slim occluder of `scene` ray cast per pixel, the
 // nearest hit kept (other occluders are not drawn). threads <= 0: all cores.
-SlimPixels slim_reference(const Scene& scene, const Camera& cam, int threads = 0);
+// samples > 1: coverage still from the pixel's centre ray, depth and normal
+// the mean over samples x samples rays spread over the pixel (those that
+// hit): the pixel-area surface the points' blend estimates.
+SlimPixels slim_reference(const Scene& scene, const Camera& cam, int threads = 0, int samples = 1);
 
 // The GPU's surface from the slim_sum_normal and slim_sum_albedo targets
 // (RGBA float, top-down, as FrameOptions::read_targets returns them).

@@ -14,6 +14,7 @@
 #include "protocol/scene_json.hpp"
 #include "protocol/slim_io.hpp"
 #include "protocol/slim_model.hpp"
+#include "render/slim_compare.hpp"
 #include "tests/common/slim_shapes.hpp"
 
 namespace beamcast {
@@ -112,6 +113,50 @@ TEST(SlimModel, TransformsMoveTheSurfacePointsRigidlyAndScaleThem) {
                 1e-6);
     }
   }
+}
+
+// The supersampled reference averages depth and normal over the pixel: on a
+// tilted plane seen by an orthographic camera the view depth is linear in
+// the window, so the 4 x 4 mean equals the centre's; the normal is the
+// plane's either way. Coverage comes from the centre ray in both.
+TEST(SlimReference, SupersampledDepthIsThePixelMeanOnAPlane) {
+  Scene scene;
+  std::vector<SlimSphere> spheres(1);
+  spheres[0].radius = 3.0;
+  spheres[0].rotation = quat_from_axes({1, 0, 0}, normalize(Vec3{0, 1, 1}), normalize(Vec3{0, -1, 1}));
+  scene.occluders.push_back(Occluder{SlimOccluder::from_spheres(spheres), {0.5, 0.5, 0.5}, {}});
+  Camera cam;
+  cam.projection = Projection::kOrthographic;
+  cam.ortho_height = 2.0;
+  cam.position = {0.0, 0.0, 5.0};
+  cam.target = Vec3{0.0, 0.0, 0.0};
+  cam.width = cam.height = 16;
+  const SlimPixels one = slim_reference(scene, cam, 1, 1);
+  const SlimPixels many = slim_reference(scene, cam, 1, 4);
+  EXPECT_EQ(one.covered, many.covered);
+  int covered = 0;
+  for (std::size_t i = 0; i < one.covered.size(); ++i) {
+    if (!one.covered[i]) continue;
+    ++covered;
+    EXPECT_NEAR(many.depth[i], one.depth[i], 1e-5) << i;
+    EXPECT_LT(angle_deg(many.normal[i], normalize(Vec3{0, -1, 1})), 1e-4) << i;
+  }
+  EXPECT_EQ(covered, 256);
+  // On a sphere the depth is not linear across a pixel: the means differ
+  // from the centres (the sub-rays do sample the pixel's area).
+  Scene round;
+  round.occluders.push_back(
+      Occluder{SlimOccluder::from_spheres(test::slim_sphere({0, 0, 0}, 1.0, 400)), {0.5, 0.5, 0.5}, {}});
+  cam.ortho_height = 2.4;
+  const SlimPixels c1 = slim_reference(round, cam, 1, 1);
+  const SlimPixels c4 = slim_reference(round, cam, 1, 4);
+  int differ = 0, hits = 0;
+  for (std::size_t i = 0; i < c1.covered.size(); ++i) {
+    if (!c1.covered[i]) continue;
+    ++hits;
+    if (std::abs(c4.depth[i] - c1.depth[i]) > 1e-4) ++differ;
+  }
+  EXPECT_GT(differ, hits / 2);
 }
 
 // ---- The scene format -------------------------------------------------------------
