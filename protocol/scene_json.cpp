@@ -3,6 +3,8 @@
 #include "protocol/scene_json.hpp"
 
 #include <algorithm>
+#include <array>
+#include <span>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -787,10 +789,14 @@ void check_method_fits_densities(const Scene& scene) {
   }
 }
 
-// The SLIM point sampling knobs (issue 16; docs/slim.md).
+// The SLIM point sampling knobs (issue 16; docs/slim.md), also listed by
+// `hello` (scene_capabilities).
+constexpr std::array<std::string_view, 4> kSlimSettingFields{"sampling", "depth_threshold", "fill_holes",
+                                                             "cull_backfaces"};
+
 SlimSettings parse_slim_settings(const Node& n) {
   ObjectReader o(n, "slim settings");
-  o.allow_only({"sampling", "depth_threshold", "fill_holes", "cull_backfaces"});
+  o.allow_only(std::span<const std::string_view>(kSlimSettingFields));
   SlimSettings s;
   // S above 16 leaves 8-pixel gaps that no threshold closes; below 0.25
   // every sphere emits 64 points per pixel it covers.
@@ -902,7 +908,8 @@ nlohmann::json scene_capabilities() {
           {"material_types", {"diffuse", "mirror", "glass"}},
           {"gi_kernels", {"box", "cone", "epanechnikov"}},
           {"gi_direct", {"shadow_maps", "photons"}},
-          {"camera_rigs", enum_names(kRigKinds)}};
+          {"camera_rigs", enum_names(kRigKinds)},
+          {"slim_settings", std::vector<std::string_view>(kSlimSettingFields.begin(), kSlimSettingFields.end())}};
 }
 
 }  // namespace beamcast

@@ -4,6 +4,7 @@
 // model files (JSON and binary).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -241,6 +242,26 @@ TEST(SlimFormat, BadFieldsAreRefusedWithTheirPath) {
   EXPECT_REJECTED(settings, "wrong_type", "/slim/cull_backfaces");
   settings["slim"] = {{"holes", true}};
   EXPECT_REJECTED(settings, "unknown_field", "/slim/holes");
+}
+
+// hello lists the kind and the settings the parser accepts (each of them
+// parses; a field not listed is refused above).
+TEST(SlimFormat, HelloListsTheKindAndTheSettings) {
+  const json caps = scene_capabilities();
+  const auto& types = caps.at("occluder_types");
+  EXPECT_NE(std::find(types.begin(), types.end(), "slim"), types.end());
+  json scene = slim_scene({{"type", "slim"}, {"spheres", {one_sphere()}}});
+  scene["slim"] = json::object();
+  for (const auto& field : caps.at("slim_settings")) {
+    const std::string name = field.get<std::string>();
+    scene["slim"][name] = name == "sampling" ? json(3.0) : name == "depth_threshold" ? json(0.5) : json(false);
+  }
+  EXPECT_EQ(caps.at("slim_settings").size(), 4u);
+  const Scene parsed = parse_scene(scene, {});
+  EXPECT_EQ(parsed.slim.sampling, 3.0);
+  EXPECT_EQ(parsed.slim.depth_threshold, 0.5);
+  EXPECT_FALSE(parsed.slim.fill_holes);
+  EXPECT_FALSE(parsed.slim.cull_backfaces);
 }
 
 TEST(SlimFormat, TheSphereCountIsLimitedOverTheScene) {
