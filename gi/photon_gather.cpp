@@ -30,10 +30,14 @@ double splat_kernel(SplatKernel kernel, double d, double r) {
 
 namespace {
 
+// Photons [first, first + count) of one vector: the global map's, the
+// caustic map's, or both (nearest), without copies.
 struct Cloud {
   const std::vector<Photon>* photons;
-  std::size_t kdtree_get_point_count() const { return photons->size(); }
-  float kdtree_get_pt(std::size_t i, std::size_t dim) const { return (*photons)[i].p[dim]; }
+  std::size_t first = 0, count = 0;
+  std::size_t kdtree_get_point_count() const { return count; }
+  float kdtree_get_pt(std::size_t i, std::size_t dim) const { return (*photons)[first + i].p[dim]; }
+  const Photon& at(std::size_t i) const { return (*photons)[first + i]; }
   template <class Box>
   bool kdtree_get_bbox(Box&) const {
     return false;
@@ -53,47 +57,40 @@ bool passes(const Photon& p, const Vec3& x, const Vec3& n, double r, const Splat
 }  // namespace
 
 struct PhotonGather::Index {
-  std::vector<Photon> points;  // the global map's index keeps its own copy
   Cloud cloud;
   Tree tree;
-  explicit Index(const std::vector<Photon>* photons)
-      : cloud{photons}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
-    tree.buildIndex();
-  }
-  explicit Index(std::vector<Photon> own)
-      : points(std::move(own)), cloud{&points}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+  Index(const std::vector<Photon>* photons, std::size_t first, std::size_t count)
+      : cloud{photons, first, count}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
     tree.buildIndex();
   }
 };
 
 PhotonGather::PhotonGather(const PhotonMaps& maps, bool skip_direct) {
+  std::size_t global_count = 0;
   for (const auto* map : {&maps.global, &maps.caustic}) {
     for (const Photon& p : *map) {
-      if (skip_direct && p.bounces == 0) continue;
-      photons_.push_back(p);
-      if (map == &maps.caustic) caustic_.push_back(p);
+      if (!skip_direct || p.bounces != 0) photons_.push_back(p);
     }
-    if (map == &maps.global) global_count_ = photons_.size();
+    if (map == &maps.global) global_count = photons_.size();
   }
-  index_ = std::make_unique<Index>(&photons_);
-  global_index_ = std::make_unique<Index>(
-      std::vector<Photon>(photons_.begin(), photons_.begin() + static_cast<std::ptrdiff_t>(global_count_)));
-  caustic_index_ = std::make_unique<Index>(&caustic_);
+  index_ = std::make_unique<Index>(&photons_, 0, photons_.size());
+  global_index_ = std::make_unique<Index>(&photons_, 0, global_count);
+  caustic_index_ = std::make_unique<Index>(&photons_, global_count, photons_.size() - global_count);
 }
 
 PhotonGather::~PhotonGather() = default;
 
-Color PhotonGather::within(const Index& index, const std::vector<Photon>& photons, const Vec3& x,
-                           const Vec3& n, double r, SplatKernel kernel, const SplatTests& tests) const {
+Color PhotonGather::within(const Index& index, const Vec3& x, const Vec3& n, double r, SplatKernel kernel,
+                           const SplatTests& tests) const {
   Color sum{0.0, 0.0, 0.0};
-  if (photons.empty() || !(r > 0.0)) return sum;
+  if (index.cloud.count == 0 || !(r > 0.0)) return sum;
   const float q[3] = {static_cast<float>(x[0]), static_cast<float>(x[1]), static_cast<float>(x[2])};
   std::vector<std::pair<std::uint32_t, float>> found;
   nanoflann::SearchParams params;
   params.sorted = false;
   index.tree.radiusSearch(q, static_cast<float>(r * r) * 1.0001f, found, params);
   for (const auto& [i, d2] : found) {
-    const Photon& p = photons[i];
+    const Photon& p = index.cloud.at(i);
     const double d = length(x - pos(p));
     const double w = splat_kernel(kernel, d, r);
     if (w == 0.0 || !passes(p, x, n, r, tests)) continue;
@@ -104,8 +101,8 @@ Color PhotonGather::within(const Index& index, const std::vector<Photon>& photon
 
 Color PhotonGather::fixed_radius(const Vec3& x, const Vec3& n, const Color& albedo, const SplatRadii& radii,
                                  SplatKernel kernel, const SplatTests& tests) const {
-  const Color sum = within(*global_index_, global_index_->points, x, n, radii.global, kernel, tests) +
-                    within(*caustic_index_, caustic_, x, n, radii.caustic, kernel, tests);
+  const Color sum = within(*global_index_, x, n, radii.global, kernel, tests) +
+                    within(*caustic_index_, x, n, radii.caustic, kernel, tests);
   return {albedo[0] / std::numbers::pi * sum[0], albedo[1] / std::numbers::pi * sum[1],
           albedo[2] / std::numbers::pi * sum[2]};
 }

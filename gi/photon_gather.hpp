@@ -42,13 +42,12 @@ class PhotonGather {
 
  private:
   struct Index;
-  std::vector<Photon> photons_;  // both maps (nearest)
-  std::unique_ptr<Index> index_;
-  std::size_t global_count_ = 0;  // photons_[0, global_count_) are the global map's
-  std::vector<Photon> caustic_;   // the caustic map's, for its own radius
-  std::unique_ptr<Index> global_index_, caustic_index_;
-  Color within(const Index& index, const std::vector<Photon>& photons, const Vec3& x, const Vec3& n,
-               double r, SplatKernel kernel, const SplatTests& tests) const;
+  std::vector<Photon> photons_;  // the global map's, then the caustic map's
+  // Trees over photons_: all of them (nearest), the global and the caustic
+  // map's (fixed radius, each map with its own radius).
+  std::unique_ptr<Index> index_, global_index_, caustic_index_;
+  Color within(const Index& index, const Vec3& x, const Vec3& n, double r, SplatKernel kernel,
+               const SplatTests& tests) const;
 };
 
 enum class GatherMethod { kFixedRadius, kNearest };

@@ -221,7 +221,7 @@ double default_caustic_radius(const Scene& scene, std::int64_t caustic_photons) 
 }
 
 SplatRadii splat_radii(const Scene& scene, double drawn) {
-  const double share = std::clamp(drawn, 1e-3, 1.0);
+  const double share = display_share(drawn);
   auto count = [&](std::int64_t n) {
     return std::max<std::int64_t>(1, std::llround(share * static_cast<double>(n)));
   };

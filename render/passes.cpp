@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "gi/photon_map.hpp"
 #include "render/slim_pass.hpp"
 #include "shaders/shader_sources.hpp"
 
@@ -446,7 +447,7 @@ class PhotonPass final : public Pass {
     const GLsizei split_all = ctx.resources.photon_caustic_first();
     const GLsizei total_all = ctx.resources.photon_count();
     // gi.display_fraction: the first share of each map, power scaled up.
-    const double share = std::clamp(ctx.scene.gi.display_fraction, 1e-3, 1.0);
+    const double share = display_share(ctx.scene.gi.display_fraction);
     auto part = [&](GLsizei n) {
       return static_cast<GLsizei>(std::llround(share * static_cast<double>(n)));
     };

@@ -71,21 +71,15 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
   if (settings.cull_backfaces && faces_away(sphere, p, length(p), ortho, basis.forward)) return {};
   const double th = ortho ? basis.half_height : basis.tan_half_fov;
   const double tw = th * basis.aspect;
-  // Pixels per world unit at the sphere's nearest depth and at its centre's.
-  double ppw = 0.0, ppw_centre = 0.0;
-  if (ortho) {
-    if (std::abs(x) > tw + r || std::abs(y) > th + r) return {};
-    ppw = ppw_centre = cam.height / (2.0 * th);
-  } else {
-    // Outside a side plane of the frustum by more than r: culled.
-    if ((std::abs(x) - tw * z) / std::sqrt(1.0 + tw * tw) > r ||
-        (std::abs(y) - th * z) / std::sqrt(1.0 + th * th) > r) {
-      return {};
-    }
-    const double z_near = std::max(z - r, cam.near_plane);
-    ppw = cam.height / (2.0 * th * z_near);
-    ppw_centre = cam.height / (2.0 * th * std::max(z, z_near));
+  // Culled outside the frustum (a side plane farther than r away).
+  if (ortho ? std::abs(x) > tw + r || std::abs(y) > th + r
+            : (std::abs(x) - tw * z) / std::sqrt(1.0 + tw * tw) > r ||
+                  (std::abs(y) - th * z) / std::sqrt(1.0 + th * th) > r) {
+    return {};
   }
+  // Pixels per world unit at the depth d (orthographic: everywhere).
+  auto ppw = [&](double d) { return cam.height / (2.0 * th * (ortho ? 1.0 : d)); };
+  const double ppw_centre = ppw(std::max(z, cam.near_plane));
   // N: the sphere's projected width, at its centre's depth (the seed's);
   // nearer parts project wider, which the second stage fills.
   const double n_px = 2.0 * r * ppw_centre;
@@ -104,7 +98,7 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
       const Vec3 q = sphere.surface_point(u, v) - basis.eye;
       const double qz = dot(q, basis.forward);
       if (!ortho && !(qz > cam.near_plane)) return false;
-      const double scale = ortho ? ppw : cam.height / (2.0 * th * qz);
+      const double scale = ppw(qz);
       (*out)[0] = dot(q, basis.right) * scale;
       (*out)[1] = dot(q, basis.up) * scale;
       return true;
@@ -135,11 +129,12 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
 
 SlimResources::SlimResources(const Scene& scene) {
   Aabb box;
-  for (std::size_t o = 0; o < scene.occluders.size(); ++o) {
-    if (const auto* slim = std::get_if<SlimOccluder>(&scene.occluders[o].shape)) {
+  std::vector<const Occluder*> occluder_of;  // each sphere's occluder (its albedo)
+  for (const Occluder& occ : scene.occluders) {
+    if (const auto* slim = std::get_if<SlimOccluder>(&occ.shape)) {
       for (const SlimSphere& s : slim->spheres()) {
         spheres_.push_back(&s);
-        occluder_of_.push_back(static_cast<std::uint32_t>(o));
+        occluder_of.push_back(&occ);
       }
       box.grow(slim->bounds());
     }
@@ -149,7 +144,7 @@ SlimResources::SlimResources(const Scene& scene) {
   std::vector<std::uint32_t> index(spheres_.size());
   for (std::size_t i = 0; i < spheres_.size(); ++i) {
     const SlimSphere& s = *spheres_[i];
-    const Occluder& occ = scene.occluders[occluder_of_[i]];
+    const Occluder& occ = *occluder_of[i];
     SlimGpu& d = data[i];
     auto put = [](float* out, const Vec3& v, double w) {
       for (int k = 0; k < 3; ++k) out[k] = static_cast<float>(v[k]);

@@ -71,7 +71,6 @@ class SlimResources {
 
  private:
   std::vector<const SlimSphere*> spheres_;
-  std::vector<std::uint32_t> occluder_of_;
   Vec3 anchor_{};
   GlBuffer sphere_ssbo_, index_vbo_, command_buffer_, grid_ssbo_;
   GlVertexArray vao_;
