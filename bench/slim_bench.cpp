@@ -103,11 +103,12 @@ int run_slim_bench(const SlimBenchOptions& opts) {
     models[models.size() - opts.models.size() + i].mesh = opts.meshes[i];
   }
   std::vector<Setting> settings;
-  auto with = [](double s, double t, bool fill) {
+  auto with = [](double s, double t, bool fill, SlimEvaluation e = SlimEvaluation::kField) {
     SlimSettings x;
     x.sampling = s;
     x.depth_threshold = t;
     x.fill_holes = fill;
+    x.evaluation = e;
     return x;
   };
   const std::vector<double> zooms = opts.quick ? std::vector<double>{0.25, 1.0, 4.0}
@@ -115,6 +116,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
   for (double z : zooms) {
     settings.push_back({"zoom", with(2.0, 0.25, true), z});
     settings.push_back({"zoom, no 2nd stage", with(2.0, 0.25, false), z});
+    settings.push_back({"zoom, seed's blend", with(2.0, 0.25, true, SlimEvaluation::kBlend), z});
   }
   for (double s : opts.quick ? std::vector<double>{1.0, 4.0} : std::vector<double>{1.0, 4.0, 8.0}) {
     settings.push_back({"S", with(s, 0.25, true), 1.0});
@@ -126,7 +128,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
   ropts.egl = opts.egl;
   Renderer renderer(ropts);
   std::ofstream csv(opts.out / "slim.csv");
-  csv << "model,spheres,knob,sampling,depth_threshold,fill_holes,zoom,size,points,gpu_ms,slim_ms,"
+  csv << "model,spheres,knob,evaluation,sampling,depth_threshold,fill_holes,zoom,size,points,gpu_ms,slim_ms,"
          "reference_pixels,holes,interior_holes,spurious,spurious_far,other_layer,depth_mean,"
          "depth_p99,depth_max,normal_mean_deg,normal_p99_deg,normal_max_deg,interior,interior_depth_p99,"
          "interior_normal_p99_deg,crease_pixels,crease_normal_mean_deg\n";
@@ -141,13 +143,14 @@ int run_slim_bench(const SlimBenchOptions& opts) {
      << "; slim ms: the three slim passes. Holes: pixels the reference covers and the points do "
         "not (interior: all 8 neighbours covered by the reference); spurious: the reverse (far: "
         "no covered neighbour). Depth: |GPU - reference| view depth at the model scaled to "
-        "size 10 (its box diagonal). Normal: angle between the blended point normal and F's "
-        "gradient. Inner: the pixels whose 3x3 neighbourhood both cover (not the outline). Crease: inner "
+        "size 10 (its box diagonal). Normal: angle between the GPU's normal and F's "
+        "gradient. Evaluation: field (F and its gradient at each pixel's centre ray) or blend "
+        "(the seed's weighted mean of the points' depths and normals). Inner: the pixels whose 3x3 neighbourhood both cover (not the outline). Crease: inner "
         "pixels where the reference's normal turns by over 30 degrees to a neighbour.\n\n"
-     << "| model | spheres | knob | S | t | 2nd stage | zoom | points | GPU ms | slim ms | ref px | "
+     << "| model | spheres | knob | evaluation | S | t | 2nd stage | zoom | points | GPU ms | slim ms | ref px | "
         "holes | interior | spurious | far | depth mean | depth p99 | normal mean ° | normal p99 ° | "
         "inner depth p99 | inner normal p99 ° | crease px | crease normal ° |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Model& model : models) {
     Scene base;
     base.occluders.push_back(
@@ -174,7 +177,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
       FrameResult last;
       for (int r = 0; r < std::max(1, opts.repeats); ++r) {
         fo.read_targets.clear();
-        if (r + 1 == std::max(1, opts.repeats)) fo.read_targets = {"slim_sum_normal", "slim_sum_albedo"};
+        if (r + 1 == std::max(1, opts.repeats)) fo.read_targets = {"slim_surface"};
         auto frames = renderer.render(scene, fo);
         gpu.push_back(frames[0].gpu_ms);
         double s = 0.0;
@@ -184,20 +187,20 @@ int run_slim_bench(const SlimBenchOptions& opts) {
         slim_ms.push_back(s);
         last = std::move(frames[0]);
       }
-      const SlimPixels pts = slim_from_sums(last.targets["slim_sum_normal"], last.targets["slim_sum_albedo"],
-                                            size, size);
+      const SlimPixels pts = slim_from_surface(last.targets["slim_surface"], size, size);
       const SlimErrors e = compare_slim(pts, ref->second, model_size);
+      const char* eval_name = st.slim.evaluation == SlimEvaluation::kField ? "field" : "blend";
       if (opts.images && st.knob.rfind("zoom", 0) == 0) {
         char name[256];
-        std::snprintf(name, sizeof name, "%s_zoom%g_%s.png", model.name.c_str(), st.zoom,
-                      st.slim.fill_holes ? "fill" : "nofill");
+        std::snprintf(name, sizeof name, "%s_zoom%g_%s_%s.png", model.name.c_str(), st.zoom,
+                      st.slim.fill_holes ? "fill" : "nofill", eval_name);
         write_png(opts.out / name, coverage_image(pts, ref->second));
       }
       char line[1024];
       std::snprintf(line, sizeof line,
-                    "%s,%zu,%s,%g,%g,%d,%g,%d,%lld,%.2f,%.2f,%lld,%lld,%lld,%lld,%lld,%lld,%.5f,%.5f,%.4f,%.4f,"
+                    "%s,%zu,\"%s\",%s,%g,%g,%d,%g,%d,%lld,%.2f,%.2f,%lld,%lld,%lld,%lld,%lld,%lld,%.5f,%.5f,%.4f,%.4f,"
                     "%.4f,%.4f,%lld,%.5f,%.4f,%lld,%.4f\n",
-                    model.name.c_str(), model.spheres.size(), st.knob.c_str(), st.slim.sampling,
+                    model.name.c_str(), model.spheres.size(), st.knob.c_str(), eval_name, st.slim.sampling,
                     st.slim.depth_threshold, st.slim.fill_holes ? 1 : 0, st.zoom, size,
                     static_cast<long long>(last.slim_points), median(gpu), median(slim_ms),
                     static_cast<long long>(e.reference_pixels), static_cast<long long>(e.holes),
@@ -209,9 +212,9 @@ int run_slim_bench(const SlimBenchOptions& opts) {
                     e.crease_normal_mean_deg);
       csv << line << std::flush;
       std::snprintf(line, sizeof line,
-                    "| %s | %zu | %s | %g | %g | %s | %g | %lld | %.1f | %.1f | %lld | %lld | %lld | %lld | "
+                    "| %s | %zu | %s | %s | %g | %g | %s | %g | %lld | %.1f | %.1f | %lld | %lld | %lld | %lld | "
                     "%lld | %.4f | %.4f | %.3f | %.2f | %.4f | %.2f | %lld | %.1f |\n",
-                    model.name.c_str(), model.spheres.size(), st.knob.c_str(), st.slim.sampling,
+                    model.name.c_str(), model.spheres.size(), st.knob.c_str(), eval_name, st.slim.sampling,
                     st.slim.depth_threshold, st.slim.fill_holes ? "on" : "off", st.zoom,
                     static_cast<long long>(last.slim_points), median(gpu), median(slim_ms),
                     static_cast<long long>(e.reference_pixels), static_cast<long long>(e.holes),

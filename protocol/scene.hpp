@@ -107,6 +107,17 @@ struct GiSettings {
 
 // SLIM point sampling ("slim" in JSON; issue 16): the accuracy knobs of the
 // GPU pass (docs/slim.md measures each against time).
+// How a pixel's surface is computed from the SLIM points that reach it.
+enum class SlimEvaluation : std::uint8_t {
+  // F and its gradient evaluated at the pixel's centre ray, over the
+  // spheres whose points reach the pixel: view depth by a Newton step of F
+  // along the ray, normal from F's gradient (the reference's surface).
+  kField,
+  // The seed's: the points' weighted mean depth and normal (each point's own
+  // height-field normal).
+  kBlend,
+};
+
 struct SlimSettings {
   // S: the (u, v) grid step is n = S r / N, N the sphere's projected width
   // (diameter) in pixels, so S = 2 puts samples about one pixel apart.
@@ -121,6 +132,7 @@ struct SlimSettings {
   // points lie behind the front of a closed surface); false for open
   // sheets meant to be seen from both sides.
   bool cull_backfaces = true;
+  SlimEvaluation evaluation = SlimEvaluation::kField;
 };
 
 // One directional light for Lambert shading of occluders.

@@ -791,8 +791,8 @@ void check_method_fits_densities(const Scene& scene) {
 
 // The SLIM point sampling knobs (issue 16; docs/slim.md), also listed by
 // `hello` (scene_capabilities).
-constexpr std::array<std::string_view, 4> kSlimSettingFields{"sampling", "depth_threshold", "fill_holes",
-                                                             "cull_backfaces"};
+constexpr std::array<std::string_view, 5> kSlimSettingFields{"sampling", "depth_threshold", "fill_holes",
+                                                             "cull_backfaces", "evaluation"};
 
 SlimSettings parse_slim_settings(const Node& n) {
   ObjectReader o(n, "slim settings");
@@ -806,6 +806,9 @@ SlimSettings parse_slim_settings(const Node& n) {
   }
   if (auto v = o.optional("fill_holes")) s.fill_holes = read_bool(*v);
   if (auto v = o.optional("cull_backfaces")) s.cull_backfaces = read_bool(*v);
+  if (auto v = o.optional("evaluation")) {
+    s.evaluation = read_enum<SlimEvaluation>(*v, {{"field", SlimEvaluation::kField}, {"blend", SlimEvaluation::kBlend}});
+  }
   return s;
 }
 

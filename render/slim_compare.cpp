@@ -75,8 +75,7 @@ SlimPixels slim_reference(const Scene& scene, const Camera& cam, int threads, in
   return out;
 }
 
-SlimPixels slim_from_sums(const std::vector<float>& sum_normal, const std::vector<float>& sum_albedo,
-                          int width, int height) {
+SlimPixels slim_from_surface(const std::vector<float>& surface, int width, int height) {
   SlimPixels out;
   out.width = width;
   out.height = height;
@@ -84,15 +83,14 @@ SlimPixels slim_from_sums(const std::vector<float>& sum_normal, const std::vecto
   out.covered.assign(n, 0);
   out.depth.assign(n, 0.0f);
   out.normal.assign(n, Vec3{0.0, 0.0, 0.0});
-  if (sum_normal.size() < 4 * n || sum_albedo.size() < 4 * n) return out;
+  if (surface.size() < 4 * n) return out;
   for (std::size_t i = 0; i < n; ++i) {
-    const float w = sum_normal[4 * i + 3];
-    if (!(w > 0.0f)) continue;
-    out.covered[i] = 1;
-    out.depth[i] = sum_albedo[4 * i + 3] / w;
-    const Vec3 v{sum_normal[4 * i], sum_normal[4 * i + 1], sum_normal[4 * i + 2]};
+    const Vec3 v{surface[4 * i], surface[4 * i + 1], surface[4 * i + 2]};
     const double len = length(v);
-    out.normal[i] = len > 0.0 ? (1.0 / len) * v : v;
+    if (!(len > 0.0)) continue;
+    out.covered[i] = 1;
+    out.depth[i] = surface[4 * i + 3];
+    out.normal[i] = (1.0 / len) * v;
   }
   return out;
 }

@@ -27,10 +27,10 @@ struct SlimPixels {
 // hit): the pixel-area surface the points' blend estimates.
 SlimPixels slim_reference(const Scene& scene, const Camera& cam, int threads = 0, int samples = 1);
 
-// The GPU's surface from the slim_sum_normal and slim_sum_albedo targets
-// (RGBA float, top-down, as FrameOptions::read_targets returns them).
-SlimPixels slim_from_sums(const std::vector<float>& sum_normal, const std::vector<float>& sum_albedo,
-                          int width, int height);
+// The GPU's surface from the slim_surface target (unit normal, view depth;
+// RGBA float, top-down, as FrameOptions::read_targets returns it): covered
+// where the normal is not zero.
+SlimPixels slim_from_surface(const std::vector<float>& surface, int width, int height);
 
 struct SlimErrors {
   std::int64_t reference_pixels = 0;  // covered by the reference

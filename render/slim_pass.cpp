@@ -224,6 +224,10 @@ void SlimResources::plan_views(const std::vector<Camera>& cams, const std::vecto
 
 namespace {
 
+// Field evaluation: the second point of the centre ray lies this many pixel
+// footprints behind the first (the nearest depth).
+constexpr float kSlimFieldStep = 2.0f;
+
 // Passes 1 and 2: every sphere's points, one indirect command each, per view.
 class SlimPointsPass final : public Pass {
  public:
@@ -244,6 +248,7 @@ class SlimPointsPass final : public Pass {
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     if (!depth_) {
       glBindTextureUnit(1, ctx.targets.texture("slim_near"));
+      glBindTextureUnit(2, ctx.targets.texture("slim_centre"));
       glUniform1f(program_.uniform(multi, "u_threshold"),
                   static_cast<float>(ctx.scene.slim.depth_threshold));
     }
@@ -253,8 +258,23 @@ class SlimPointsPass final : public Pass {
     glBindVertexArray(slim->instance_vao());
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
-    glDisable(GL_PROGRAM_POINT_SIZE);
-    glPointSize(1.0f);
+    // Field evaluation: the accumulate pass's points cover the pixels their
+    // sample can stand for (slim_points.vert sets the size); single pixels
+    // otherwise.
+    const bool field_mode = ctx.scene.slim.evaluation == SlimEvaluation::kField;
+    const int field = !depth_ && field_mode ? 1 : 0;
+    glUniform1i(program_.uniform(multi, "u_field"), field);
+    if (depth_) {
+      glUniform1i(program_.uniform(multi, "u_centre_depth"), field_mode ? 1 : 0);
+    } else {
+      glUniform1f(program_.uniform(multi, "u_step"), kSlimFieldStep);
+    }
+    if (field == 1) {
+      glEnable(GL_PROGRAM_POINT_SIZE);
+    } else {
+      glDisable(GL_PROGRAM_POINT_SIZE);
+      glPointSize(1.0f);
+    }
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
     glBlendEquation(depth_ ? GL_MIN : GL_FUNC_ADD);
@@ -269,6 +289,7 @@ class SlimPointsPass final : public Pass {
     });
     glBlendEquation(GL_FUNC_ADD);
     glDisable(GL_BLEND);
+    glDisable(GL_PROGRAM_POINT_SIZE);
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     gl_check(depth_ ? "slim_depth pass" : "slim_accumulate pass");
   }
@@ -287,8 +308,16 @@ class SlimResolvePass final : public Pass {
     const bool multi = ctx.views > 0;
     glUseProgram(program_.get(multi));
     glUniform1i(program_.uniform(multi, "u_gi"), self.id == PassId::kSlimGbuffer ? 1 : 0);
+    glUniform1i(program_.uniform(multi, "u_field"),
+                ctx.scene.slim.evaluation == SlimEvaluation::kField ? 1 : 0);
     glBindTextureUnit(0, ctx.targets.texture("slim_sum_normal"));
     glBindTextureUnit(1, ctx.targets.texture("slim_sum_albedo"));
+    glBindTextureUnit(2, ctx.targets.texture("slim_sum_field"));
+    glBindTextureUnit(3, ctx.targets.texture("slim_sum_weight"));
+    glBindTextureUnit(4, ctx.targets.texture("slim_centre"));
+    glBindTextureUnit(5, ctx.targets.texture("slim_sum_field2"));
+    glBindTextureUnit(6, ctx.targets.texture("slim_sum_weight2"));
+    glUniform1f(program_.uniform(multi, "u_step"), kSlimFieldStep);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);

@@ -254,14 +254,22 @@ TEST(SlimFormat, HelloListsTheKindAndTheSettings) {
   scene["slim"] = json::object();
   for (const auto& field : caps.at("slim_settings")) {
     const std::string name = field.get<std::string>();
-    scene["slim"][name] = name == "sampling" ? json(3.0) : name == "depth_threshold" ? json(0.5) : json(false);
+    scene["slim"][name] = name == "sampling"          ? json(3.0)
+                          : name == "depth_threshold" ? json(0.5)
+                          : name == "evaluation"      ? json("blend")
+                                                      : json(false);
   }
-  EXPECT_EQ(caps.at("slim_settings").size(), 4u);
+  EXPECT_EQ(caps.at("slim_settings").size(), 5u);
   const Scene parsed = parse_scene(scene, {});
   EXPECT_EQ(parsed.slim.sampling, 3.0);
   EXPECT_EQ(parsed.slim.depth_threshold, 0.5);
   EXPECT_FALSE(parsed.slim.fill_holes);
   EXPECT_FALSE(parsed.slim.cull_backfaces);
+  EXPECT_EQ(parsed.slim.evaluation, SlimEvaluation::kBlend);
+  EXPECT_EQ(parse_scene(slim_scene({{"type", "slim"}, {"spheres", {one_sphere()}}}), {}).slim.evaluation,
+            SlimEvaluation::kField);
+  scene["slim"]["evaluation"] = "exact";
+  EXPECT_REJECTED(scene, "invalid_value", "/slim/evaluation");
 }
 
 TEST(SlimFormat, TheSphereCountIsLimitedOverTheScene) {
