@@ -92,6 +92,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
       {"sphere_400", test::slim_sphere({0, 0, 0}, 1.0, 400, 1.2), {}},
       {"torus_768", test::slim_torus({0, 0, 0}, 2.0, 0.6, 48, 16, 1.0), {}},
   };
+  if (opts.no_generated) models.clear();
   for (const auto& path : opts.models) {
     std::ifstream in(path, std::ios::binary);
     std::ostringstream bytes;
@@ -111,18 +112,24 @@ int run_slim_bench(const SlimBenchOptions& opts) {
     x.evaluation = e;
     return x;
   };
-  const std::vector<double> zooms = opts.quick ? std::vector<double>{0.25, 1.0, 4.0}
-                                               : std::vector<double>{0.25, 1.0, 4.0, 16.0};
+  const std::vector<double> zooms = !opts.zooms.empty() ? opts.zooms
+                                    : opts.quick         ? std::vector<double>{0.25, 1.0, 4.0}
+                                                         : std::vector<double>{0.25, 1.0, 4.0, 16.0};
   for (double z : zooms) {
     settings.push_back({"zoom", with(2.0, 0.25, true), z});
     settings.push_back({"zoom, no 2nd stage", with(2.0, 0.25, false), z});
     settings.push_back({"zoom, seed's blend", with(2.0, 0.25, true, SlimEvaluation::kBlend), z});
   }
-  for (double s : opts.quick ? std::vector<double>{1.0, 4.0} : std::vector<double>{1.0, 4.0, 8.0}) {
+  for (double s : opts.zoom_only ? std::vector<double>{}
+                  : opts.quick   ? std::vector<double>{1.0, 4.0}
+                                 : std::vector<double>{1.0, 4.0, 8.0}) {
     settings.push_back({"S", with(s, 0.25, true), 1.0});
     settings.push_back({"S, no 2nd stage", with(s, 0.25, false), 1.0});
+    settings.push_back({"S, seed's blend", with(s, 0.25, true, SlimEvaluation::kBlend), 1.0});
   }
-  for (double t : {0.05, 1.0}) settings.push_back({"t", with(2.0, t, true), 1.0});
+  if (!opts.zoom_only) {
+    for (double t : {0.05, 1.0}) settings.push_back({"t", with(2.0, t, true), 1.0});
+  }
 
   RendererOptions ropts;
   ropts.egl = opts.egl;

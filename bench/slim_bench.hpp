@@ -24,6 +24,9 @@ struct SlimBenchOptions {
   // The reference's depth and normal averaged over K x K rays per pixel (1:
   // the centre ray; coverage always from the centre ray).
   int reference_samples = 1;
+  std::vector<double> zooms;  // empty: 0.25, 1, 4, 16 (quick: 0.25, 1, 4)
+  bool zoom_only = false;     // skip the S and t rows
+  bool no_generated = false;  // skip the generated sphere and torus
   // SLIM model files (JSON or binary, e.g. from `beamcast slim fit`) besides
   // the generated sphere and torus.
   std::vector<std::filesystem::path> models;

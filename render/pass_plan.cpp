@@ -30,13 +30,13 @@ const std::vector<TargetDecl>& target_catalog() {
       // At gi.splat_scale times fewer pixels per side (indirect light is smooth).
       {"gi_indirect", TargetFormat::kRgba32f, TargetSize::kSplat, TargetClear::kZero},
       // SLIM point sampling (render/slim_pass.cpp): the nearest point's view
-      // depth per pixel (and the nearest at the pixel's centre), then the weighted sums of the points within the
+      // depth per pixel (field evaluation: at the pixel's centre ray), then the weighted sums of the points within the
       // depth threshold behind it: (w n, w) and (w albedo, w view depth);
       // with slim.evaluation "field" also F's terms at two points of the
       // pixel's centre ray (w grad h + h grad w, w h) and (grad w, w). The resolved
       // surface: (unit normal, view depth), zero where none.
       {"slim_near", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
-      {"slim_centre", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
+      {"slim_radius", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
       {"slim_sum_normal", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       {"slim_sum_albedo", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       {"slim_sum_field", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
@@ -68,22 +68,22 @@ const std::vector<PassDecl>& pass_catalog() {
       // targets (before the lighting passes, which shade them like any
       // occluder). Points behind a nearer occluder are dropped.
       {PassId::kSlimDepth, "slim_depth", [](const PlanInput& in) { return has_slim(in.scene); },
-       {"view_depth"}, {}, {"slim_near", "slim_centre"}, {"slim"}},
+       {"view_depth"}, {}, {"slim_near", "slim_radius"}, {"slim"}},
       {PassId::kSlimAccumulate, "slim_accumulate",
-       [](const PlanInput& in) { return has_slim(in.scene); }, {"view_depth", "slim_near", "slim_centre"}, {},
+       [](const PlanInput& in) { return has_slim(in.scene); }, {"view_depth", "slim_near", "slim_radius"}, {},
        {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_sum_field2",
         "slim_sum_weight2"},
        {"slim"}},
       {PassId::kSlimResolve, "slim_resolve",
        [](const PlanInput& in) { return has_slim(in.scene) && !in.scene.has_gi(); },
-       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_centre", "slim_sum_field2",
-        "slim_sum_weight2"},
+       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_near", "slim_sum_field2",
+        "slim_sum_weight2", "slim_radius"},
        {},
        {"hdr", "view_depth", "slim_surface"}, {}},
       {PassId::kSlimGbuffer, "slim_gbuffer",
        [](const PlanInput& in) { return has_slim(in.scene) && in.scene.has_gi(); },
-       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_centre", "slim_sum_field2",
-        "slim_sum_weight2"},
+       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_near", "slim_sum_field2",
+        "slim_sum_weight2", "slim_radius"},
        {},
        {"hdr", "view_depth", "slim_surface", "gb_normal", "gb_albedo"}, {}},
       // Direct light of a lit scene (gi.direct "shadow_maps"): every light as

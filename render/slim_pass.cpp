@@ -61,6 +61,10 @@ bool faces_away(const SlimSphere& sphere, const Vec3& to_centre, double distance
 
 }  // namespace
 
+double slim_cell_diagonal(const SlimSettings& settings) {
+  return settings.evaluation == SlimEvaluation::kField ? 6.0 : std::sqrt(3.0) / 2.0;
+}
+
 SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasis& basis,
                    const SlimSettings& settings) {
   const Vec3 p = sphere.center - basis.eye;
@@ -122,7 +126,7 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
       }
     }
     g.s = static_cast<std::uint32_t>(
-        std::clamp(std::ceil(1.1 * worst / (std::sqrt(3.0) / 2.0)), 1.0, static_cast<double>(kSlimMaxFill)));
+        std::clamp(std::ceil(1.1 * worst / slim_cell_diagonal(settings)), 1.0, static_cast<double>(kSlimMaxFill)));
   }
   return g;
 }
@@ -248,7 +252,7 @@ class SlimPointsPass final : public Pass {
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     if (!depth_) {
       glBindTextureUnit(1, ctx.targets.texture("slim_near"));
-      glBindTextureUnit(2, ctx.targets.texture("slim_centre"));
+      glBindTextureUnit(2, ctx.targets.texture("slim_radius"));
       glUniform1f(program_.uniform(multi, "u_threshold"),
                   static_cast<float>(ctx.scene.slim.depth_threshold));
     }
@@ -258,18 +262,13 @@ class SlimPointsPass final : public Pass {
     glBindVertexArray(slim->instance_vao());
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
-    // Field evaluation: the accumulate pass's points cover the pixels their
-    // sample can stand for (slim_points.vert sets the size); single pixels
-    // otherwise.
-    const bool field_mode = ctx.scene.slim.evaluation == SlimEvaluation::kField;
-    const int field = !depth_ && field_mode ? 1 : 0;
-    glUniform1i(program_.uniform(multi, "u_field"), field);
-    if (depth_) {
-      glUniform1i(program_.uniform(multi, "u_centre_depth"), field_mode ? 1 : 0);
-    } else {
-      glUniform1f(program_.uniform(multi, "u_step"), kSlimFieldStep);
-    }
-    if (field == 1) {
+    // Field evaluation: points cover the pixels their sample can stand for
+    // (slim_points.vert sets the size); the seed's blend: single pixels.
+    const bool field = ctx.scene.slim.evaluation == SlimEvaluation::kField;
+    glUniform1i(program_.uniform(multi, "u_field"), field ? 1 : 0);
+    glUniform1f(program_.uniform(multi, "u_cell_diag"), static_cast<float>(slim_cell_diagonal(ctx.scene.slim)));
+    if (!depth_) glUniform1f(program_.uniform(multi, "u_step"), kSlimFieldStep);
+    if (field) {
       glEnable(GL_PROGRAM_POINT_SIZE);
     } else {
       glDisable(GL_PROGRAM_POINT_SIZE);
@@ -314,9 +313,10 @@ class SlimResolvePass final : public Pass {
     glBindTextureUnit(1, ctx.targets.texture("slim_sum_albedo"));
     glBindTextureUnit(2, ctx.targets.texture("slim_sum_field"));
     glBindTextureUnit(3, ctx.targets.texture("slim_sum_weight"));
-    glBindTextureUnit(4, ctx.targets.texture("slim_centre"));
+    glBindTextureUnit(4, ctx.targets.texture("slim_near"));
     glBindTextureUnit(5, ctx.targets.texture("slim_sum_field2"));
     glBindTextureUnit(6, ctx.targets.texture("slim_sum_weight2"));
+    glBindTextureUnit(7, ctx.targets.texture("slim_radius"));
     glUniform1f(program_.uniform(multi, "u_step"), kSlimFieldStep);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_TEST);

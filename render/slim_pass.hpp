@@ -43,6 +43,12 @@ struct SlimGrid {
   std::uint32_t s = 1;
 };
 
+// The second stage splits a cell whose projected diagonal exceeds this
+// (pixels): sqrt(3)/2 for the seed's blend (every pixel centre inside a
+// patch then has a sample in its pixel), 6 for the field evaluation (whose
+// points are drawn as wide as their cells: it bounds their size).
+double slim_cell_diagonal(const SlimSettings& settings);
+
 // The grid of `sphere` for a camera (CPU, double): culled (m = 0) when the
 // sphere lies outside the view frustum; else as described above, with s the
 // most second-stage samples a side any cell needs, from the projected cells

@@ -1,7 +1,6 @@
 // SLIM support spheres as the GPU holds them (render/slim_pass.cpp packs
-// them), and their local height field with the crease rule: shared by the
-// point sampling (slim_points.vert) and the field evaluation
-// (slim_accumulate.frag).
+// them), their local height field with the crease rule, and the field
+// evaluation's ownership rule: shared by the slim point programs.
 struct SlimGpu {
   vec4 center;  // xyz: relative to the scene's slim anchor; w: radius
   vec4 axis_u;  // the local frame in world space
@@ -33,4 +32,48 @@ float height(SlimGpu s, vec2 x, out vec2 grad) {
     return f2;
   }
   return f;
+}
+
+// Field evaluation: where the centre ray `ray` meets the height field of
+// sphere s (centre c, camera-relative), by Newton steps along the ray from
+// the crossing of the sample's tangent plane (point p, unit normal n), and
+// whether that point is the sample's own: inside the sphere and over the
+// sample's (u, v) square (cell: corner, side). Neighbouring samples of a
+// sphere converge to the same point, so exactly one of them owns it: each
+// sphere answers once per pixel. t: the ray distance of the point.
+bool slim_owner(SlimGpu s, vec3 c, ViewRay ray, vec3 p, vec3 n, vec3 cell, out float t) {
+  t = 0.0;
+  float dn = dot(ray.dir, n);
+  if (abs(dn) < 1e-4) return false;
+  t = dot(p - ray.origin, n) / dn;
+  vec3 o = ray.origin - c;
+  vec3 dl = vec3(dot(ray.dir, s.axis_u.xyz), dot(ray.dir, s.axis_v.xyz), dot(ray.dir, s.axis_w.xyz));
+  vec3 ol = vec3(dot(o, s.axis_u.xyz), dot(o, s.axis_v.xyz), dot(o, s.axis_w.xyz));
+  float r = s.center.w;
+  float h = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    vec3 l = ol + t * dl;
+    vec2 gf;
+    h = l.z - height(s, l.xy, gf);
+    float slope = dl.z - dot(gf, dl.xy);
+    if (abs(slope) < 1e-4) return false;
+    t -= h / slope;
+  }
+  vec3 l = ol + t * dl;
+  vec2 gf;
+  if (abs(l.z - height(s, l.xy, gf)) > 1e-4 * r) return false;  // did not settle
+  if (dot(l, l) >= r * r) return false;
+  vec2 uv = l.xy - cell.xy;
+  return uv.x >= 0.0 && uv.x < cell.z && uv.y >= 0.0 && uv.y < cell.z;
+}
+
+// The field evaluation's step along the centre ray (view depth) from the
+// nearest depth `near`: u_step pixel footprints, at most a twentieth of the
+// smallest owning sphere's radius (F bends over the spheres' size: a
+// linear interpolation of its sums over the step is then accurate to
+// ~(1/20)^2 of it).
+uniform float u_step;
+float slim_field_step(float near, float radius) {
+  float footprint = 2.0 * cam.cam_right.w / cam.viewport.y * (is_orthographic() ? 1.0 : near);
+  return min(u_step * footprint, 0.05 * radius);
 }

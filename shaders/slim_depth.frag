@@ -1,16 +1,13 @@
-// SLIM pass 1 (seed 003): the nearest point's view depth per pixel (MIN
-// blending into slim_near); points behind a nearer occluder are dropped.
-// With slim.evaluation "field" (u_centre_depth = 1) also the nearest depth
-// at the pixel's centre (slim_centre): a point gives the view
-// depth where the pixel's centre ray meets its sphere's own height field
-// (two Newton steps from the crossing of the point's tangent plane; the
-// point's own depth where they do not settle or the ray runs within ~6
-// degrees of the plane): the field is evaluated at the nearest of these,
-// which lies on the surface up to how much the spheres disagree, rather
-// than up to the surface's slope over the pixel (the near edge of a pixel
-// that sees the surface at a grazing angle).
+// SLIM pass 1 (seed 003): the nearest view depth per pixel (MIN blending
+// into slim_near); points behind a nearer occluder are dropped.
+// slim.evaluation "blend" (the seed's): the depth of the nearest point in
+// the pixel. "field" (u_field = 1): the nearest depth at which the pixel's
+// centre ray meets a sphere's own height field, from the points that own
+// that crossing (slim_owner): the surface layer the field is evaluated on;
+// and the smallest radius of those spheres (slim_radius): the scale over
+// which F bends, which bounds the accumulate pass's step along the ray.
 layout(binding = 0) uniform VIEW_SAMPLER u_scene_depth;
-uniform int u_centre_depth;
+uniform int u_field;
 uniform vec3 u_offset;  // slim anchor minus eye
 
 in float v_weight;
@@ -24,37 +21,20 @@ flat in vec2 v_window;
 flat in vec3 v_cell;
 
 layout(location = 0) out float out_near;
-layout(location = 1) out float out_centre;
+layout(location = 1) out float out_radius;  // field: the smallest owning sphere's radius (MIN)
 
 void main() {
   select_view(view_index());
-  if (v_depth >= VIEW_TEXEL(u_scene_depth, ivec2(gl_FragCoord.xy)).r) discard;
-  out_near = v_depth;
   float depth = v_depth;
-  if (u_centre_depth == 1) {
+  if (u_field == 1) {
+    SlimGpu s = spheres[v_sphere];
     ViewRay ray = view_ray(gl_FragCoord.xy);
-    float dn = dot(ray.dir, v_normal);
-    if (abs(dn) > 0.1) {
-      float t = dot(v_point - ray.origin, v_normal) / dn;
-      SlimGpu s = spheres[v_sphere];
-      vec3 o = ray.origin - (s.center.xyz + u_offset);
-      vec3 dl = vec3(dot(ray.dir, s.axis_u.xyz), dot(ray.dir, s.axis_v.xyz), dot(ray.dir, s.axis_w.xyz));
-      vec3 ol = vec3(dot(o, s.axis_u.xyz), dot(o, s.axis_v.xyz), dot(o, s.axis_w.xyz));
-      float h = 0.0;
-      for (int k = 0; k < 2; ++k) {
-        vec3 l = ol + t * dl;
-        vec2 gf;
-        h = l.z - height(s, l.xy, gf);
-        float slope = dl.z - dot(gf, dl.xy);
-        if (abs(slope) < 0.05) break;
-        t -= h / slope;
-      }
-      // The centre lies within ~0.7 pixel of the point: where its sphere's
-      // surface is steeper than ~3 (or a crease's other face takes over) the
-      // extrapolation stops two pixel footprints from the point's depth.
-      float footprint = 2.0 * cam.cam_right.w / cam.viewport.y * (is_orthographic() ? 1.0 : v_depth);
-      depth = clamp(t * ray.cos_axis, v_depth - 2.0 * footprint, v_depth + 2.0 * footprint);
-    }
+    float t;
+    if (!slim_owner(s, s.center.xyz + u_offset, ray, v_point, v_normal, v_cell, t)) discard;
+    depth = t * ray.cos_axis;
+    if (depth < cam.viewport.z) discard;  // before the near plane
   }
-  out_centre = depth;
+  if (depth >= VIEW_TEXEL(u_scene_depth, ivec2(gl_FragCoord.xy)).r) discard;
+  out_near = depth;
+  out_radius = v_radius;
 }

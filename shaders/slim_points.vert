@@ -8,7 +8,8 @@ layout(std430, binding = 6) readonly buffer SlimGrids { uvec2 grids[]; };
 layout(location = 0) in uint a_sphere;  // per instance: the draw's base instance
 uniform vec3 u_offset;    // slim anchor minus eye
 uniform int u_grid_base;  // this view's first grid
-uniform int u_field;      // slim.evaluation "field": accumulate draws larger points (below)
+uniform int u_field;      // slim.evaluation "field": points as wide as their cells (below)
+uniform float u_cell_diag;  // the second stage's largest projected cell diagonal (pixels)
 
 out float v_weight;
 out float v_depth;  // view depth
@@ -61,9 +62,11 @@ void main() {
   vec2 dv = 0.5 * cam.viewport.xy * (cv.xy - c.xy * (cv.w * iw)) * iw * h;
   float diag = max(length(du + dv), length(du - dv));
   // The seed's second stage: L x L samples at the centres of L x L
-  // sub-cells, L = the cell's longer projected diagonal over sqrt(3)/2
-  // pixels (5% margin), at most the s planned on the CPU.
-  float level = fill > 1u ? clamp(ceil(1.05 * diag / 0.8660254), 1.0, float(fill)) : 1.0;
+  // sub-cells, L = the cell's longer projected diagonal over u_cell_diag
+  // (5% margin), at most the s planned on the CPU. Blend: sqrt(3)/2 pixels,
+  // so every pixel centre within a patch has a sample in its pixel; field:
+  // 6 pixels, a bound on the points' size.
+  float level = fill > 1u ? clamp(ceil(1.05 * diag / u_cell_diag), 1.0, float(fill)) : 1.0;
   float a = float(sub % fill), b = float(sub / fill);
   if (a >= level || b >= level) {
     drop();
@@ -75,11 +78,15 @@ void main() {
   vec2 grad;
   float w = height(s, x, grad);
   float q2 = dot(vec3(x, w), vec3(x, w)) / (r * r);
-  if (q2 >= 1.0) {
+  // Blend: a point outside the sphere weighs nothing. Field: a sample
+  // stands for its whole square, kept while the square reaches into the
+  // sphere's disc (slim_owner tests the exact crossing).
+  vec2 nearest = clamp(vec2(0.0), lo, lo + side);
+  if (u_field == 1 ? dot(nearest, nearest) >= r * r : q2 >= 1.0) {
     drop();
     return;
   }
-  float t = 1.0 - q2;
+  float t = max(1.0 - q2, 0.0);
   v_weight = t * t * t;  // slim_weight (protocol/slim_model.hpp)
   vec3 p = s.center.xyz + x.x * s.axis_u.xyz + x.y * s.axis_v.xyz + w * s.axis_w.xyz + u_offset;
   v_normal = normalize(-grad.x * s.axis_u.xyz - grad.y * s.axis_v.xyz + s.axis_w.xyz);
@@ -91,10 +98,28 @@ void main() {
   v_cell = vec3(lo, side);
   gl_Position = cam.view_proj * vec4(p, 1.0);
   v_window = (gl_Position.xy / max(gl_Position.w, 1e-30) * 0.5 + 0.5) * cam.viewport.xy;
-  // Field evaluation: the sample whose (u, v) square holds the pixel's
-  // centre ray stands for its sphere there; it projects within half its
-  // square's diagonal of that centre, so a point that wide (even sizes
-  // cover the pixels whose centres lie within half the size) reaches the
-  // pixel. The depth pass draws single pixels (u_field = 0).
-  gl_PointSize = u_field == 1 ? min(2.0 * ceil(0.5 * diag / level + 0.05), 16.0) : 1.0;
+  // Field evaluation: the sample whose (u, v) square holds the point where
+  // a pixel's centre ray meets the sphere's surface stands for the sphere
+  // there (slim_common.glsl, slim_owner); that point projects within half
+  // the square's diagonal of the sample, so a point that wide (even sizes
+  // cover the pixels whose centres lie within half the size; 10% margin
+  // for the linearization) reaches the pixel. Blend: single pixels.
+  if (u_field == 0) {
+    gl_PointSize = 1.0;
+    return;
+  }
+  float size = 2.0 * ceil(0.55 * diag / level + 0.05);
+  // A point whose centre lies outside the viewport is clipped whole: one
+  // within reach of it is moved to its edge and widened by as much.
+  vec2 inside = clamp(v_window, vec2(0.5), cam.viewport.xy - 0.5);
+  float shift = max(abs(v_window.x - inside.x), abs(v_window.y - inside.y));
+  if (shift > 0.0) {
+    if (shift >= 0.5 * size || gl_Position.w <= 0.0) {
+      drop();
+      return;
+    }
+    size = 2.0 * ceil(0.5 * size + shift);
+    gl_Position.xy = (inside / cam.viewport.xy * 2.0 - 1.0) * gl_Position.w;
+  }
+  gl_PointSize = min(size, 32.0);
 }
