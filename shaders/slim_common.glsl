@@ -50,6 +50,10 @@ bool slim_owner(SlimGpu s, vec3 c, ViewRay ray, vec3 p, vec3 n, vec3 cell, out f
   vec3 dl = vec3(dot(ray.dir, s.axis_u.xyz), dot(ray.dir, s.axis_v.xyz), dot(ray.dir, s.axis_w.xyz));
   vec3 ol = vec3(dot(o, s.axis_u.xyz), dot(o, s.axis_v.xyz), dot(o, s.axis_w.xyz));
   float r = s.center.w;
+  // Cheap rejection first: the tangent plane's crossing lies within a
+  // square's side of the sample's square unless the ray grazes the patch.
+  vec2 uv0 = (ol + t * dl).xy - cell.xy;
+  if (any(lessThan(uv0, vec2(-cell.z))) || any(greaterThan(uv0, vec2(2.0 * cell.z)))) return false;
   float h = 0.0;
   for (int k = 0; k < 4; ++k) {
     vec3 l = ol + t * dl;

@@ -101,14 +101,14 @@ void main() {
   // Field evaluation: the sample whose (u, v) square holds the point where
   // a pixel's centre ray meets the sphere's surface stands for the sphere
   // there (slim_common.glsl, slim_owner); that point projects within half
-  // the square's diagonal of the sample, so a point that wide (even sizes
-  // cover the pixels whose centres lie within half the size; 10% margin
-  // for the linearization) reaches the pixel. Blend: single pixels.
+  // the square's diagonal of the sample, so a point that wide (a point
+  // covers the pixels whose centres lie within half its size of it; 10%
+  // margin for the linearization) reaches the pixel. Blend: single pixels.
   if (u_field == 0) {
     gl_PointSize = 1.0;
     return;
   }
-  float size = 2.0 * ceil(0.55 * diag / level + 0.05);
+  float size = ceil(1.1 * diag / level + 0.1);
   // A point whose centre lies outside the viewport is clipped whole: one
   // within reach of it is moved to its edge and widened by as much.
   vec2 inside = clamp(v_window, vec2(0.5), cam.viewport.xy - 0.5);
@@ -118,7 +118,7 @@ void main() {
       drop();
       return;
     }
-    size = 2.0 * ceil(0.5 * size + shift);
+    size = ceil(size + 2.0 * shift);
     gl_Position.xy = (inside / cam.viewport.xy * 2.0 - 1.0) * gl_Position.w;
   }
   gl_PointSize = min(size, 32.0);
