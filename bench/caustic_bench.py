@@ -11,9 +11,10 @@ GPU frame for caustic photon counts 1e3 ... 1e6 (global map at its default,
 (horizontally) of the point where the glass sphere touches it: where the
 light focused by the sphere lands. Per count: photon tracing time, GPU time
 per frame (maps cached), the relative L1 error over the caustic region and
-over the image's diffuse surfaces (the spheres themselves, black on the GPU
-for now, are left out of both), and the log-log slope of the region's
-error against the caustic photon count. Writes DIR/caustic.csv,
+over the image's diffuse surfaces (the spheres left out), over the mirror
+and over the glass sphere's pixels (what the "specular" pass shows: the
+CPU follows their rays to the photon-lit surfaces they reach), and the
+log-log slope of the region's error against the caustic photon count. Writes DIR/caustic.csv,
 DIR/caustic.md, DIR/caustic.png (error against count) and
 DIR/caustic_crop.png (the region: reference, 1e4, 1e5, 1e6 photons).
 """
@@ -45,7 +46,8 @@ def sphere_hits(o, d, spheres):
 
 
 def regions(scene, cam):
-    """(caustic region, diffuse pixels) as boolean masks, rows top-down."""
+    """(caustic region, diffuse pixels, {material: its sphere's pixels}) as
+    boolean masks, rows top-down."""
     o, d = camera_rays(cam)
     label = label_pixels(scene, cam)
     spheres = [s for s in scene["occluders"] if s["type"] == "sphere"]
@@ -60,7 +62,11 @@ def regions(scene, cam):
     near = np.hypot(p[..., 0] - c[0], p[..., 2] - c[2]) < 1.5 * glass["radius"]
     # Spheres stand inside the room: a ray that meets one meets it first.
     diffuse = (label >= 0) & ~np.isfinite(t_sphere)
-    return floor & near, diffuse
+    by_material = {}
+    for sph in spheres:
+        kind = sph.get("material", {}).get("type", "diffuse")
+        by_material[kind] = np.isfinite(sphere_hits(o, d, [sph])) & (sphere_hits(o, d, [sph]) <= t_sphere)
+    return floor & near, diffuse, by_material
 
 
 def tone(hdr, exposure):
@@ -86,7 +92,7 @@ def main():
     cam = dict(base["cameras"][0], width=size, height=size)
     base["cameras"] = [cam]
     exposure = base.get("output", {}).get("exposure", 1.0)
-    region, diffuse = regions(base, cam)
+    region, diffuse, spheres = regions(base, cam)
 
     refs, walls = [], []
     for seed in (1, 2):
@@ -97,6 +103,8 @@ def main():
     ref = 0.5 * (refs[0] + refs[1])
     noise_region = rel_l1(refs[0], refs[1], region) / 2
     noise_diffuse = rel_l1(refs[0], refs[1], diffuse) / 2
+    noise_mirror = rel_l1(refs[0], refs[1], spheres["mirror"]) / 2
+    noise_glass = rel_l1(refs[0], refs[1], spheres["glass"]) / 2
 
     counts = [1000, 10000, 100000] if a.quick else [1000, 3000, 10000, 30000, 100000, 300000, 1000000]
     rows, crops = [], {}
@@ -112,6 +120,9 @@ def main():
                "gpu_ms": round(statistics.median(f["gpu_ms"] for f in frames), 1),
                "rel_l1_caustic": round(rel_l1(img, ref, region), 4),
                "rel_l1_diffuse": round(rel_l1(img, ref, diffuse), 4),
+               "rel_l1_mirror": round(rel_l1(img, ref, spheres["mirror"]), 4),
+               "rel_l1_glass": round(rel_l1(img, ref, spheres["glass"]), 4),
+               "wall_ms": round(statistics.median(f["wall_ms"] for f in frames), 1),
                "caustic_ratio": round(float(img[region].sum() / ref[region].sum()), 4)}
         rows.append(row)
         print(json.dumps(row), flush=True)
@@ -129,7 +140,9 @@ def main():
         f.write(f"# The glass sphere's caustic against the path tracer ({size}x{size})\n\n")
         f.write(f"Reference: 2 x {spp} spp ({walls[0]:.0f} + {walls[1]:.0f} s); its own noise "
                 f"(rel. L1) over the caustic region {noise_region:.4f}, over the diffuse "
-                f"surfaces {noise_diffuse:.4f}. Caustic region: {int(region.sum())} pixels.\n")
+                f"surfaces {noise_diffuse:.4f}, over the mirror sphere {noise_mirror:.4f}, over the "
+                f"glass sphere {noise_glass:.4f}. Caustic region: {int(region.sum())} pixels; mirror "
+                f"{int(spheres['mirror'].sum())}, glass {int(spheres['glass'].sum())}.\n")
         f.write(f"Log-log slope of the region's error against caustic photons: {slope:.2f}.\n\n")
         cols = list(rows[0].keys())
         f.write("| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n")

@@ -119,6 +119,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
     settings.push_back({"zoom", with(2.0, 0.25, true), z});
     settings.push_back({"zoom, no 2nd stage", with(2.0, 0.25, false), z});
     settings.push_back({"zoom, seed's blend", with(2.0, 0.25, true, SlimEvaluation::kBlend), z});
+    settings.push_back({"zoom, seed's blend, no 2nd stage", with(2.0, 0.25, false, SlimEvaluation::kBlend), z});
   }
   for (double s : opts.zoom_only ? std::vector<double>{}
                   : opts.quick   ? std::vector<double>{1.0, 4.0}

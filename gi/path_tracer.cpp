@@ -24,8 +24,6 @@ double uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) *
 
 double luminance(const Color& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
-Color mul(const Color& a, const Color& b) { return {a[0] * b[0], a[1] * b[1], a[2] * b[2]}; }
-
 // SplitMix64's finalizer: neighbouring pixel indices give unrelated seeds.
 std::uint64_t mix64(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ull;

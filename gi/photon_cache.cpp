@@ -128,7 +128,7 @@ std::shared_ptr<const PhotonMaps> PhotonCache::get(const Scene& scene, bool* tra
   auto maps = std::make_shared<const PhotonMaps>(trace_photons(scene, surfaces));
   if (traced) *traced = true;
   const std::size_t bytes = (maps->global.size() + maps->caustic.size()) * sizeof(Photon);
-  entries_.push_front({key, maps, bytes});
+  entries_.push_front({key, maps, bytes, {}});
   bytes_ += bytes;
   // Evict the least recently used, but keep the one just traced.
   while (bytes_ > max_bytes_ && entries_.size() > 1) {
@@ -136,6 +136,23 @@ std::shared_ptr<const PhotonMaps> PhotonCache::get(const Scene& scene, bool* tra
     entries_.pop_back();
   }
   return maps;
+}
+
+std::shared_ptr<const PhotonGather> PhotonCache::gather(const std::shared_ptr<const PhotonMaps>& maps,
+                                                        bool skip_direct) {
+  for (Entry& e : entries_) {
+    if (e.maps != maps) continue;
+    auto& g = e.gather[skip_direct ? 1 : 0];
+    if (!g) {
+      g = std::make_shared<const PhotonGather>(*maps, skip_direct);
+      // The trees and their copy of the photons count with the maps.
+      const std::size_t extra = 2 * (maps->global.size() + maps->caustic.size()) * sizeof(Photon);
+      e.bytes += extra;
+      bytes_ += extra;
+    }
+    return g;
+  }
+  return std::make_shared<const PhotonGather>(*maps, skip_direct);
 }
 
 }  // namespace beamcast

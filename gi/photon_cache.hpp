@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "gi/photon_gather.hpp"
 #include "gi/photon_map.hpp"
 
 namespace beamcast {
@@ -24,6 +25,10 @@ class PhotonCache {
   explicit PhotonCache(std::size_t max_bytes = std::size_t{256} << 20) : max_bytes_(max_bytes) {}
   // The scene's maps, traced now (and kept) unless cached; `traced` tells which.
   std::shared_ptr<const PhotonMaps> get(const Scene& scene, bool* traced = nullptr);
+  // The photon search structures over `maps` (which get() returned and
+  // which is still cached; else built for this call only), built on first
+  // use and kept with the maps: one per skip_direct.
+  std::shared_ptr<const PhotonGather> gather(const std::shared_ptr<const PhotonMaps>& maps, bool skip_direct);
   std::size_t bytes() const { return bytes_; }
   std::size_t entries() const { return entries_.size(); }
 
@@ -32,6 +37,7 @@ class PhotonCache {
     std::string key;
     std::shared_ptr<const PhotonMaps> maps;
     std::size_t bytes;
+    std::shared_ptr<const PhotonGather> gather[2];  // by skip_direct
   };
   std::size_t max_bytes_;
   std::size_t bytes_ = 0;

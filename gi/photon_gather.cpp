@@ -5,10 +5,13 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <numbers>
 #include <thread>
 #include <variant>
 
+#include "gi/optics.hpp"
 #include "gi/parallel.hpp"
 #include "protocol/camera.hpp"
 
@@ -128,19 +131,27 @@ Color PhotonGather::nearest(const Vec3& x, const Vec3& n, const Color& albedo, i
   return {albedo[0] * scale * sum[0], albedo[1] * scale * sum[1], albedo[2] * scale * sum[2]};
 }
 
-namespace {
+LitShading::LitShading(const Scene& scene, const GiScene& surfaces, const PhotonGather& gather,
+                       GatherMethod method, int k)
+    : scene_(scene), surfaces_(surfaces), gather_(gather), method_(method), k_(k), radii_(splat_radii(scene)) {
+  if (scene.gi.direct == DirectLightMethod::kShadowMaps) {
+    for (const Light& l : scene.lights) {
+      const auto points =
+          std::visit([&](const auto& kind) { return kind.direct_points(scene.gi.direct_samples); }, l.shape);
+      for (const DirectPoint& p : points) direct_.push_back({p, l.flux});
+    }
+  }
+}
 
-struct FluxPoint {
-  DirectPoint point;
-  Color flux;
-};
-
-// The direct pass's sum (shaders/direct_light.frag) with exact visibility.
-Color direct_light(const GiScene& surfaces, const std::vector<FluxPoint>& points, const Vec3& x,
-                   const Vec3& n, const Color& albedo) {
+// The direct pass's sum (shaders/direct_light.frag) with exact visibility,
+// plus the photon estimate.
+Color LitShading::diffuse(const Vec3& x, const Vec3& n, const Color& albedo) const {
+  Color c = method_ == GatherMethod::kFixedRadius ? gather_.fixed_radius(x, n, albedo, radii_, scene_.gi.kernel)
+                                                  : gather_.nearest(x, n, albedo, k_);
+  if (direct_.empty()) return c;
   Color sum{0.0, 0.0, 0.0};
-  const double eps = surfaces.epsilon();
-  for (const FluxPoint& fp : points) {
+  const double eps = surfaces_.epsilon();
+  for (const FluxPoint& fp : direct_) {
     const DirectPoint& p = fp.point;
     const Vec3 to = p.position - x;
     const double d = length(to);
@@ -148,68 +159,85 @@ Color direct_light(const GiScene& surfaces, const std::vector<FluxPoint>& points
     const Vec3 l = (1.0 / d) * to;
     const double cos_x = dot(n, l);
     if (cos_x <= 0.0) continue;
-    const double c = -dot(p.axis, l);
+    const double cl = -dot(p.axis, l);
     double angular = 1.0;
     if (p.mode == DirectPoint::Mode::kCosine) {
-      angular = std::max(c, 0.0);
+      angular = std::max(cl, 0.0);
     } else if (p.mode == DirectPoint::Mode::kCone) {
-      if (c >= p.cos_inner) {
+      if (cl >= p.cos_inner) {
         angular = 1.0;
-      } else if (c <= p.cos_outer) {
+      } else if (cl <= p.cos_outer) {
         angular = 0.0;
       } else {
-        const double t = (c - p.cos_outer) / (p.cos_inner - p.cos_outer);
+        const double t = (cl - p.cos_outer) / (p.cos_inner - p.cos_outer);
         angular = t * t * (3.0 - 2.0 * t);
       }
     }
-    if (angular <= 0.0 || surfaces.occluded(x, l, eps, d - eps)) continue;
+    if (angular <= 0.0 || surfaces_.occluded(x, l, eps, d - eps)) continue;
     const double g = p.scale * angular * cos_x / (d * d);
     for (std::size_t k = 0; k < 3; ++k) sum[k] += g * fp.flux[k];
   }
-  for (std::size_t k = 0; k < 3; ++k) sum[k] *= albedo[k] / std::numbers::pi;
-  return sum;
+  for (std::size_t k = 0; k < 3; ++k) c[k] += sum[k] * albedo[k] / std::numbers::pi;
+  return c;
 }
 
-}  // namespace
+Color LitShading::trace(const Vec3& o, const Vec3& d, double t_min, double t_max) const {
+  return trace(o, d, t_min, t_max, 0, 1.0);
+}
+
+Color LitShading::trace(const Vec3& o, const Vec3& d, double t_min, double t_max, int depth,
+                        double weight) const {
+  const auto hit = surfaces_.intersect(o, d, t_min, t_max);
+  if (!hit) return scene_.background;
+  if (hit->light >= 0) {  // a quad light seen from its front: its radiance
+    const Light& l = scene_.lights[static_cast<std::size_t>(hit->light)];
+    const double scale = std::visit([](const auto& k) { return k.radiance_scale(); }, l.shape);
+    return {scale * l.flux[0], scale * l.flux[1], scale * l.flux[2]};
+  }
+  if (hit->occluder < 0) return {0.0, 0.0, 0.0};
+  const Occluder& occ = scene_.occluders[static_cast<std::size_t>(hit->occluder)];
+  const Material& m = occ.material;
+  if (m.type == MaterialType::kDiffuse) return diffuse(hit->p, hit->n, occ.albedo);
+  if (depth >= kMaxSpecularDepth || weight < 1e-3) return {0.0, 0.0, 0.0};
+  const double eps = surfaces_.epsilon();
+  const Vec3& n = hit->n;
+  auto follow = [&](const Vec3& v, double w) {
+    return trace(hit->p, v, eps, std::numeric_limits<double>::infinity(), depth + 1, weight * w);
+  };
+  if (m.type == MaterialType::kMirror) {
+    const double w = std::max({m.reflectance[0], m.reflectance[1], m.reflectance[2]});
+    return mul(m.reflectance, follow(reflect(d, n), w));
+  }
+  // Glass (the outside is vacuum; `entering` says which side the ray came
+  // from): F of the reflected ray, 1 - F of the refracted one times the
+  // tint of this crossing; radiance's (eta_t / eta_i)^2 cancels over a path
+  // that starts and ends outside (as in the path tracer).
+  const double eta_i = hit->entering ? 1.0 : m.ior;
+  const double eta_t = hit->entering ? m.ior : 1.0;
+  const double F = fresnel_dielectric(-dot(d, n), eta_i, eta_t);
+  Color c = F > 0.0 ? F * follow(reflect(d, n), F) : Color{0.0, 0.0, 0.0};
+  if (F < 1.0) {
+    if (const std::optional<Vec3> t = refract(d, n, eta_i, eta_t)) {
+      const double tw = std::max({m.tint[0], m.tint[1], m.tint[2]});
+      c = c + (1.0 - F) * mul(m.tint, follow(normalize(*t), (1.0 - F) * tw));
+    }
+  }
+  return c;
+}
 
 HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonGather& gather,
                       const Camera& cam, const GatherImageOptions& opts) {
-  std::vector<FluxPoint> direct;
-  if (scene.gi.direct == DirectLightMethod::kShadowMaps) {
-    for (const Light& l : scene.lights) {
-      const auto points =
-          std::visit([&](const auto& k) { return k.direct_points(scene.gi.direct_samples); }, l.shape);
-      for (const DirectPoint& p : points) direct.push_back({p, l.flux});
-    }
-  }
+  const LitShading shading(scene, surfaces, gather, opts.method, opts.k);
   HdrImage img;
   img.width = cam.width;
   img.height = cam.height;
   img.rgb.assign(3 * static_cast<std::size_t>(cam.width) * cam.height, 0.0f);
   const CameraBasis basis = camera_basis(cam);
-  const SplatRadii r = splat_radii(scene);
   auto row = [&](int y) {
     const int py = cam.height - 1 - y;  // GL pixel rows count from the bottom
     for (int x = 0; x < cam.width; ++x) {
       const Ray ray = camera_ray(cam, basis, x, py);
-      const auto hit = surfaces.intersect(ray.origin, ray.dir, ray.t_min, ray.t_max);
-      Color c = scene.background;
-      if (hit) {
-        c = {0.0, 0.0, 0.0};
-        if (hit->light >= 0) {  // a quad light seen from its front: its radiance
-          const Light& l = scene.lights[static_cast<std::size_t>(hit->light)];
-          const double scale = std::visit([](const auto& k) { return k.radiance_scale(); }, l.shape);
-          c = {scale * l.flux[0], scale * l.flux[1], scale * l.flux[2]};
-        } else if (hit->occluder >= 0) {
-          const Occluder& o = scene.occluders[static_cast<std::size_t>(hit->occluder)];
-          if (o.material.type == MaterialType::kDiffuse) {
-            c = opts.method == GatherMethod::kFixedRadius
-                    ? gather.fixed_radius(hit->p, hit->n, o.albedo, r, scene.gi.kernel)
-                    : gather.nearest(hit->p, hit->n, o.albedo, opts.k);
-            if (!direct.empty()) c = c + direct_light(surfaces, direct, hit->p, hit->n, o.albedo);
-          }
-        }
-      }
+      const Color c = shading.trace(ray.origin, ray.dir, ray.t_min, ray.t_max);
       float* px = img.at(x, y);
       for (int k = 0; k < 3; ++k) px[k] = static_cast<float>(c[k]);
     }

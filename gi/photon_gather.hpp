@@ -52,17 +52,49 @@ class PhotonGather {
 
 enum class GatherMethod { kFixedRadius, kNearest };
 
+// What a lit frame shows along a ray, on the CPU in double: diffuse surfaces
+// the photon estimate (and, with gi.direct "shadow_maps", the direct pass's
+// term with exact visibility), quad lights seen from the front their
+// radiance, the background where nothing is hit; mirrors their reflectance
+// times what the reflected ray shows, glass the Fresnel-weighted sum of the
+// reflected and the refracted ray (times the tint per crossing), both
+// followed, up to kMaxSpecularDepth specular bounces (then black) and while
+// a branch's weight is at least 1e-3. The renderer's "specular" pass shows
+// mirror and glass pixels with it (issue 14, item 4).
+class LitShading {
+ public:
+  static constexpr int kMaxSpecularDepth = 8;
+  // `gather` must have been built with skip_direct when gi.direct is
+  // "shadow_maps". Both must outlive this.
+  LitShading(const Scene& scene, const GiScene& surfaces, const PhotonGather& gather,
+             GatherMethod method = GatherMethod::kFixedRadius, int k = 50);
+  Color trace(const Vec3& o, const Vec3& d, double t_min, double t_max) const;
+
+ private:
+  struct FluxPoint {
+    DirectPoint point;
+    Color flux;
+  };
+  Color trace(const Vec3& o, const Vec3& d, double t_min, double t_max, int depth, double weight) const;
+  Color diffuse(const Vec3& p, const Vec3& n, const Color& albedo) const;
+  const Scene& scene_;
+  const GiScene& surfaces_;
+  const PhotonGather& gather_;
+  GatherMethod method_;
+  int k_;
+  SplatRadii radii_;
+  std::vector<FluxPoint> direct_;
+};
+
 struct GatherImageOptions {
   GatherMethod method = GatherMethod::kFixedRadius;
   int k = 50;  // kNearest
   int threads = 0;
 };
 
-// A lit scene's image (rows top-down, like render_reference): the nearest
-// surface along each pixel's centre ray; diffuse surfaces get the photon
-// estimate, quad lights their radiance, mirrors and glass and the background
-// as the GPU draws them. With gi.direct "shadow_maps" diffuse surfaces also
-// get the direct pass's term from the same DirectPoints, with visibility by
+// A lit scene's image (rows top-down, like render_reference): LitShading
+// along each pixel's centre ray. With gi.direct "shadow_maps" the direct
+// term comes from the same DirectPoints as the GPU's, with visibility by
 // shadow rays in double (so the GPU's difference is the shadow maps' error);
 // `gather` must then have been built with skip_direct.
 HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonGather& gather,

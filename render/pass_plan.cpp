@@ -1,5 +1,6 @@
 #include "render/pass_plan.hpp"
 
+#include "gi/photon_map.hpp"
 #include "protocol/occluders/slim.hpp"
 
 #include <algorithm>
@@ -44,6 +45,8 @@ const std::vector<TargetDecl>& target_catalog() {
       {"slim_sum_field2", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       {"slim_sum_weight2", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       {"slim_surface", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
+      // What mirror and glass pixels show, found on the CPU (render/specular_pass.hpp).
+      {"specular", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
   };
   return kTargets;
 }
@@ -110,6 +113,12 @@ const std::vector<PassDecl>& pass_catalog() {
       {PassId::kGiResolve, "gi_resolve",
        [](const PlanInput& in) { return !in.scene.occluders.empty() && in.scene.has_gi(); },
        {"hdr", "gi_indirect", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {}},
+      // Mirror and glass pixels of a lit scene: the CPU follows their centre
+      // rays to what they reach and the radiance there is added to hdr
+      // (render/specular_pass.hpp).
+      {PassId::kSpecular, "specular",
+       [](const PlanInput& in) { return in.scene.has_gi() && has_specular(in.scene); },
+       {"hdr", "gb_albedo", "specular"}, {}, {"hdr"}, {"specular"}},
       // Beams: energy added to hdr; a ray ends at the nearest surface if
       // anything wrote view_depth.
       {PassId::kBeams, "beams", [](const PlanInput& in) { return !in.scene.beams.empty(); },

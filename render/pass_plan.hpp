@@ -30,11 +30,12 @@ enum class PassId {
   kDirect,
   kPhotons,
   kGiResolve,
+  kSpecular,
   kBeams,
   kTonemap,
   kUpscale
 };
-inline constexpr std::size_t kPassCount = 12;
+inline constexpr std::size_t kPassCount = 13;
 
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {

@@ -9,6 +9,7 @@
 
 #include "gi/photon_map.hpp"
 #include "render/slim_pass.hpp"
+#include "render/specular_pass.hpp"
 #include "shaders/shader_sources.hpp"
 
 namespace beamcast {
@@ -595,6 +596,8 @@ std::unique_ptr<Pass> make_pass(PassId id) {
       return std::make_unique<PhotonPass>();
     case PassId::kGiResolve:
       return std::make_unique<GiResolvePass>();
+    case PassId::kSpecular:
+      return make_specular_pass();
     case PassId::kBeams:
       return std::make_unique<BeamPass>();
     case PassId::kTonemap:

@@ -13,6 +13,7 @@
 
 #include "protocol/camera.hpp"
 #include "protocol/scene.hpp"
+#include "gi/gi_scene.hpp"
 #include "gi/photon_cache.hpp"
 #include "render/gl_util.hpp"
 #include "render/lut.hpp"
@@ -85,6 +86,10 @@ class SceneResources {
   // The triangle vertices' anchor (positions in triangle_vao() are relative to it).
   const Vec3& mesh_anchor() const { return mesh_anchor_; }
   const Aabb& mesh_bounds() const { return mesh_bounds_; }
+  // Ray tracing on the CPU (group "specular"): the scene's surfaces and its
+  // photon maps' search structures; null without the group.
+  const GiScene* gi_scene() const { return gi_scene_.get(); }
+  const PhotonGather* photon_gather() const { return photon_gather_.get(); }
   // SLIM surfaces (group "slim"); null without them.
   SlimResources* slim() const { return slim_.get(); }
   // Time spent tracing the maps for this render (0 when they came from the
@@ -126,6 +131,8 @@ class SceneResources {
   double photon_trace_ms_ = 0.0;
   double photon_upload_ms_ = 0.0;
   std::unique_ptr<SlimResources> slim_;
+  std::unique_ptr<GiScene> gi_scene_;
+  std::shared_ptr<const PhotonGather> photon_gather_;
   // The per-camera data of bind_camera, written to `out` (for bind_views).
   void fill_camera(const Camera& cam, const CameraBasis& basis, void* block) const;
   void fill_beams(const Vec3& eye, void* beams) const;

@@ -164,12 +164,12 @@ TEST(Slim, BackfaceCullingKeepsClosedSurfacesAndDropsSheetsSeenFromBehind) {
 }
 
 // A capsule beam passing through the SLIM sphere and behind it: the GPU
-// ends each beam ray at the points' blended view depth, the CPU reference at
-// F's first zero. Compared over the pixels away from the sphere's outline
-// (where point coverage and the centre ray's hit differ by design, the
-// first test). Tolerance 1%: the depths differ by 0.003 (size-10 units,
-// the first test), so the clipped beam segments differ by ~1e-3 of the
-// beam's radius, and the shading by the 0.14 degree normal error; the
+// ends each beam ray at the surface's view depth (F's zero on the centre
+// ray, field evaluation), the CPU reference at F's first zero. Compared
+// over the pixels away from the sphere's outline (where coverage may
+// differ, the first test). Tolerance 1%: the depths differ by under 0.003
+// (size-10 units, the first test), so the clipped beam segments differ by
+// ~1e-3 of the beam's radius, and the shading by the 0.2 degree normal error; the
 // beam's own GPU-vs-reference error is 1e-3 (the examples' test). The same
 // beam without the sphere differs from the reference by far more than 1%
 // (checked), so a beam not clipped fails.

@@ -11,10 +11,11 @@
 namespace beamcast {
 namespace {
 
-Scene scene_with(bool beams, bool occluders, bool lit = false, bool slim = false) {
+Scene scene_with(bool beams, bool occluders, bool lit = false, bool slim = false, bool mirror = false) {
   Scene s;
   if (beams) s.beams.emplace_back();
   if (occluders) s.occluders.push_back(Occluder{SphereOccluder{}, {0.5, 0.5, 0.5}, {}});
+  if (occluders && mirror) s.occluders[0].material.type = MaterialType::kMirror;
   if (lit) s.lights.push_back(Light{PointLight{}, {1.0, 1.0, 1.0}});
   if (slim) {
     s.occluders.push_back(Occluder{SlimOccluder::from_spheres({SlimSphere{}}), {0.5, 0.5, 0.5}, {}});
@@ -72,9 +73,11 @@ TEST(PassPlan, EveryCatalogPassIsReachable) {
     for (bool o : {false, true}) {
       for (bool lit : {false, true}) {
         for (bool slim : {false, true}) {
-          for (double scale : {1.0, 0.5}) {
-            for (const auto& n : make_plan(PlanInput{scene_with(b, o, lit, slim), scale}).names()) {
-              seen.push_back(n);
+          for (bool mirror : {false, true}) {
+            for (double scale : {1.0, 0.5}) {
+              for (const auto& n : make_plan(PlanInput{scene_with(b, o, lit, slim, mirror), scale}).names()) {
+                seen.push_back(n);
+              }
             }
           }
         }
@@ -132,6 +135,12 @@ TEST(PassPlan, LitScenesSplatPhotonsOverAGbuffer) {
                                       "output", "view_depth"}));
   EXPECT_TRUE(plan.uploads_group("photons"));
   EXPECT_TRUE(plan.written("view_depth"));
+  // Mirror or glass surfaces add the specular pass after the splats' resolve.
+  const FramePlan mirror = make_plan(PlanInput{scene_with(true, true, true, false, true)});
+  EXPECT_EQ(mirror.names(), (std::vector<std::string>{"gbuffer", "direct", "photons", "gi_resolve",
+                                                      "specular", "beams", "tonemap"}));
+  EXPECT_TRUE(mirror.uploads_group("specular"));
+  EXPECT_FALSE(plan.uploads_group("specular"));
   EXPECT_EQ(make_plan(PlanInput{scene_with(true, false, true)}).names(),
             (std::vector<std::string>{"beams", "tonemap"}));
   // Unlit scenes never upload photons.

@@ -1,0 +1,74 @@
+#include "render/specular_pass.hpp"
+
+#include <vector>
+
+#include "gi/parallel.hpp"
+#include "gi/photon_gather.hpp"
+#include "protocol/camera.hpp"
+#include "render/passes.hpp"
+
+namespace beamcast {
+
+namespace {
+
+class SpecularPass final : public Pass {
+ public:
+  SpecularPass() : program_("specular_add") {}
+  void execute(FrameContext& ctx, const PassDecl& self) override {
+    const GiScene* surfaces = ctx.resources.gi_scene();
+    const PhotonGather* gather = ctx.resources.photon_gather();
+    if (!surfaces || !gather) throw GlError("specular pass: the scene's ray tracing data is missing");
+    const LitShading shading(ctx.scene, *surfaces, *gather);
+    const bool multi = ctx.views > 0;
+    const int views = multi ? ctx.views : 1;
+    const GLuint albedo_tex = ctx.targets.texture("gb_albedo");
+    const GLuint out_tex = ctx.targets.texture("specular");
+    std::vector<float> albedo, out;
+    for (int v = 0; v < views; ++v) {
+      const Camera& cam = multi ? (*ctx.view_cameras)[static_cast<std::size_t>(v)] : ctx.camera;
+      const CameraBasis& basis = multi ? (*ctx.view_bases)[static_cast<std::size_t>(v)] : ctx.basis;
+      const int w = cam.width, h = cam.height;
+      const std::size_t n = static_cast<std::size_t>(w) * h;
+      albedo.resize(4 * n);
+      glGetTextureSubImage(albedo_tex, 0, 0, 0, v, w, h, 1, GL_RGBA, GL_FLOAT,
+                           static_cast<GLsizei>(albedo.size() * sizeof(float)), albedo.data());
+      out.assign(4 * n, 0.0f);
+      // Rows bottom-up, as GL stores them and camera_ray counts them.
+      parallel_items(h, 0, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * w + x;
+          const float material = albedo[4 * i + 3];
+          if (!(material > 0.5f && material < 2.5f)) continue;  // mirror (1) or glass (2)
+          const Ray ray = camera_ray(cam, basis, x, y);
+          const Color c = shading.trace(ray.origin, ray.dir, ray.t_min, ray.t_max);
+          for (int k = 0; k < 3; ++k) out[4 * i + static_cast<std::size_t>(k)] = static_cast<float>(c[k]);
+          out[4 * i + 3] = 1.0f;
+        }
+      });
+      if (multi) {
+        glTextureSubImage3D(out_tex, 0, 0, 0, v, w, h, 1, GL_RGBA, GL_FLOAT, out.data());
+      } else {
+        glTextureSubImage2D(out_tex, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, out.data());
+      }
+    }
+    glUseProgram(program_.get(multi));
+    glBindTextureUnit(0, out_tex);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_DEPTH_TEST);
+    glBindVertexArray(ctx.empty_vao);
+    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    glDisable(GL_BLEND);
+    gl_check("specular pass");
+  }
+
+ private:
+  ProgramPair program_;
+};
+
+}  // namespace
+
+std::unique_ptr<Pass> make_specular_pass() { return std::make_unique<SpecularPass>(); }
+
+}  // namespace beamcast
