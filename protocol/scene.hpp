@@ -89,6 +89,10 @@ struct GiSettings {
   // sees it (pass gi_resolve; the first 8 quad lights): without it the
   // light's aliased edge is most of the Cornell box's error (docs/gi.md).
   bool light_antialias = true;
+  // Mirror and glass pixels (pass "specular"): K x K rays spread over each
+  // pixel, their radiance averaged (the reflections' and refractions' edges
+  // and the light seen in them, as the reference's pixel average does).
+  int specular_samples = 2;
   // Photons are splatted at 1/splat_scale of the render size per side, then
   // brought back by a surface-aware upsampling (pass gi_resolve): near edges
   // the upsampling pulls values from further inside a surface, which the

@@ -301,7 +301,7 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "gi settings");
   o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth", "direct",
                 "direct_samples", "shadow_size", "edge_correction", "splat_scale",
-                "light_antialias", "caustic_radius"});
+                "light_antialias", "caustic_radius", "specular_samples"});
   GiSettings g;
   std::int64_t total = 0;
   auto count = [&](const Node& v) {
@@ -362,6 +362,7 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   if (auto v = o.optional("edge_correction")) g.edge_correction = read_bool(*v);
   if (auto v = o.optional("light_antialias")) g.light_antialias = read_bool(*v);
   if (auto v = o.optional("splat_scale")) g.splat_scale = read_int_in(*v, 1, 8);
+  if (auto v = o.optional("specular_samples")) g.specular_samples = read_int_in(*v, 1, 8);
   return g;
 }
 

@@ -24,6 +24,7 @@ class SpecularPass final : public Pass {
     const GLuint albedo_tex = ctx.targets.texture("gb_albedo");
     const GLuint out_tex = ctx.targets.texture("specular");
     std::vector<float> albedo, out;
+    const int k = ctx.scene.gi.specular_samples;
     for (int v = 0; v < views; ++v) {
       const Camera& cam = multi ? (*ctx.view_cameras)[static_cast<std::size_t>(v)] : ctx.camera;
       const CameraBasis& basis = multi ? (*ctx.view_bases)[static_cast<std::size_t>(v)] : ctx.basis;
@@ -39,8 +40,17 @@ class SpecularPass final : public Pass {
           const std::size_t i = static_cast<std::size_t>(y) * w + x;
           const float material = albedo[4 * i + 3];
           if (!(material > 0.5f && material < 2.5f)) continue;  // mirror (1) or glass (2)
-          const Ray ray = camera_ray(cam, basis, x, y);
-          const Color c = shading.trace(ray.origin, ray.dir, ray.t_min, ray.t_max);
+          // K x K rays at the centres of a K x K grid over the pixel.
+          Color c{0.0, 0.0, 0.0};
+          for (int sy = 0; sy < k; ++sy) {
+            for (int sx = 0; sx < k; ++sx) {
+              const double nx = 2.0 * (x + (sx + 0.5) / k) / w - 1.0;
+              const double ny = 2.0 * (y + (sy + 0.5) / k) / h - 1.0;
+              const Ray ray = camera_ray_ndc(cam, basis, nx, ny);
+              c = c + shading.trace(ray.origin, ray.dir, ray.t_min, ray.t_max);
+            }
+          }
+          c = (1.0 / (k * k)) * c;
           for (int k = 0; k < 3; ++k) out[4 * i + static_cast<std::size_t>(k)] = static_cast<float>(c[k]);
           out[4 * i + 3] = 1.0f;
         }

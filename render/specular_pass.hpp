@@ -1,6 +1,7 @@
 // What mirror and glass surfaces show in a lit scene (issue 14, item 4):
 // the pass "specular". The G-buffer marks their pixels (material 1 or 2);
-// for each, the CPU follows the pixel's centre ray through the specular
+// for each, the CPU follows gi.specular_samples^2 rays spread over the
+// pixel through the specular
 // surfaces to what it reaches (gi/photon_gather.hpp, LitShading: the photon
 // estimate and the direct light on diffuse surfaces, lights, background),
 // and the pass adds that radiance to hdr. The photons' kd-trees come with
