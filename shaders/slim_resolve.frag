@@ -64,6 +64,14 @@ void main() {
       f = mix(sf, sf2, lambda);
       w = mix(sw, sw2, lambda);
       depth = near + lambda * step;
+      // Across a crease F's gradient jumps between x1 and x2 (the min/max
+      // of two polynomials): there the nearer end's gradient, not a blend.
+      vec3 g1 = sf.xyz - (sf.w / sw.w) * sw.xyz;
+      vec3 g2 = sf2.xyz - (sf2.w / sw2.w) * sw2.xyz;
+      if (dot(g1, g2) < 0.985 * length(g1) * length(g2)) {  // over 10 degrees apart
+        f = lambda < 0.5 ? sf : sf2;
+        w = lambda < 0.5 ? sw : sw2;
+      }
     }
     if (!(w.w > 0.0)) {
       f = sf;
