@@ -88,4 +88,29 @@ inline std::vector<SlimSphere> slim_plane(double h, double half, int n) {
   return out;
 }
 
+// A roof y = -slope |x| over [-half, half]^2 (a ridge along z at x = 0):
+// n x n supports on the roof, each in the world frame (u = x, v = z, w = y)
+// with the crease rule min(P1, P2) of the two planes relative to its centre,
+// so every support holds the roof exactly and F = y - roof(x) wherever a
+// support reaches.
+inline std::vector<SlimSphere> slim_roof(double slope, double half, int n) {
+  std::vector<SlimSphere> out;
+  const double step = 2.0 * half / n;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const double cx = -half + (i + 0.5) * step, cz = -half + (j + 0.5) * step;
+      SlimSphere sp;
+      sp.center = {cx, -slope * std::abs(cx), cz};
+      sp.radius = 1.5 * step;
+      sp.rotation = quat_from_axes({1.0, 0.0, 0.0}, {0.0, 0.0, -1.0}, {0.0, 1.0, 0.0});
+      // local w = roof(cx + u) - roof(cx) = min(-slope (cx + u), slope (cx + u)) + slope |cx|
+      sp.poly.c = {0.0, 0.0, 0.0, -slope, 0.0, slope * (std::abs(cx) - cx)};
+      sp.poly2.c = {0.0, 0.0, 0.0, slope, 0.0, slope * (std::abs(cx) + cx)};
+      sp.crease = SlimCrease::kMin;
+      out.push_back(sp);
+    }
+  }
+  return out;
+}
+
 }  // namespace beamcast::test

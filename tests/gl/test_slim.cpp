@@ -305,6 +305,39 @@ TEST(Slim, TheSecondStageFillsTheHoles) {
   }
 }
 
+// A roof with a sharp ridge (every support holds the crease rule min(P1,
+// P2) exactly, so F = y - roof(x)): the field evaluation applies the rule
+// at each pixel's centre ray and takes the face the reference takes; the
+// seed's blend averages both faces' points in a pixel on the ridge. Bounds:
+// the field's normals are exact up to float rounding (measured: 0.000
+// degrees p99 inside, 0.00 mean on the ridge; 0.5 and 1 allowed, room for
+// a ridge pixel whose two evaluation points straddle it); the blend,
+// mixing faces 2 atan(0.6) = 62 degrees apart, is at 5.6 degrees on the
+// ridge pixels (the reference's normal turning by over 30 degrees to a
+// neighbour).
+TEST(Slim, ARidgeStaysSharpWithTheFieldEvaluation) {
+  Scene scene;
+  scene.occluders.push_back(Occluder{SlimOccluder::from_spheres(test::slim_roof(0.6, 1.0, 8)), {0.8, 0.8, 0.8}, {}});
+  Camera cam;
+  cam.position = {0.7, 2.2, 2.4};
+  cam.target = Vec3{0.0, -0.3, 0.0};
+  cam.width = cam.height = 128;
+  scene.cameras.push_back(cam);
+  const double size = 2.0 * std::sqrt(3.0) * 1.2;
+  const Compared field = render_and_compare(scene, size);
+  scene.slim.evaluation = SlimEvaluation::kBlend;
+  const Compared blend = render_and_compare(scene, size);
+  std::printf("  ridge pixels %lld: field %.2f deg, blend %.2f deg (inner p99 %.3f / %.3f)\n",
+              static_cast<long long>(field.errors.crease_pixels), field.errors.crease_normal_mean_deg,
+              blend.errors.crease_normal_mean_deg, field.errors.interior_normal_p99_deg,
+              blend.errors.interior_normal_p99_deg);
+  EXPECT_GT(field.errors.crease_pixels, 50);
+  EXPECT_LT(field.errors.interior_normal_p99_deg, 0.5);
+  EXPECT_LT(field.errors.crease_normal_mean_deg, 1.0);
+  EXPECT_GT(blend.errors.crease_normal_mean_deg, 3.0);
+  EXPECT_EQ(field.errors.interior_holes, 0);
+}
+
 // A lit scene (a point light, photon mapping on): the SLIM sphere writes the
 // G-buffer that the direct light and photon passes shade, so it must look
 // like the analytic sphere it approximates. Over the pixels both cover with
