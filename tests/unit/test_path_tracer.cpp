@@ -13,6 +13,7 @@
 #include "protocol/camera.hpp"
 #include "protocol/density.hpp"
 #include "render/reference.hpp"
+#include "tests/common/lit_shapes.hpp"
 
 namespace beamcast {
 namespace {
@@ -30,29 +31,8 @@ Camera make_camera(const Vec3& pos, const Vec3& target, double fov_y, int w, int
   return c;
 }
 
-Occluder quad_occluder(const Vec3& corner, const Vec3& eu, const Vec3& ev, Material m = {},
-                       Color albedo = {0.8, 0.8, 0.8}) {
-  Occluder o;
-  o.shape = QuadOccluder{corner, eu, ev, true};
-  o.albedo = albedo;
-  o.material = m;
-  return o;
-}
-
-// A quad light of radiance L (flux = pi A L, as the parser makes it).
-Light quad_light(const Vec3& corner, const Vec3& eu, const Vec3& ev, const Color& L) {
-  QuadLight q;
-  q.corner = corner;
-  q.edge_u = eu;
-  q.edge_v = ev;
-  const Vec3 n = cross(eu, ev);
-  q.area = length(n);
-  q.normal = (1.0 / q.area) * n;
-  Light l;
-  l.shape = q;
-  l.flux = (kPi * q.area) * L;
-  return l;
-}
+using test::quad_light;
+using test::quad_occluder;
 
 struct Stats {
   double mean = 0.0;
@@ -167,38 +147,20 @@ TEST(PathTracer, QuadLightSeenDirectlyGivesItsRadiance) {
 }
 
 TEST(PathTracer, MirrorReflectsTheLightTimesReflectance) {
-  Scene scene;
-  const Color L{5.0, 3.0, 2.0};
-  Material mirror;
-  mirror.type = MaterialType::kMirror;
-  mirror.reflectance = {0.9, 0.5, 0.2};
-  // Mirror floor y = 0 facing up; the camera at (-2, 2, 0) looks at the origin,
-  // the reflected rays leave along (1, 1, 0) to the light centred at (2, 2, 0)
-  // that faces back along (-1, -1, 0).
-  scene.occluders.push_back(
-      quad_occluder({-10.0, 0.0, -10.0}, {0.0, 0.0, 20.0}, {20.0, 0.0, 0.0}, mirror));
-  scene.lights.push_back(quad_light({1.5, 2.5, -1.0}, {1.0, -1.0, 0.0}, {0.0, 0.0, 2.0}, L));
+  const Color L{5.0, 3.0, 2.0}, reflectance{0.9, 0.5, 0.2};
+  // The camera at (-2, 2, 0) looks at the origin: the reflected rays reach the light.
+  const Scene scene = test::mirror_floor_and_light(L, reflectance);
   const GiScene gi(scene);
   const Camera cam = make_camera({-2.0, 2.0, 0.0}, {0.0, 0.0, 0.0}, 4.0, 8, 8);
   for (const Color& c : path_trace(gi, cam, PathTraceOptions{.spp = 4})) {
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], mirror.reflectance[k] * L[k], 1e-12 * L[k]);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], reflectance[k] * L[k], 1e-12 * L[k]);
   }
 }
 
 TEST(PathTracer, GlassSlabTransmitsTheFresnelSeries) {
-  Scene scene;
-  const Color L{4.0, 4.0, 4.0};
-  Material glass;
-  glass.type = MaterialType::kGlass;
-  glass.ior = 1.5;
-  glass.tint = {0.9, 0.8, 0.7};
-  // A slab z in [1, 1.1] between the camera (z = 5) and the light (z = 0),
-  // each face's normal pointing out of the glass.
-  scene.occluders.push_back(
-      quad_occluder({-5.0, -5.0, 1.1}, {10.0, 0.0, 0.0}, {0.0, 10.0, 0.0}, glass));
-  scene.occluders.push_back(
-      quad_occluder({-5.0, -5.0, 1.0}, {0.0, 10.0, 0.0}, {10.0, 0.0, 0.0}, glass));
-  scene.lights.push_back(quad_light({-2.0, -2.0, 0.0}, {4.0, 0.0, 0.0}, {0.0, 4.0, 0.0}, L));
+  const Color L{4.0, 4.0, 4.0}, tint{0.9, 0.8, 0.7};
+  // The slab between the camera (z = 5) and the light (z = 0).
+  const Scene scene = test::glass_slab_over_light(L, tint);
   const GiScene gi(scene);
   const Camera cam = make_camera({0.0, 0.0, 5.0}, {0.0, 0.0, 0.0}, 2.0, 48, 48);
   PathTraceOptions po;
@@ -212,7 +174,7 @@ TEST(PathTracer, GlassSlabTransmitsTheFresnelSeries) {
   // black background.
   const double F = 0.04;
   for (int k = 0; k < 3; ++k) {
-    const double expected = L[k] * glass.tint[k] * glass.tint[k] * (1.0 - F) / (1.0 + F);
+    const double expected = L[k] * tint[k] * tint[k] * (1.0 - F) / (1.0 + F);
     const Stats st = pixel_stats(img, k);
     std::printf("glass slab channel %d: %.6f expected %.6f (%+.3f%%, standard error %.3f%%)\n", k,
                 st.mean, expected, 100.0 * (st.mean / expected - 1.0), 100.0 * st.se / expected);
