@@ -113,13 +113,14 @@ int run_slim_bench(const SlimBenchOptions& opts) {
     return x;
   };
   const std::vector<double> zooms = !opts.zooms.empty() ? opts.zooms
-                                    : opts.quick         ? std::vector<double>{0.25, 1.0, 4.0}
-                                                         : std::vector<double>{0.25, 1.0, 4.0, 16.0};
+                                    : opts.quick        ? std::vector<double>{0.25, 1.0, 4.0}
+                                                        : std::vector<double>{0.25, 1.0, 4.0, 16.0};
   for (double z : zooms) {
     settings.push_back({"zoom", with(2.0, 0.25, true), z});
     settings.push_back({"zoom, no 2nd stage", with(2.0, 0.25, false), z});
     settings.push_back({"zoom, seed's blend", with(2.0, 0.25, true, SlimEvaluation::kBlend), z});
-    settings.push_back({"zoom, seed's blend, no 2nd stage", with(2.0, 0.25, false, SlimEvaluation::kBlend), z});
+    settings.push_back(
+        {"zoom, seed's blend, no 2nd stage", with(2.0, 0.25, false, SlimEvaluation::kBlend), z});
   }
   for (double s : opts.zoom_only ? std::vector<double>{}
                   : opts.quick   ? std::vector<double>{1.0, 4.0}
@@ -136,9 +137,11 @@ int run_slim_bench(const SlimBenchOptions& opts) {
   ropts.egl = opts.egl;
   Renderer renderer(ropts);
   std::ofstream csv(opts.out / "slim.csv");
-  csv << "model,spheres,knob,evaluation,sampling,depth_threshold,fill_holes,zoom,size,points,gpu_ms,slim_ms,"
+  csv << "model,spheres,knob,evaluation,sampling,depth_threshold,fill_holes,zoom,size,points,gpu_"
+         "ms,slim_ms,"
          "reference_pixels,holes,interior_holes,spurious,spurious_far,other_layer,depth_mean,"
-         "depth_p99,depth_max,normal_mean_deg,normal_p99_deg,normal_max_deg,interior,interior_depth_p99,"
+         "depth_p99,depth_max,normal_mean_deg,normal_p99_deg,normal_max_deg,interior,interior_"
+         "depth_p99,"
          "interior_normal_p99_deg,crease_pixels,crease_normal_mean_deg\n";
   std::ofstream md(opts.out / "slim.md");
   md << "# SLIM point sampling against the CPU reference (" << size << "x" << size << ", "
@@ -153,12 +156,16 @@ int run_slim_bench(const SlimBenchOptions& opts) {
         "no covered neighbour). Depth: |GPU - reference| view depth at the model scaled to "
         "size 10 (its box diagonal). Normal: angle between the GPU's normal and F's "
         "gradient. Evaluation: field (F and its gradient at each pixel's centre ray) or blend "
-        "(the seed's weighted mean of the points' depths and normals). Inner: the pixels whose 3x3 neighbourhood both cover (not the outline). Crease: inner "
+        "(the seed's weighted mean of the points' depths and normals). Inner: the pixels whose 3x3 "
+        "neighbourhood both cover (not the outline). Crease: inner "
         "pixels where the reference's normal turns by over 30 degrees to a neighbour.\n\n"
-     << "| model | spheres | knob | evaluation | S | t | 2nd stage | zoom | points | GPU ms | slim ms | ref px | "
-        "holes | interior | spurious | far | depth mean | depth p99 | normal mean ° | normal p99 ° | "
+     << "| model | spheres | knob | evaluation | S | t | 2nd stage | zoom | points | GPU ms | slim "
+        "ms | ref px | "
+        "holes | interior | spurious | far | depth mean | depth p99 | normal mean ° | normal p99 ° "
+        "| "
         "inner depth p99 | inner normal p99 ° | crease px | crease normal ° |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|-"
+        "--|---|\n";
   for (const Model& model : models) {
     Scene base;
     base.occluders.push_back(
@@ -174,7 +181,8 @@ int run_slim_bench(const SlimBenchOptions& opts) {
       if (ref == references.end()) {
         const auto t0 = std::chrono::steady_clock::now();
         ref = references
-                  .emplace(st.zoom, slim_reference(scene, scene.cameras[0], 0, opts.reference_samples))
+                  .emplace(st.zoom,
+                           slim_reference(scene, scene.cameras[0], 0, opts.reference_samples))
                   .first;
         std::fprintf(stderr, "%s zoom %g: reference %.1f s\n", model.name.c_str(), st.zoom,
                      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -206,11 +214,12 @@ int run_slim_bench(const SlimBenchOptions& opts) {
       }
       char line[1024];
       std::snprintf(line, sizeof line,
-                    "%s,%zu,\"%s\",%s,%g,%g,%d,%g,%d,%lld,%.2f,%.2f,%lld,%lld,%lld,%lld,%lld,%lld,%.5f,%.5f,%.4f,%.4f,"
+                    "%s,%zu,\"%s\",%s,%g,%g,%d,%g,%d,%lld,%.2f,%.2f,%lld,%lld,%lld,%lld,%lld,%lld,%"
+                    ".5f,%.5f,%.4f,%.4f,"
                     "%.4f,%.4f,%lld,%.5f,%.4f,%lld,%.4f\n",
-                    model.name.c_str(), model.spheres.size(), st.knob.c_str(), eval_name, st.slim.sampling,
-                    st.slim.depth_threshold, st.slim.fill_holes ? 1 : 0, st.zoom, size,
-                    static_cast<long long>(last.slim_points), median(gpu), median(slim_ms),
+                    model.name.c_str(), model.spheres.size(), st.knob.c_str(), eval_name,
+                    st.slim.sampling, st.slim.depth_threshold, st.slim.fill_holes ? 1 : 0, st.zoom,
+                    size, static_cast<long long>(last.slim_points), median(gpu), median(slim_ms),
                     static_cast<long long>(e.reference_pixels), static_cast<long long>(e.holes),
                     static_cast<long long>(e.interior_holes), static_cast<long long>(e.spurious),
                     static_cast<long long>(e.spurious_far), static_cast<long long>(e.occluded),
@@ -220,16 +229,18 @@ int run_slim_bench(const SlimBenchOptions& opts) {
                     e.crease_normal_mean_deg);
       csv << line << std::flush;
       std::snprintf(line, sizeof line,
-                    "| %s | %zu | %s | %s | %g | %g | %s | %g | %lld | %.1f | %.1f | %lld | %lld | %lld | %lld | "
+                    "| %s | %zu | %s | %s | %g | %g | %s | %g | %lld | %.1f | %.1f | %lld | %lld | "
+                    "%lld | %lld | "
                     "%lld | %.4f | %.4f | %.3f | %.2f | %.4f | %.2f | %lld | %.1f |\n",
-                    model.name.c_str(), model.spheres.size(), st.knob.c_str(), eval_name, st.slim.sampling,
-                    st.slim.depth_threshold, st.slim.fill_holes ? "on" : "off", st.zoom,
-                    static_cast<long long>(last.slim_points), median(gpu), median(slim_ms),
+                    model.name.c_str(), model.spheres.size(), st.knob.c_str(), eval_name,
+                    st.slim.sampling, st.slim.depth_threshold, st.slim.fill_holes ? "on" : "off",
+                    st.zoom, static_cast<long long>(last.slim_points), median(gpu), median(slim_ms),
                     static_cast<long long>(e.reference_pixels), static_cast<long long>(e.holes),
                     static_cast<long long>(e.interior_holes), static_cast<long long>(e.spurious),
-                    static_cast<long long>(e.spurious_far), e.depth_mean, e.depth_p99, e.normal_mean_deg,
-                    e.normal_p99_deg, e.interior_depth_p99, e.interior_normal_p99_deg,
-                    static_cast<long long>(e.crease_pixels), e.crease_normal_mean_deg);
+                    static_cast<long long>(e.spurious_far), e.depth_mean, e.depth_p99,
+                    e.normal_mean_deg, e.normal_p99_deg, e.interior_depth_p99,
+                    e.interior_normal_p99_deg, static_cast<long long>(e.crease_pixels),
+                    e.crease_normal_mean_deg);
       md << line << std::flush;
       std::fputs(line, stdout);
       std::fflush(stdout);

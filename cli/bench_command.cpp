@@ -52,13 +52,16 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::Range(16, 4096));
   slim->add_option("--repeats", sopts->repeats, "GPU frames per row, median reported (default 3)")
       ->check(CLI::Range(1, 100));
-  slim->add_option("--reference-samples", sopts->reference_samples,
-                   "Reference depth and normal averaged over K x K rays per pixel (default 1: the centre)")
+  slim->add_option(
+          "--reference-samples", sopts->reference_samples,
+          "Reference depth and normal averaged over K x K rays per pixel (default 1: the centre)")
       ->check(CLI::Range(1, 8));
-  slim->add_option("--zoom", sopts->zooms, "Only these zooms (repeatable; default 0.25 1 4 16, --quick 0.25 1 4)")
+  slim->add_option("--zoom", sopts->zooms,
+                   "Only these zooms (repeatable; default 0.25 1 4 16, --quick 0.25 1 4)")
       ->check(CLI::Range(0.01, 1000.0));
   slim->add_flag("--zoom-only", sopts->zoom_only, "Only the zoom rows (not the S and t rows)");
-  slim->add_flag("--no-generated", sopts->no_generated, "Only the --model files (not the generated sphere and torus)");
+  slim->add_flag("--no-generated", sopts->no_generated,
+                 "Only the --model files (not the generated sphere and torus)");
   slim->add_flag("--images", sopts->images,
                  "Coverage pictures of the zoom rows (grey: both, red: holes, blue: spurious)");
   slim->add_option("--model", sopts->models,

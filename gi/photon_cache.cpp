@@ -138,8 +138,8 @@ std::shared_ptr<const PhotonMaps> PhotonCache::get(const Scene& scene, bool* tra
   return maps;
 }
 
-std::shared_ptr<const PhotonGather> PhotonCache::gather(const std::shared_ptr<const PhotonMaps>& maps,
-                                                        bool skip_direct) {
+std::shared_ptr<const PhotonGather> PhotonCache::gather(
+    const std::shared_ptr<const PhotonMaps>& maps, bool skip_direct) {
   for (Entry& e : entries_) {
     if (e.maps != maps) continue;
     auto& g = e.gather[skip_direct ? 1 : 0];

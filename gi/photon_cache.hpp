@@ -28,7 +28,8 @@ class PhotonCache {
   // The photon search structures over `maps` (which get() returned and
   // which is still cached; else built for this call only), built on first
   // use and kept with the maps: one per skip_direct.
-  std::shared_ptr<const PhotonGather> gather(const std::shared_ptr<const PhotonMaps>& maps, bool skip_direct);
+  std::shared_ptr<const PhotonGather> gather(const std::shared_ptr<const PhotonMaps>& maps,
+                                             bool skip_direct);
   std::size_t bytes() const { return bytes_; }
   std::size_t entries() const { return entries_.size(); }
 

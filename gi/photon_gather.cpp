@@ -6,8 +6,8 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <numbers>
+#include <optional>
 #include <thread>
 #include <variant>
 
@@ -63,7 +63,8 @@ struct PhotonGather::Index {
   Cloud cloud;
   Tree tree;
   Index(const std::vector<Photon>* photons, std::size_t first, std::size_t count)
-      : cloud{photons, first, count}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+      : cloud{photons, first, count},
+        tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
     tree.buildIndex();
   }
 };
@@ -83,8 +84,8 @@ PhotonGather::PhotonGather(const PhotonMaps& maps, bool skip_direct) {
 
 PhotonGather::~PhotonGather() = default;
 
-Color PhotonGather::within(const Index& index, const Vec3& x, const Vec3& n, double r, SplatKernel kernel,
-                           const SplatTests& tests) const {
+Color PhotonGather::within(const Index& index, const Vec3& x, const Vec3& n, double r,
+                           SplatKernel kernel, const SplatTests& tests) const {
   Color sum{0.0, 0.0, 0.0};
   if (index.cloud.count == 0 || !(r > 0.0)) return sum;
   const float q[3] = {static_cast<float>(x[0]), static_cast<float>(x[1]), static_cast<float>(x[2])};
@@ -133,11 +134,16 @@ Color PhotonGather::nearest(const Vec3& x, const Vec3& n, const Color& albedo, i
 
 LitShading::LitShading(const Scene& scene, const GiScene& surfaces, const PhotonGather& gather,
                        GatherMethod method, int k)
-    : scene_(scene), surfaces_(surfaces), gather_(gather), method_(method), k_(k), radii_(splat_radii(scene)) {
+    : scene_(scene),
+      surfaces_(surfaces),
+      gather_(gather),
+      method_(method),
+      k_(k),
+      radii_(splat_radii(scene)) {
   if (scene.gi.direct == DirectLightMethod::kShadowMaps) {
     for (const Light& l : scene.lights) {
-      const auto points =
-          std::visit([&](const auto& kind) { return kind.direct_points(scene.gi.direct_samples); }, l.shape);
+      const auto points = std::visit(
+          [&](const auto& kind) { return kind.direct_points(scene.gi.direct_samples); }, l.shape);
       for (const DirectPoint& p : points) direct_.push_back({p, l.flux});
     }
   }
@@ -146,8 +152,9 @@ LitShading::LitShading(const Scene& scene, const GiScene& surfaces, const Photon
 // The direct pass's sum (shaders/direct_light.frag) with exact visibility,
 // plus the photon estimate.
 Color LitShading::diffuse(const Vec3& x, const Vec3& n, const Color& albedo) const {
-  Color c = method_ == GatherMethod::kFixedRadius ? gather_.fixed_radius(x, n, albedo, radii_, scene_.gi.kernel)
-                                                  : gather_.nearest(x, n, albedo, k_);
+  Color c = method_ == GatherMethod::kFixedRadius
+                ? gather_.fixed_radius(x, n, albedo, radii_, scene_.gi.kernel)
+                : gather_.nearest(x, n, albedo, k_);
   if (direct_.empty()) return c;
   Color sum{0.0, 0.0, 0.0};
   const double eps = surfaces_.epsilon();

@@ -75,7 +75,8 @@ class LitShading {
     DirectPoint point;
     Color flux;
   };
-  Color trace(const Vec3& o, const Vec3& d, double t_min, double t_max, int depth, double weight) const;
+  Color trace(const Vec3& o, const Vec3& d, double t_min, double t_max, int depth,
+              double weight) const;
   Color diffuse(const Vec3& p, const Vec3& n, const Color& albedo) const;
   const Scene& scene_;
   const GiScene& surfaces_;

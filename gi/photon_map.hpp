@@ -68,7 +68,9 @@ double default_caustic_radius(const Scene& scene, std::int64_t caustic_photons);
 
 // The share of each map the photon pass draws: GiSettings::display_fraction
 // kept in [1e-3, 1] (the draws and the radii take the same share).
-inline double display_share(double display_fraction) { return std::clamp(display_fraction, 1e-3, 1.0); }
+inline double display_share(double display_fraction) {
+  return std::clamp(display_fraction, 1e-3, 1.0);
+}
 
 // The radii the splat pass uses for the global and the caustic map: the
 // scene's gi.radius / gi.caustic_radius, or the defaults at the photon

@@ -4,12 +4,12 @@
 
 #include <algorithm>
 #include <array>
-#include <span>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <numbers>
-#include <fstream>
 #include <set>
+#include <span>
 #include <sstream>
 
 #include "protocol/beams/beam_parse.hpp"
@@ -792,8 +792,8 @@ void check_method_fits_densities(const Scene& scene) {
 
 // The SLIM point sampling knobs (issue 16; docs/slim.md), also listed by
 // `hello` (scene_capabilities).
-constexpr std::array<std::string_view, 5> kSlimSettingFields{"sampling", "depth_threshold", "fill_holes",
-                                                             "cull_backfaces", "evaluation"};
+constexpr std::array<std::string_view, 5> kSlimSettingFields{
+    "sampling", "depth_threshold", "fill_holes", "cull_backfaces", "evaluation"};
 
 SlimSettings parse_slim_settings(const Node& n) {
   ObjectReader o(n, "slim settings");
@@ -808,7 +808,8 @@ SlimSettings parse_slim_settings(const Node& n) {
   if (auto v = o.optional("fill_holes")) s.fill_holes = read_bool(*v);
   if (auto v = o.optional("cull_backfaces")) s.cull_backfaces = read_bool(*v);
   if (auto v = o.optional("evaluation")) {
-    s.evaluation = read_enum<SlimEvaluation>(*v, {{"field", SlimEvaluation::kField}, {"blend", SlimEvaluation::kBlend}});
+    s.evaluation = read_enum<SlimEvaluation>(
+        *v, {{"field", SlimEvaluation::kField}, {"blend", SlimEvaluation::kBlend}});
   }
   return s;
 }
@@ -913,7 +914,8 @@ nlohmann::json scene_capabilities() {
           {"gi_kernels", {"box", "cone", "epanechnikov"}},
           {"gi_direct", {"shadow_maps", "photons"}},
           {"camera_rigs", enum_names(kRigKinds)},
-          {"slim_settings", std::vector<std::string_view>(kSlimSettingFields.begin(), kSlimSettingFields.end())}};
+          {"slim_settings",
+           std::vector<std::string_view>(kSlimSettingFields.begin(), kSlimSettingFields.end())}};
 }
 
 }  // namespace beamcast

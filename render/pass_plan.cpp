@@ -30,12 +30,14 @@ const std::vector<TargetDecl>& target_catalog() {
       // What the photon splats add up, before the edge correction (gi_resolve).
       // At gi.splat_scale times fewer pixels per side (indirect light is smooth).
       {"gi_indirect", TargetFormat::kRgba32f, TargetSize::kSplat, TargetClear::kZero},
-      // SLIM point sampling (render/slim_pass.cpp): the nearest point's view
-      // depth per pixel (field evaluation: at the pixel's centre ray), then the weighted sums of the points within the
-      // depth threshold behind it: (w n, w) and (w albedo, w view depth);
-      // with slim.evaluation "field" also F's terms at two points of the
-      // pixel's centre ray (w grad h + h grad w, w h) and (grad w, w). The resolved
-      // surface: (unit normal, view depth), zero where none.
+      // SLIM point sampling (render/slim_pass.cpp): the nearest view depth
+      // per pixel (field evaluation: on the pixel's centre ray, with the
+      // smallest owning sphere's radius), then the sums of what lies within
+      // the depth threshold behind it: blend (the seed's) (w n, w) and
+      // (w albedo, w view depth); field F's terms at two points of the
+      // centre ray, (w grad h + h grad w, w h) and (grad w, w), and
+      // (w albedo, -). The resolved surface: (unit normal, view depth), zero
+      // where none.
       {"slim_near", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
       {"slim_radius", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
       {"slim_sum_normal", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
@@ -73,20 +75,21 @@ const std::vector<PassDecl>& pass_catalog() {
       {PassId::kSlimDepth, "slim_depth", [](const PlanInput& in) { return has_slim(in.scene); },
        {"view_depth"}, {}, {"slim_near", "slim_radius"}, {"slim"}},
       {PassId::kSlimAccumulate, "slim_accumulate",
-       [](const PlanInput& in) { return has_slim(in.scene); }, {"view_depth", "slim_near", "slim_radius"}, {},
-       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_sum_field2",
-        "slim_sum_weight2"},
+       [](const PlanInput& in) { return has_slim(in.scene); },
+       {"view_depth", "slim_near", "slim_radius"}, {},
+       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight",
+        "slim_sum_field2", "slim_sum_weight2"},
        {"slim"}},
       {PassId::kSlimResolve, "slim_resolve",
        [](const PlanInput& in) { return has_slim(in.scene) && !in.scene.has_gi(); },
-       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_near", "slim_sum_field2",
-        "slim_sum_weight2", "slim_radius"},
+       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_near",
+        "slim_sum_field2", "slim_sum_weight2", "slim_radius"},
        {},
        {"hdr", "view_depth", "slim_surface"}, {}},
       {PassId::kSlimGbuffer, "slim_gbuffer",
        [](const PlanInput& in) { return has_slim(in.scene) && in.scene.has_gi(); },
-       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_near", "slim_sum_field2",
-        "slim_sum_weight2", "slim_radius"},
+       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_near",
+        "slim_sum_field2", "slim_sum_weight2", "slim_radius"},
        {},
        {"hdr", "view_depth", "slim_surface", "gb_normal", "gb_albedo"}, {}},
       // Direct light of a lit scene (gi.direct "shadow_maps"): every light as

@@ -152,7 +152,8 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
   if (plan.uploads_group("shadows")) upload_direct();
   if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene);
   if (plan.uploads_group("specular")) {
-    if (!photons) throw GlError("the plan traces specular rays but the renderer has no photon cache");
+    if (!photons)
+      throw GlError("the plan traces specular rays but the renderer has no photon cache");
     if (!maps_) maps_ = photons->get(scene);
     gi_scene_ = std::make_unique<GiScene>(scene);
     photon_gather_ = photons->gather(maps_, plan.uploads_group("shadows"));

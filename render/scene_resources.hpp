@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "protocol/camera.hpp"
-#include "protocol/scene.hpp"
 #include "gi/gi_scene.hpp"
 #include "gi/photon_cache.hpp"
+#include "protocol/camera.hpp"
+#include "protocol/scene.hpp"
 #include "render/gl_util.hpp"
 #include "render/lut.hpp"
 #include "render/pass_plan.hpp"

@@ -27,7 +27,8 @@ SlimPixels slim_reference(const Scene& scene, const Camera& cam, int threads, in
   const CameraBasis basis = camera_basis(cam);
   // The nearest hit along a ray through window position (wx, wy).
   auto trace = [&](double wx, double wy, double* depth, Vec3* normal) {
-    const Ray ray = camera_ray_ndc(cam, basis, 2.0 * wx / cam.width - 1.0, 2.0 * wy / cam.height - 1.0);
+    const Ray ray =
+        camera_ray_ndc(cam, basis, 2.0 * wx / cam.width - 1.0, 2.0 * wy / cam.height - 1.0);
     double best = ray.t_max;
     std::optional<OccluderHit> hit;
     for (const SlimOccluder* s : slims) {

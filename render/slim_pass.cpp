@@ -125,8 +125,9 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
                           std::hypot(p10[0] - p01[0], p10[1] - p01[1])});
       }
     }
-    g.s = static_cast<std::uint32_t>(
-        std::clamp(std::ceil(1.1 * worst / slim_cell_diagonal(settings)), 1.0, static_cast<double>(kSlimMaxFill)));
+    g.s =
+        static_cast<std::uint32_t>(std::clamp(std::ceil(1.1 * worst / slim_cell_diagonal(settings)),
+                                              1.0, static_cast<double>(kSlimMaxFill)));
   }
   return g;
 }
@@ -266,7 +267,8 @@ class SlimPointsPass final : public Pass {
     // (slim_points.vert sets the size); the seed's blend: single pixels.
     const bool field = ctx.scene.slim.evaluation == SlimEvaluation::kField;
     glUniform1i(program_.uniform(multi, "u_field"), field ? 1 : 0);
-    glUniform1f(program_.uniform(multi, "u_cell_diag"), static_cast<float>(slim_cell_diagonal(ctx.scene.slim)));
+    glUniform1f(program_.uniform(multi, "u_cell_diag"),
+                static_cast<float>(slim_cell_diagonal(ctx.scene.slim)));
     if (!depth_) glUniform1f(program_.uniform(multi, "u_step"), kSlimFieldStep);
     if (field) {
       glEnable(GL_PROGRAM_POINT_SIZE);

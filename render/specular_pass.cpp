@@ -17,14 +17,15 @@ class SpecularPass final : public Pass {
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const GiScene* surfaces = ctx.resources.gi_scene();
     const PhotonGather* gather = ctx.resources.photon_gather();
-    if (!surfaces || !gather) throw GlError("specular pass: the scene's ray tracing data is missing");
+    if (!surfaces || !gather)
+      throw GlError("specular pass: the scene's ray tracing data is missing");
     const LitShading shading(ctx.scene, *surfaces, *gather);
     const bool multi = ctx.views > 0;
     const int views = multi ? ctx.views : 1;
     const GLuint albedo_tex = ctx.targets.texture("gb_albedo");
     const GLuint out_tex = ctx.targets.texture("specular");
     std::vector<float> albedo, out;
-    const int k = ctx.scene.gi.specular_samples;
+    const int samples = ctx.scene.gi.specular_samples;  // K x K rays a pixel
     for (int v = 0; v < views; ++v) {
       const Camera& cam = multi ? (*ctx.view_cameras)[static_cast<std::size_t>(v)] : ctx.camera;
       const CameraBasis& basis = multi ? (*ctx.view_bases)[static_cast<std::size_t>(v)] : ctx.basis;
@@ -42,16 +43,17 @@ class SpecularPass final : public Pass {
           if (!(material > 0.5f && material < 2.5f)) continue;  // mirror (1) or glass (2)
           // K x K rays at the centres of a K x K grid over the pixel.
           Color c{0.0, 0.0, 0.0};
-          for (int sy = 0; sy < k; ++sy) {
-            for (int sx = 0; sx < k; ++sx) {
-              const double nx = 2.0 * (x + (sx + 0.5) / k) / w - 1.0;
-              const double ny = 2.0 * (y + (sy + 0.5) / k) / h - 1.0;
+          for (int sy = 0; sy < samples; ++sy) {
+            for (int sx = 0; sx < samples; ++sx) {
+              const double nx = 2.0 * (x + (sx + 0.5) / samples) / w - 1.0;
+              const double ny = 2.0 * (y + (sy + 0.5) / samples) / h - 1.0;
               const Ray ray = camera_ray_ndc(cam, basis, nx, ny);
               c = c + shading.trace(ray.origin, ray.dir, ray.t_min, ray.t_max);
             }
           }
-          c = (1.0 / (k * k)) * c;
-          for (int k = 0; k < 3; ++k) out[4 * i + static_cast<std::size_t>(k)] = static_cast<float>(c[k]);
+          c = (1.0 / (samples * samples)) * c;
+          for (int k = 0; k < 3; ++k)
+            out[4 * i + static_cast<std::size_t>(k)] = static_cast<float>(c[k]);
           out[4 * i + 3] = 1.0f;
         }
       });

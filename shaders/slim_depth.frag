@@ -10,14 +10,11 @@ layout(binding = 0) uniform VIEW_SAMPLER u_scene_depth;
 uniform int u_field;
 uniform vec3 u_offset;  // slim anchor minus eye
 
-in float v_weight;
 in float v_depth;
 in vec3 v_normal;
 flat in float v_radius;
-flat in vec3 v_albedo;
 flat in uint v_sphere;
 flat in vec3 v_point;
-flat in vec2 v_window;
 flat in vec3 v_cell;
 
 layout(location = 0) out float out_near;

@@ -40,7 +40,8 @@ inline Scene mirror_floor_and_light(const Color& L, const Color& reflectance) {
   Material mirror;
   mirror.type = MaterialType::kMirror;
   mirror.reflectance = reflectance;
-  scene.occluders.push_back(quad_occluder({-10.0, 0.0, -10.0}, {0.0, 0.0, 20.0}, {20.0, 0.0, 0.0}, mirror));
+  scene.occluders.push_back(
+      quad_occluder({-10.0, 0.0, -10.0}, {0.0, 0.0, 20.0}, {20.0, 0.0, 0.0}, mirror));
   scene.lights.push_back(quad_light({1.5, 2.5, -1.0}, {1.0, -1.0, 0.0}, {0.0, 0.0, 2.0}, L));
   return scene;
 }
@@ -54,8 +55,10 @@ inline Scene glass_slab_over_light(const Color& L, const Color& tint) {
   glass.type = MaterialType::kGlass;
   glass.ior = 1.5;
   glass.tint = tint;
-  scene.occluders.push_back(quad_occluder({-5.0, -5.0, 1.1}, {10.0, 0.0, 0.0}, {0.0, 10.0, 0.0}, glass));
-  scene.occluders.push_back(quad_occluder({-5.0, -5.0, 1.0}, {0.0, 10.0, 0.0}, {10.0, 0.0, 0.0}, glass));
+  scene.occluders.push_back(
+      quad_occluder({-5.0, -5.0, 1.1}, {10.0, 0.0, 0.0}, {0.0, 10.0, 0.0}, glass));
+  scene.occluders.push_back(
+      quad_occluder({-5.0, -5.0, 1.0}, {0.0, 10.0, 0.0}, {10.0, 0.0, 0.0}, glass));
   scene.lights.push_back(quad_light({-2.0, -2.0, 0.0}, {4.0, 0.0, 0.0}, {0.0, 4.0, 0.0}, L));
   return scene;
 }

@@ -125,8 +125,9 @@ TEST(Gi, SplattingEqualsTheCpuEstimatorOnTheSamePhotons) {
   // Every bounce from photons (the CPU estimator has no shadow maps).
   // At the full render size, without the edge correction, with the
   // light's outline aliased and the mirror and glass pixels followed along
-  // their centre rays only, as the CPU estimator does them. (The outline's antialiasing alone is a 20% L1 difference:
-  // the light is ~100x brighter than the walls.)
+  // their centre rays only, as the CPU estimator does them. (The
+  // outline's antialiasing alone is a 20% L1 difference: the light is
+  // ~100x brighter than the walls.)
   j["gi"] = {{"photons", 20000}, {"caustic_photons", 20000}, {"kernel", "epanechnikov"},
              {"direct", "photons"}, {"edge_correction", false}, {"splat_scale", 1},
              {"light_antialias", false}, {"specular_samples", 1}};

@@ -265,7 +265,8 @@ TEST(Slim, TheSecondStageFillsTheHoles) {
       const std::size_t i = static_cast<std::size_t>(y) * ref.width + x;
       for (std::size_t j : {i + 1, i + ref.width}) {
         if (ref.covered[i] && ref.covered[j]) {
-          pixel_step = std::max(pixel_step, std::abs(double(ref.depth[i]) - ref.depth[j]) * 10.0 / size);
+          pixel_step =
+              std::max(pixel_step, std::abs(double(ref.depth[i]) - ref.depth[j]) * 10.0 / size);
         }
       }
     }
@@ -317,7 +318,8 @@ TEST(Slim, TheSecondStageFillsTheHoles) {
 // neighbour).
 TEST(Slim, ARidgeStaysSharpWithTheFieldEvaluation) {
   Scene scene;
-  scene.occluders.push_back(Occluder{SlimOccluder::from_spheres(test::slim_roof(0.6, 1.0, 8)), {0.8, 0.8, 0.8}, {}});
+  scene.occluders.push_back(
+      Occluder{SlimOccluder::from_spheres(test::slim_roof(0.6, 1.0, 8)), {0.8, 0.8, 0.8}, {}});
   Camera cam;
   cam.position = {0.7, 2.2, 2.4};
   cam.target = Vec3{0.0, -0.3, 0.0};
@@ -328,9 +330,9 @@ TEST(Slim, ARidgeStaysSharpWithTheFieldEvaluation) {
   scene.slim.evaluation = SlimEvaluation::kBlend;
   const Compared blend = render_and_compare(scene, size);
   std::printf("  ridge pixels %lld: field %.2f deg, blend %.2f deg (inner p99 %.3f / %.3f)\n",
-              static_cast<long long>(field.errors.crease_pixels), field.errors.crease_normal_mean_deg,
-              blend.errors.crease_normal_mean_deg, field.errors.interior_normal_p99_deg,
-              blend.errors.interior_normal_p99_deg);
+              static_cast<long long>(field.errors.crease_pixels),
+              field.errors.crease_normal_mean_deg, blend.errors.crease_normal_mean_deg,
+              field.errors.interior_normal_p99_deg, blend.errors.interior_normal_p99_deg);
   EXPECT_GT(field.errors.crease_pixels, 50);
   EXPECT_LT(field.errors.interior_normal_p99_deg, 0.5);
   EXPECT_LT(field.errors.crease_normal_mean_deg, 1.0);
@@ -347,12 +349,13 @@ TEST(Slim, ARidgeStaysSharpWithTheFieldEvaluation) {
 // moves n.l by at most 0.005 where n.l > 0.1 (cos changes by sin * angle);
 // the mean relative difference must stay under 1%.
 TEST(Slim, ALitSlimSphereShadesLikeTheAnalyticSphere) {
-  const json j = {{"occluders", {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1.0},
-                                  {"albedo", {0.8, 0.8, 0.8}}}}},
-                  {"lights", {{{"type", "point"}, {"position", {3, 4, 5}}, {"power", 400}}}},
-                  {"gi", {{"photons", 10000}, {"caustic_photons", 0}}},
-                  {"cameras", {{{"position", {1.2, 0.8, 4.0}}, {"target", {0, 0, 0}}, {"width", 96},
-                                {"height", 96}}}}};
+  const json j = {
+      {"occluders",
+       {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1.0}, {"albedo", {0.8, 0.8, 0.8}}}}},
+      {"lights", {{{"type", "point"}, {"position", {3, 4, 5}}, {"power", 400}}}},
+      {"gi", {{"photons", 10000}, {"caustic_photons", 0}}},
+      {"cameras",
+       {{{"position", {1.2, 0.8, 4.0}}, {"target", {0, 0, 0}}, {"width", 96}, {"height", 96}}}}};
   const Scene analytic = parse_scene(j, {});
   Scene slim = analytic;
   slim.occluders[0].shape = SlimOccluder::from_spheres(test::slim_sphere({0, 0, 0}, 1.0, 400));
@@ -377,7 +380,8 @@ TEST(Slim, ALitSlimSphereShadesLikeTheAnalyticSphere) {
     for (int x = 1; x + 1 < ha.width; ++x) {
       bool inner = true;
       for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) inner = inner && lit(ha, x + dx, y + dy) && lit(hb, x + dx, y + dy);
+        for (int dx = -1; dx <= 1; ++dx)
+          inner = inner && lit(ha, x + dx, y + dy) && lit(hb, x + dx, y + dy);
       }
       if (!inner) continue;
       for (int c = 0; c < 3; ++c) {

@@ -55,12 +55,17 @@ TEST(BeamMedium, TheThreeTermSeriesIsWithin1e3WhereSigmaRIsAtMostOne) {
         if (!(exact > 0.0)) continue;
         const ChordMoments m = chord_moments(f, r, d);
         for (int t = 1; t <= 3; ++t) {
-          worst[t - 1] = std::max(worst[t - 1], std::abs(beam_medium_series(m, sigma, t) - exact) / exact);
+          worst[t - 1] =
+              std::max(worst[t - 1], std::abs(beam_medium_series(m, sigma, t) - exact) / exact);
         }
       }
       std::printf("%-10s %8.3g %10.2e %10.2e %10.2e\n", name, sr, worst[0], worst[1], worst[2]);
-      if (sr <= 1.0) EXPECT_LE(worst[2], 1e-3) << name << " sigma r " << sr;
-      if (sr == 1.0) EXPECT_GT(worst[1], 1e-3) << name;  // why the fourth moment is needed
+      if (sr <= 1.0) {
+        EXPECT_LE(worst[2], 1e-3) << name << " sigma r " << sr;
+      }
+      if (sr == 1.0) {
+        EXPECT_GT(worst[1], 1e-3) << name;  // why the fourth moment is needed
+      }
     }
   }
 }

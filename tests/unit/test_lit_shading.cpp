@@ -25,8 +25,8 @@ Color trace_in(const Scene& scene, const Vec3& o, const Vec3& d) {
 
 TEST(LitShading, AMirrorShowsTheLightTimesItsReflectance) {
   const Color L{2.0, 3.0, 4.0}, reflectance{0.9, 0.5, 0.2};
-  const Color c =
-      trace_in(test::mirror_floor_and_light(L, reflectance), {-2.0, 2.0, 0.0}, normalize(Vec3{1.0, -1.0, 0.0}));
+  const Color c = trace_in(test::mirror_floor_and_light(L, reflectance), {-2.0, 2.0, 0.0},
+                           normalize(Vec3{1.0, -1.0, 0.0}));
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], reflectance[k] * L[k], 1e-12 * L[k]);
 }
 
@@ -54,7 +54,8 @@ TEST(LitShading, ADiffuseWallInAMirrorLooksAsItDoesDirectly) {
   mirror.reflectance = {0.5, 0.5, 0.5};
   scene.occluders.push_back(quad({-10.0, 0.0, -10.0}, {0.0, 0.0, 20.0}, {20.0, 0.0, 0.0}, mirror));
   // A diffuse wall x = 2 facing -x.
-  scene.occluders.push_back(quad({2.0, -1.0, -10.0}, {0.0, 20.0, 0.0}, {0.0, 0.0, 20.0}, Material{}));
+  scene.occluders.push_back(
+      quad({2.0, -1.0, -10.0}, {0.0, 20.0, 0.0}, {0.0, 0.0, 20.0}, Material{}));
   PhotonMaps maps;
   for (int i = 0; i < 50; ++i) {
     Photon p{};

@@ -11,7 +11,8 @@
 namespace beamcast {
 namespace {
 
-Scene scene_with(bool beams, bool occluders, bool lit = false, bool slim = false, bool mirror = false) {
+Scene scene_with(bool beams, bool occluders, bool lit = false, bool slim = false,
+                 bool mirror = false) {
   Scene s;
   if (beams) s.beams.emplace_back();
   if (occluders) s.occluders.push_back(Occluder{SphereOccluder{}, {0.5, 0.5, 0.5}, {}});
@@ -75,7 +76,8 @@ TEST(PassPlan, EveryCatalogPassIsReachable) {
         for (bool slim : {false, true}) {
           for (bool mirror : {false, true}) {
             for (double scale : {1.0, 0.5}) {
-              for (const auto& n : make_plan(PlanInput{scene_with(b, o, lit, slim, mirror), scale}).names()) {
+              for (const auto& n :
+                   make_plan(PlanInput{scene_with(b, o, lit, slim, mirror), scale}).names()) {
                 seen.push_back(n);
               }
             }

@@ -48,7 +48,8 @@ TEST(SchlickPhase, TheCdfIsTheIntegralAndTheSamplerItsInverse) {
     // The CDF's slope is 2 pi p (central difference, step 1e-6).
     for (double mu : {-0.9, 0.0, 0.7}) {
       const double slope = (schlick_cdf(k, mu + 1e-6) - schlick_cdf(k, mu - 1e-6)) / 2e-6;
-      EXPECT_NEAR(slope, 2.0 * std::numbers::pi * schlick_phase(k, mu), 1e-6 * slope) << k << " " << mu;
+      EXPECT_NEAR(slope, 2.0 * std::numbers::pi * schlick_phase(k, mu), 1e-6 * slope)
+          << k << " " << mu;
     }
   }
 }
@@ -100,8 +101,8 @@ TEST(SchlickPhase, SampledDirectionsFollowTheDensity) {
     const double mean = sum / kSamples;
     const double se = std::sqrt((sum2 / kSamples - mean * mean) / kSamples);
     const double want = moment(k, -1.0, 1.0, [](double mu) { return mu; });
-    std::printf("k = %.2f: chi-square %.1f (19 dof), mean mu %.4f (density %.4f, se %.4f)\n", k, chi2,
-                mean, want, se);
+    std::printf("k = %.2f: chi-square %.1f (19 dof), mean mu %.4f (density %.4f, se %.4f)\n", k,
+                chi2, mean, want, se);
     EXPECT_LT(chi2, 43.8) << "k = " << k;
     EXPECT_NEAR(mean, want, 4.0 * se) << "k = " << k;
     // The convention: k > 0 scatters forward (mean mu > 0), k < 0 back.

@@ -124,7 +124,8 @@ TEST(SlimReference, SupersampledDepthIsThePixelMeanOnAPlane) {
   Scene scene;
   std::vector<SlimSphere> spheres(1);
   spheres[0].radius = 3.0;
-  spheres[0].rotation = quat_from_axes({1, 0, 0}, normalize(Vec3{0, 1, 1}), normalize(Vec3{0, -1, 1}));
+  spheres[0].rotation =
+      quat_from_axes({1, 0, 0}, normalize(Vec3{0, 1, 1}), normalize(Vec3{0, -1, 1}));
   scene.occluders.push_back(Occluder{SlimOccluder::from_spheres(spheres), {0.5, 0.5, 0.5}, {}});
   Camera cam;
   cam.projection = Projection::kOrthographic;
@@ -146,8 +147,8 @@ TEST(SlimReference, SupersampledDepthIsThePixelMeanOnAPlane) {
   // On a sphere the depth is not linear across a pixel: the means differ
   // from the centres (the sub-rays do sample the pixel's area).
   Scene round;
-  round.occluders.push_back(
-      Occluder{SlimOccluder::from_spheres(test::slim_sphere({0, 0, 0}, 1.0, 400)), {0.5, 0.5, 0.5}, {}});
+  round.occluders.push_back(Occluder{
+      SlimOccluder::from_spheres(test::slim_sphere({0, 0, 0}, 1.0, 400)), {0.5, 0.5, 0.5}, {}});
   cam.ortho_height = 2.4;
   const SlimPixels c1 = slim_reference(round, cam, 1, 1);
   const SlimPixels c4 = slim_reference(round, cam, 1, 4);
@@ -266,8 +267,9 @@ TEST(SlimFormat, HelloListsTheKindAndTheSettings) {
   EXPECT_FALSE(parsed.slim.fill_holes);
   EXPECT_FALSE(parsed.slim.cull_backfaces);
   EXPECT_EQ(parsed.slim.evaluation, SlimEvaluation::kBlend);
-  EXPECT_EQ(parse_scene(slim_scene({{"type", "slim"}, {"spheres", {one_sphere()}}}), {}).slim.evaluation,
-            SlimEvaluation::kField);
+  EXPECT_EQ(
+      parse_scene(slim_scene({{"type", "slim"}, {"spheres", {one_sphere()}}}), {}).slim.evaluation,
+      SlimEvaluation::kField);
   scene["slim"]["evaluation"] = "exact";
   EXPECT_REJECTED(scene, "invalid_value", "/slim/evaluation");
 }
