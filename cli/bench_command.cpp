@@ -1,10 +1,14 @@
 // `beamcast bench accuracy`: the accuracy/time benchmark of bench/accuracy.hpp;
-// `bench views`; `bench slim` (bench/slim_bench.hpp); `bench gi` (bench/gi_bench.py, run with this binary).
+// `bench views`; `bench slim` (bench/slim_bench.hpp); `bench gi` (bench/gi_bench.py, run with this binary);
+// `bench medium` (bench/medium_bench.py, likewise) and `bench medium-rule`.
 #include <sys/wait.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <utility>
 
 #include "bench/accuracy_report.hpp"
 #include "protocol/data_dir.hpp"
@@ -12,6 +16,8 @@
 #include "bench/accuracy.hpp"
 #include "bench/slim_bench.hpp"
 #include "bench/views.hpp"
+#include "protocol/density.hpp"
+#include "render/beam_medium.hpp"
 #include "cli/commands.hpp"
 
 namespace beamcast::cli {
@@ -138,6 +144,59 @@ void add_bench_command(CLI::App& app) {
     const int status = std::system(cmd.c_str());
     if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
       throw CLI::RuntimeError(status == -1 || !WIFEXITED(status) ? 1 : WEXITSTATUS(status));
+    }
+  });
+
+  // Beams through a medium on the GPU against the reference, per rule and
+  // step across sigma_t r: bench/medium_bench.py with this binary.
+  struct MediumArgs {
+    std::string out;
+    int size = 0;
+  };
+  auto mopts = std::make_shared<MediumArgs>();
+  CLI::App* medium = bench->add_subcommand(
+      "medium",
+      "Beams seen through a homogeneous medium against the CPU reference: the beam rule and step "
+      "across sigma_t r, image error and GPU time; writes medium.csv, medium.md and medium.png to "
+      "--out (runs bench/medium_bench.py with /usr/bin/python3 and numpy)");
+  medium->add_option("--out,-o", mopts->out, "Output directory (created if missing)")->required();
+  medium->add_option("--size", mopts->size, "Frame width and height (default 256)")
+      ->check(CLI::Range(16, 4096));
+  medium->callback([mopts] {
+    const std::filesystem::path script = find_data_dir("bench") / "medium_bench.py";
+    std::string cmd = "/usr/bin/python3 " + bench::shell_quote(script.string()) + " --binary " +
+                      bench::shell_quote(std::filesystem::read_symlink("/proc/self/exe").string()) +
+                      " --out " + bench::shell_quote(mopts->out);
+    if (mopts->size > 0) cmd += " --size " + std::to_string(mopts->size);
+    const int status = std::system(cmd.c_str());
+    if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      throw CLI::RuntimeError(status == -1 || !WIFEXITED(status) ? 1 : WEXITSTATUS(status));
+    }
+  });
+
+  // The beam rule's own error in double (render/beam_medium.hpp), as CSV on
+  // stdout: what medium_bench.py plots beside the GPU's image error.
+  CLI::App* rule = bench->add_subcommand(
+      "medium-rule",
+      "The beam-in-medium rule's own error in double (exact moments) per density, sigma_t r and "
+      "variant, against the exact integral; CSV on stdout");
+  rule->callback([] {
+    std::printf("density,sigma_r,rule,step,worst_rel_error\n");
+    for (std::string_view view : density_names()) {
+      const std::string name(view);
+      Density f;
+      if (!density_from_name(name, &f)) continue;
+      for (double kappa : {1e-3, 1e-2, 0.1, 0.3, 1.0, 3.0, 10.0}) {
+        for (const auto& [r, step] : {std::pair{BeamMediumRule::kGauss2, 2.0},
+                                      std::pair{BeamMediumRule::kGauss2, 1.0},
+                                      std::pair{BeamMediumRule::kGauss2, 0.5},
+                                      std::pair{BeamMediumRule::kMidpoint, 1.0},
+                                      std::pair{BeamMediumRule::kMidpoint, 8.0}}) {
+          std::printf("%s,%g,%s,%g,%.3e\n", name.c_str(), kappa,
+                      r == BeamMediumRule::kGauss2 ? "gauss2" : "midpoint", step,
+                      beam_rule_worst_error(f, kappa, r, step));
+        }
+      }
     }
   });
 }

@@ -6,8 +6,6 @@
 
 namespace beamcast {
 
-double schlick_k_from_g(double g) { return 1.55 * g - 0.55 * g * g * g; }
-
 double schlick_phase(double k, double mu) {
   const double d = 1.0 - k * mu;
   return (1.0 - k * k) / (4.0 * std::numbers::pi * d * d);

@@ -18,15 +18,13 @@
 // backward). Here both use mu as above.
 #pragma once
 
+#include "protocol/medium.hpp"
 #include "protocol/vec.hpp"
 
 namespace beamcast {
 
-// k of the Schlick lobe that approximates a Henyey-Greenstein lobe of mean
-// cosine g: k = 1.55 g - 0.55 g^3. It reaches 1 at g = 0.938 (and peaks at
-// 1.0015 near g = 0.97), so only |g| <= kSchlickMaxG gives a valid |k| < 1.
-inline constexpr double kSchlickMaxG = 0.93;
-double schlick_k_from_g(double g);
+// kSchlickMaxG and schlick_k_from_g (from Henyey-Greenstein g) live with the
+// scene's medium, protocol/medium.hpp.
 
 // p(mu) per steradian.
 double schlick_phase(double k, double mu);

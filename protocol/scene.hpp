@@ -15,6 +15,7 @@
 #include "protocol/beams/beams.hpp"
 #include "protocol/density.hpp"
 #include "protocol/lights/lights.hpp"
+#include "protocol/medium.hpp"
 #include "protocol/occluders/occluders.hpp"
 #include "protocol/vec.hpp"
 
@@ -226,10 +227,14 @@ struct Scene {
   RenderSettings render;
   GiSettings gi;
   SlimSettings slim;
+  // A participating medium filling the scene ("medium"; issue 15).
+  std::optional<Medium> medium;
 
   // Global illumination runs when a light of "lights" lights the scene;
   // otherwise the directional light shades it.
   bool has_gi() const { return !lights.empty(); }
+  // The medium passes run when the medium attenuates (sigma_t > 0).
+  bool has_medium() const { return medium && medium->sigma_t() > 0.0; }
 };
 
 }  // namespace beamcast

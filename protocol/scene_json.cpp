@@ -820,7 +820,7 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   ObjectReader o(root, "a scene");
   o.allow_only(
       {"version", "background", "light", "lights", "gi", "beams", "occluders", "cameras", "output",
-       "render", "slim"});
+       "render", "slim", "medium"});
   Scene scene;
   if (auto v = o.optional("version")) {
     const std::int64_t version = read_integer(*v);
@@ -834,6 +834,7 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   if (auto v = o.optional("output")) scene.output = parse_output(*v);
   if (auto v = o.optional("render")) scene.render = parse_render(*v, limits);
   if (auto v = o.optional("slim")) scene.slim = parse_slim_settings(*v);
+  if (auto v = o.optional("medium")) scene.medium = parse_medium(*v);
   if (auto v = o.optional("lights")) {
     for (const Node& l : read_array(*v, limits.max_lights, "max_lights")) {
       scene.lights.push_back(parse_gi_light(l, limits));
@@ -915,7 +916,10 @@ nlohmann::json scene_capabilities() {
           {"gi_direct", {"shadow_maps", "photons"}},
           {"camera_rigs", enum_names(kRigKinds)},
           {"slim_settings",
-           std::vector<std::string_view>(kSlimSettingFields.begin(), kSlimSettingFields.end())}};
+           std::vector<std::string_view>(kSlimSettingFields.begin(), kSlimSettingFields.end())},
+          {"medium_fields", std::vector<std::string_view>(std::begin(kMediumFields),
+                                                          std::end(kMediumFields))},
+          {"medium_beam_rules", {"gauss2", "midpoint"}}};
 }
 
 }  // namespace beamcast

@@ -13,7 +13,10 @@
 // approximations differ in how many even moments they keep.
 #pragma once
 
+#include <array>
+
 #include "protocol/density.hpp"
+#include "protocol/medium.hpp"
 
 namespace beamcast {
 
@@ -30,5 +33,46 @@ ChordMoments chord_moments(const Density& f, double r, double d);
 // integral alone (attenuation by the midpoint's distance), 2 adds
 // sigma^2 M_2 / 2, 3 adds sigma^4 M_4 / 24.
 double beam_medium_series(const ChordMoments& m, double sigma, int terms);
+
+// ---- A piece of a chord, as the renderer integrates it ----------------------
+// In units of the radius: d the chord's distance from the centre (< 1), tau
+// the position along it from its midpoint, a piece [a, b] of it, and
+// kappa = sigma_t r the optical depth per unit of tau. The light of the
+// piece relative to the attenuation at its start:
+//   I = integral over [a, b] of f(sqrt(d^2 + tau^2)) e^(-kappa (tau - a)) dtau.
+
+// I by adaptive Gauss-Kronrod (split at the density's breakpoints).
+double beam_piece_exact(const Density& f, double d, double a, double b, double kappa);
+
+// The integrals of f tau^n over [a, b], n = 0..3: what the renderer's moment
+// table (LineIntegralTable::gm) differences give.
+std::array<double, 4> piece_moments(const Density& f, double d, double a, double b);
+
+// One sub-piece [a, b] by the two-node Gauss rule whose weight is f, from its
+// moments m (piece_moments): nodes x (in tau) and weights w (summing to
+// m[0]), as shaders/beam_math.glsl forms them (mean, variance and third
+// central moment clamped to what a distribution on [a, b] can have; one node
+// at the mean where the variance is below 1e-6 (b - a)^2).
+struct DensityGauss2 {
+  double x[2] = {0.0, 0.0};
+  double w[2] = {0.0, 0.0};
+};
+DensityGauss2 density_gauss2(const std::array<double, 4>& m, double a, double b);
+
+// I by the renderer's rule (shaders/beam_math.glsl, medium_piece) in double
+// with exact moments: [a, b] split into ceil(kappa (b - a) / step) equal
+// sub-pieces (over at most the first 32 of optical depth; at most
+// kMaxBeamSubPieces), each by density_gauss2 (kGauss2) or by its integral
+// of f attenuated at its midpoint (kMidpoint).
+double beam_piece_rule(const Density& f, double d, double a, double b, double kappa,
+                       BeamMediumRule rule, double step);
+
+// The worst relative error of beam_piece_rule against beam_piece_exact over
+// whole chords (d from 0 to 0.99 in steps of 0.09) and two pieces of each
+// (ends from a fixed pseudo-random sequence), skipping pieces that hold
+// under 1e-6 of their chord's light (their relative error says nothing).
+// What tests/unit/test_beam_medium.cpp bounds and `beamcast bench
+// medium-rule` prints for docs/media.md.
+double beam_rule_worst_error(const Density& f, double kappa, BeamMediumRule rule, double step);
 
 }  // namespace beamcast

@@ -55,8 +55,8 @@ struct Row {
     return (*density)(std::sqrt(d * d + tau * tau));
   }
 
-  // Integral over [a, b] (a <= b), split at the breakpoints inside.
-  double integrate(double a, double b) const {
+  // Integral of f (t - 1)^power over [a, b] (a <= b), split at the breakpoints inside.
+  double integrate(double a, double b, int power = 0) const {
     if (empty) return 0.0;
     const double lo = std::max(a, t.front());
     const double hi = std::min(b, t.back());
@@ -79,7 +79,15 @@ struct Row {
     // Absolute floor: far below anything a float table or a pixel can show.
     opt.abs_tol = 1e-15 * fmax * (hi - lo);
     const auto& self = *this;
-    return quad::integrate_pieces([&self](double x) { return self(x); }, p, n, opt).value;
+    return quad::integrate_pieces(
+               [&self, power](double x) {
+                 const double v = self(x);
+                 double w = 1.0;
+                 for (int k = 0; k < power; ++k) w *= x - 1.0;
+                 return v * w;
+               },
+               p, n, opt)
+        .value;
   }
 };
 
@@ -125,6 +133,22 @@ void integrate_row(const Density& density, double d, const std::vector<double>& 
   for (std::size_t j = 1; j < s.size(); ++j) {
     acc += row.integrate(s[j - 1], s[j]);
     out[j] = static_cast<float>(acc);
+  }
+}
+
+// G_1..G_3 along one row (moments about the chord's midpoint), cumulatively,
+// into out[4 j + n]; out[4 j] gets g.
+void integrate_row_moments(const Density& density, double d, const std::vector<double>& s,
+                           const float* g, float* out) {
+  const Row row(density, d);
+  double acc[4] = {0.0, 0.0, 0.0, 0.0};
+  for (std::size_t j = 0; j < s.size(); ++j) {
+    const double a = j == 0 ? 0.0 : s[j - 1];
+    out[4 * j] = g[j];
+    for (int n = 1; n < 4; ++n) {
+      acc[n] += row.integrate(a, s[j], n);
+      out[4 * j + n] = static_cast<float>(acc[n]);
+    }
   }
 }
 
@@ -214,7 +238,7 @@ std::vector<double> table_rows(const LineIntegralTable& table) {
 }
 
 LineIntegralTable build_table(const Density& density, int nd, int ns, int nf,
-                              TableLayout layout) {
+                              TableLayout layout, bool moments) {
   check_size("nd", nd);
   check_size("ns", ns);
   check_size("nf", nf);
@@ -243,6 +267,15 @@ LineIntegralTable build_table(const Density& density, int nd, int ns, int nf,
     row_columns(rows[i], ns, chord, &s);
     integrate_row(density, rows[i], s, &table.g[static_cast<std::size_t>(i) * ns]);
   });
+  if (moments) {
+    table.gm.assign(static_cast<std::size_t>(nd) * ns * 4, 0.0f);
+    parallel_rows(nd, static_cast<long long>(nd) * ns, [&](int i) {
+      std::vector<double> s;
+      row_columns(rows[i], ns, chord, &s);
+      const std::size_t row0 = static_cast<std::size_t>(i) * ns;
+      integrate_row_moments(density, rows[i], s, &table.g[row0], &table.gm[4 * row0]);
+    });
+  }
 
   for (int k = 0; k < nf; ++k) {
     // Left limit at x = 1, where f jumps to 0 (e.g. the cut gaussian), so that

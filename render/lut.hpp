@@ -32,6 +32,11 @@ struct LineIntegralTable {
   std::vector<float> warp;
   int nf = 0;  // 1D table of f: f_k = f(k / (nf - 1)), for the near-parallel path
   std::vector<float> f;
+  // Only for scenes with a medium (build_table's `moments`): at each texel
+  // (g, G1, G2, G3), G_n(d, s) = integral_0^s f(...) (t - 1)^n dt, the
+  // moments about the chord's midpoint (a beam seen through a medium,
+  // docs/media.md); 4 floats per texel, rows as g.
+  std::vector<float> gm;
 };
 
 // g(d, s) in double, splitting the integral at every point where f has a kink or
@@ -41,7 +46,7 @@ double line_integral(const Density& density, double d, double s);
 
 // The whole table; each row is built cumulatively along s.
 LineIntegralTable build_table(const Density& density, int nd, int ns, int nf,
-                              TableLayout layout = TableLayout::kUniform);
+                              TableLayout layout = TableLayout::kUniform, bool moments = false);
 
 // Row positions of a table with `nd` rows and the given layout (d_i above).
 std::vector<double> table_rows(const LineIntegralTable& table);

@@ -122,6 +122,11 @@ const std::vector<PassDecl>& pass_catalog() {
       {PassId::kSpecular, "specular",
        [](const PlanInput& in) { return in.scene.has_gi() && has_specular(in.scene); },
        {"hdr", "gb_albedo", "specular"}, {}, {"hdr"}, {"specular"}},
+      // A medium filling the scene (render/medium_pass.hpp): what reached
+      // hdr so far (surfaces, background) attenuated by the distance to it;
+      // the beams attenuate their own light.
+      {PassId::kMedium, "medium", [](const PlanInput& in) { return in.scene.has_medium(); },
+       {"hdr"}, {"view_depth"}, {"hdr"}, {}},
       // Beams: energy added to hdr; a ray ends at the nearest surface if
       // anything wrote view_depth.
       {PassId::kBeams, "beams", [](const PlanInput& in) { return !in.scene.beams.empty(); },

@@ -31,11 +31,12 @@ enum class PassId {
   kPhotons,
   kGiResolve,
   kSpecular,
+  kMedium,
   kBeams,
   kTonemap,
   kUpscale
 };
-inline constexpr std::size_t kPassCount = 13;
+inline constexpr std::size_t kPassCount = 14;
 
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gi/photon_map.hpp"
+#include "render/medium_pass.hpp"
 #include "render/slim_pass.hpp"
 #include "render/specular_pass.hpp"
 #include "shaders/shader_sources.hpp"
@@ -494,6 +495,11 @@ class BeamPass final : public Pass {
     glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
     if (multi) glUniform1i(program_.uniform(multi, "u_view_beams"), ctx.resources.beam_count());
     const RenderSettings& rs = ctx.scene.render;
+    const Medium* medium = ctx.scene.has_medium() ? &*ctx.scene.medium : nullptr;
+    glUniform1f(program_.uniform(multi, "u_sigma_t"),
+                medium ? static_cast<float>(medium->sigma_t()) : 0.0f);
+    glUniform1f(program_.uniform(multi, "u_medium_step"),
+                medium ? static_cast<float>(medium->beam_step) : 1.0f);
     const bool chord = rs.layout == TableLayout::kChord || rs.layout == TableLayout::kChordWarped;
     const bool warped = rs.layout == TableLayout::kWarped || rs.layout == TableLayout::kChordWarped;
     const std::pair<const char*, int> knobs[] = {
@@ -504,7 +510,8 @@ class BeamPass final : public Pass {
         {"u_shader_filter", rs.filter == TableFilter::kShader ? 1 : 0},
         {"u_samples", rs.samples},
         {"u_simpson", rs.rule == MarchRule::kSimpson ? 1 : 0},
-        {"u_near_parallel", rs.near_parallel == NearParallel::kQuadrature ? 1 : 0}};
+        {"u_near_parallel", rs.near_parallel == NearParallel::kQuadrature ? 1 : 0},
+        {"u_medium_rule", medium && medium->beam_rule == BeamMediumRule::kMidpoint ? 1 : 0}};
     for (const auto& [uniform, value] : knobs) {
       glUniform1i(program_.uniform(multi, uniform), value);
     }
@@ -512,6 +519,7 @@ class BeamPass final : public Pass {
     glBindTextureUnit(1, ctx.resources.f_texture());
     glBindTextureUnit(2, surfaces ? ctx.targets.texture("view_depth") : 0);
     glBindTextureUnit(3, ctx.resources.warp_texture());
+    glBindTextureUnit(4, ctx.resources.moment_texture());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx.resources.beam_buffer());
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
@@ -598,6 +606,8 @@ std::unique_ptr<Pass> make_pass(PassId id) {
       return std::make_unique<GiResolvePass>();
     case PassId::kSpecular:
       return make_specular_pass();
+    case PassId::kMedium:
+      return make_medium_pass();
     case PassId::kBeams:
       return std::make_unique<BeamPass>();
     case PassId::kTonemap:

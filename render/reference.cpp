@@ -88,11 +88,20 @@ class Points {
 
 constexpr int kMaxGrading = 16;  // 4^14 > 0.25 / 1e-8: enough levels
 
+// A medium's attenuation along the ray, e^(-(base + kappa sigma)) at parameter
+// sigma: base = sigma_t t_ref, kappa = sigma_t r, so the exponent is
+// sigma_t times the ray distance (>= 0 on the visible part: no overflow).
+struct Attenuation {
+  double base = 0.0;
+  double kappa = 0.0;
+  bool on() const { return base != 0.0 || kappa != 0.0; }
+};
+
 // Integral of f(sqrt(d2 + k2 * (sigma - sc)^2)) over [lo, hi], split at the
 // closest approach sc and where the distance crosses each density breakpoint.
 // k2 = 1 for a sphere, sin^2(theta) for the cylinder; inv_k = 1 / sqrt(k2).
 double integrate_radial(const PreparedBeam& pb, double d2, double k2, double inv_k, double sc,
-                        double lo, double hi, double rel_tol) {
+                        double lo, double hi, double rel_tol, const Attenuation& at) {
   if (!(hi > lo)) return 0.0;
   const double d = std::sqrt(d2);
   Points pts(pb.xb.size() * 2 + 3 + 2 * kMaxGrading);
@@ -128,13 +137,20 @@ double integrate_radial(const PreparedBeam& pb, double d2, double k2, double inv
   // Absolute floor, relative to the density's scale: an energy 1e4 times below
   // the requested relative accuracy of a unit-size integral is not refined.
   opt.abs_tol = 1e-4 * rel_tol * pb.fmax;
+  if (at.on()) {
+    // Relative to the light that arrives: the floor scaled by the attenuation
+    // at the piece's near end (the most any of it keeps).
+    opt.abs_tol *= std::exp(-(at.base + at.kappa * lo));
+    auto seen = [&](double s) { return integrand(s) * std::exp(-(at.base + at.kappa * s)); };
+    return quad::integrate_pieces(seen, pts.data(), pts.size(), opt).value;
+  }
   return quad::integrate_pieces(integrand, pts.data(), pts.size(), opt).value;
 }
 
 // Region where the distance is measured to a point `a` (relative, units of r):
 // a sphere beam or one end cap of a capsule, restricted to sigma in [lo, hi].
 double integrate_point(const PreparedBeam& pb, const Vec3& q, const Vec3& v, const Vec3& a,
-                       double lo, double hi, double rel_tol) {
+                       double lo, double hi, double rel_tol, const Attenuation& at) {
   if (!(hi > lo)) return 0.0;
   const Vec3 e = a - q;
   const double sc = dot(e, v);  // closest approach (dot product, never sqrt(|e|^2 - d^2))
@@ -143,13 +159,13 @@ double integrate_point(const PreparedBeam& pb, const Vec3& q, const Vec3& v, con
   if (!(d2 < 1.0)) return 0.0;
   const double c = std::sqrt((1.0 - std::sqrt(d2)) * (1.0 + std::sqrt(d2)));
   return integrate_radial(pb, d2, 1.0, 1.0, sc, std::max(lo, sc - c), std::min(hi, sc + c),
-                          rel_tol);
+                          rel_tol, at);
 }
 
 // Region where the distance is measured to the axis line through `a0` with unit
 // direction w, restricted to sigma in [lo, hi].
 double integrate_line(const PreparedBeam& pb, const Vec3& q, const Vec3& v, const Vec3& a0,
-                      const Vec3& w, double lo, double hi, double rel_tol) {
+                      const Vec3& w, double lo, double hi, double rel_tol, const Attenuation& at) {
   if (!(hi > lo)) return 0.0;
   const Vec3 m = q - a0;
   const Vec3 mp = m - dot(m, w) * w;        // ray point at sigma = 0, radial part
@@ -161,7 +177,12 @@ double integrate_line(const PreparedBeam& pb, const Vec3& q, const Vec3& v, cons
   if (k2 * span * span <= 1e-32 * std::max(dot(mp, mp), 1e-300) || k2 < 1e-200) {
     const double rho2 = dot(mp, mp);
     if (!(rho2 < 1.0)) return 0.0;
-    return (hi - lo) * (*pb.density)(std::sqrt(rho2));
+    const double f = (*pb.density)(std::sqrt(rho2));
+    if (at.kappa > 0.0) {  // integral of e^(-(base + kappa s)) over [lo, hi]
+      return f * std::exp(-(at.base + at.kappa * lo)) * -std::expm1(-at.kappa * (hi - lo)) /
+             at.kappa;
+    }
+    return (hi - lo) * f;
   }
   const double sc = -dot(mp, vp) / k2;  // closest approach to the axis line
   const Vec3 perp = mp + sc * vp;
@@ -171,20 +192,21 @@ double integrate_line(const PreparedBeam& pb, const Vec3& q, const Vec3& v, cons
   const double d = std::sqrt(d2);
   const double c = std::sqrt((1.0 - d) * (1.0 + d)) * inv_k;
   return integrate_radial(pb, d2, k2, inv_k, sc, std::max(lo, sc - c), std::min(hi, sc + c),
-                          rel_tol);
+                          rel_tol, at);
 }
 
 // The point and line regions of one ray q + sigma v, for the kinds'
 // reference_energy (protocol/beams/beam_base.hpp).
 class RayIntegrals final : public RadialIntegrals {
  public:
-  RayIntegrals(const PreparedBeam& pb, const Vec3& q, const Vec3& v, double rel_tol)
-      : pb_(pb), q_(q), v_(v), rel_tol_(rel_tol) {}
+  RayIntegrals(const PreparedBeam& pb, const Vec3& q, const Vec3& v, double rel_tol,
+               const Attenuation& at)
+      : pb_(pb), q_(q), v_(v), rel_tol_(rel_tol), at_(at) {}
   double point(const Vec3& a, double lo, double hi) const override {
-    return integrate_point(pb_, q_, v_, a, lo, hi, rel_tol_);
+    return integrate_point(pb_, q_, v_, a, lo, hi, rel_tol_, at_);
   }
   double line(const Vec3& a, const Vec3& w, double lo, double hi) const override {
-    return integrate_line(pb_, q_, v_, a, w, lo, hi, rel_tol_);
+    return integrate_line(pb_, q_, v_, a, w, lo, hi, rel_tol_, at_);
   }
 
  private:
@@ -192,11 +214,12 @@ class RayIntegrals final : public RadialIntegrals {
   const Vec3& q_;
   const Vec3& v_;
   double rel_tol_;
+  Attenuation at_;
 };
 
-// (1/r) * integral of f along o + t v, t in [t0, t1], |v| = 1.
+// (1/r) * integral of f e^(-sigma_t t) along o + t v, t in [t0, t1], |v| = 1.
 double beam_energy_prepared(const PreparedBeam& pb, const Vec3& o, const Vec3& v, double t0,
-                            double t1, double rel_tol) {
+                            double t1, double rel_tol, double sigma_t = 0.0) {
   if (!(t1 > t0)) return 0.0;
   const Vec3 oc = o - pb.c;
   const double t_ref = -dot(oc, v);
@@ -208,7 +231,7 @@ double beam_energy_prepared(const PreparedBeam& pb, const Vec3& o, const Vec3& v
   const double s1 = std::min((t1 - t_ref) * pb.inv_r, h);
   if (!(s1 > s0)) return 0.0;
 
-  const RayIntegrals f(pb, q, v, rel_tol);
+  const RayIntegrals f(pb, q, v, rel_tol, Attenuation{sigma_t * t_ref, sigma_t * pb.r});
   return std::visit(
       [&](const auto& shape) { return shape.reference_energy(f, q, v, s0, s1, pb.r); },
       *pb.shape);
@@ -239,14 +262,16 @@ Hit nearest_hit(const Scene& scene, const Vec3& o, const Vec3& v, double t_min, 
 }  // namespace
 
 double beam_energy_reference(const Beam& beam, const Vec3& origin, const Vec3& dir, double t0,
-                             double t1, double rel_tol) {
+                             double t1, double rel_tol, double sigma_t) {
   if (!(t1 > t0) || !(beam.radius > 0.0)) return 0.0;
   const double len = length(dir);
   if (!(len > 0.0)) return 0.0;
   const PreparedBeam pb = prepare_beam(beam);
   // The integral is over the parameter t; with a non-unit direction the world
   // distance is t * |dir|, hence the rescaling.
-  return beam_energy_prepared(pb, origin, (1.0 / len) * dir, t0 * len, t1 * len, rel_tol) / len;
+  return beam_energy_prepared(pb, origin, (1.0 / len) * dir, t0 * len, t1 * len, rel_tol,
+                              sigma_t) /
+         len;
 }
 
 HdrImage render_reference(const Scene& scene, const Camera& cam, const ReferenceOptions& opts) {
@@ -266,6 +291,7 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
     beam_src.push_back(&b);
   }
 
+  const double sigma_t = scene.has_medium() ? scene.medium->sigma_t() : 0.0;
   const DirectionalLight& light = scene.light;
   const double llen = length(light.direction);
   const Vec3 to_light = llen > 0.0 ? (-1.0 / llen) * light.direction : Vec3{0.0, 0.0, 0.0};
@@ -289,9 +315,12 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
       const Hit hit = nearest_hit(scene, ray.origin, ray.dir, ray.t_min, ray.t_max);
       Color c = scene.background;
       double t_end = ray.t_max;
+      bool surface = hit.albedo != nullptr;
       if (gi) {
         // Beams end at the surface or light the path tracer sees through the centre.
-        if (const auto h = gi->intersect(ray.origin, ray.dir, ray.t_min, ray.t_max)) t_end = h->t;
+        const auto h = gi->intersect(ray.origin, ray.dir, ray.t_min, ray.t_max);
+        if (h) t_end = h->t;
+        surface = h.has_value();
         c = gi_radiance[static_cast<std::size_t>(y) * cam.width + x];
       } else if (hit.albedo) {
         t_end = hit.t;
@@ -300,9 +329,15 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
         const double lambert = light.ambient + light.intensity * std::max(0.0, dot(n, to_light));
         for (int k = 0; k < 3; ++k) c[k] = (*hit.albedo)[k] * light.color[k] * lambert;
       }
+      if (sigma_t > 0.0) {
+        // The medium fills space: the surface (or the background, at
+        // infinity) attenuated by the distance to it.
+        const double tr = surface ? std::exp(-sigma_t * t_end) : 0.0;
+        for (int k = 0; k < 3; ++k) c[k] *= tr;
+      }
       for (std::size_t b = 0; b < beams.size(); ++b) {
-        const double e =
-            beam_energy_prepared(beams[b], ray.origin, ray.dir, ray.t_min, t_end, opts.rel_tol);
+        const double e = beam_energy_prepared(beams[b], ray.origin, ray.dir, ray.t_min, t_end,
+                                              opts.rel_tol, sigma_t);
         if (e == 0.0) continue;
         const Beam& src = *beam_src[b];
         for (int k = 0; k < 3; ++k) c[k] += src.color[k] * src.intensity * e;

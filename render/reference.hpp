@@ -25,12 +25,16 @@ struct ReferenceOptions {
 // lights (Scene::has_gi) the path tracer gives each pixel's radiance instead
 // (surfaces lit by the lights, background where its paths leave the scene);
 // the beams are added on top, clipped at the surface the pixel's centre sees.
+// A medium (Scene::has_medium) attenuates the surface by e^(-sigma_t t) (the
+// background, at infinity, entirely) and each beam within itself; it does not
+// yet scatter light into the ray (issue 15, items 2, 3 and 7).
 HdrImage render_reference(const Scene& scene, const Camera& cam, const ReferenceOptions& opts = {});
 
 // The energy one beam adds along a ray for t in [t0, t1] (world units), i.e.
-// (1 / r) * integral f(dist(p(t), beam) / r) dt, without color or intensity.
-// Exposed for tests.
+// (1 / r) * integral f(dist(p(t), beam) / r) e^(-sigma_t t) dt (t from the
+// ray's origin; sigma_t a medium's extinction, 0: none), without color or
+// intensity. Exposed for tests.
 double beam_energy_reference(const Beam& beam, const Vec3& origin, const Vec3& dir, double t0,
-                             double t1, double rel_tol = 1e-10);
+                             double t1, double rel_tol = 1e-10, double sigma_t = 0.0);
 
 }  // namespace beamcast

@@ -9,18 +9,21 @@
 namespace beamcast {
 
 std::shared_ptr<const LineIntegralTable> TableCache::get(const Density& density, int nd, int ns,
-                                                         int nf, TableLayout layout) {
+                                                         int nf, TableLayout layout,
+                                                         bool moments) {
   const std::string key = density.key() + "|" + std::to_string(nd) + "x" + std::to_string(ns) +
                           "|" + std::to_string(nf) + "|" +
                           std::to_string(static_cast<int>(layout));
   for (auto it = entries_.begin(); it != entries_.end(); ++it) {
-    if (it->first == key) {
+    if (it->first == key && (!moments || !it->second->gm.empty())) {
       entries_.splice(entries_.begin(), entries_, it);  // most recently used first
       return entries_.front().second;
     }
   }
-  auto table =
-      std::make_shared<const LineIntegralTable>(build_table(density, nd, ns, nf, layout));
+  auto table = std::make_shared<const LineIntegralTable>(
+      build_table(density, nd, ns, nf, layout, moments));
+  // A table with moments replaces the one without.
+  entries_.remove_if([&](const auto& e) { return e.first == key; });
   entries_.emplace_front(key, table);
   while (entries_.size() > max_entries_) entries_.pop_back();
   return table;
@@ -179,7 +182,8 @@ void SceneResources::upload_beams(TableCache& tables) {
     auto it = std::find(keys.begin(), keys.end(), key);
     if (it == keys.end()) {
       keys.push_back(key);
-      layers.push_back(tables.get(beam.density, nd_, ns_, nf_, scene.render.layout));
+      layers.push_back(
+          tables.get(beam.density, nd_, ns_, nf_, scene.render.layout, scene.has_medium()));
       it = keys.end() - 1;
     }
     beam_layers_.push_back(static_cast<float>(it - keys.begin()));
@@ -209,7 +213,16 @@ void SceneResources::upload_beams(TableCache& tables) {
       glTextureSubImage2D(warp_tex_.get(), 0, 0, i, nw_, 1, GL_RED, GL_FLOAT,
                           layers[i]->warp.empty() ? identity : layers[i]->warp.data());
     }
-    for (GLuint tex : {g_tex_.get(), f_tex_.get()}) {
+    if (scene.has_medium()) {
+      glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+      gm_tex_ = GlTexture(id);
+      glTextureStorage3D(id, 1, GL_RGBA32F, ns_, nd_, count);
+      for (GLsizei i = 0; i < count; ++i) {
+        glTextureSubImage3D(id, 0, 0, 0, i, ns_, nd_, 1, GL_RGBA, GL_FLOAT, layers[i]->gm.data());
+      }
+    }
+    for (GLuint tex : {g_tex_.get(), f_tex_.get(), gm_tex_.get()}) {
+      if (tex == 0) continue;
       glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
       glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);

@@ -26,8 +26,10 @@ namespace beamcast {
 class TableCache {
  public:
   explicit TableCache(std::size_t max_entries) : max_entries_(max_entries) {}
+  // `moments`: with the moment channels (LineIntegralTable::gm) of scenes
+  // with a medium; a table with them serves requests without them too.
   std::shared_ptr<const LineIntegralTable> get(const Density& density, int nd, int ns, int nf,
-                                               TableLayout layout);
+                                               TableLayout layout, bool moments = false);
 
  private:
   std::size_t max_entries_;
@@ -55,6 +57,8 @@ class SceneResources {
   int table_s() const { return ns_; }
   int table_f() const { return nf_; }
   GLuint g_texture() const { return g_tex_.get(); }
+  // (g, G1, G2, G3) per texel, RGBA; 0 unless the scene has a medium.
+  GLuint moment_texture() const { return gm_tex_.get(); }
   GLuint f_texture() const { return f_tex_.get(); }
   GLuint warp_texture() const { return warp_tex_.get(); }
   int warp_size() const { return nw_; }
@@ -101,7 +105,7 @@ class SceneResources {
   const Scene& scene_;
   int nd_ = 0, ns_ = 0, nf_ = 0, nw_ = 2;
   std::vector<float> beam_layers_;  // table layer of each beam
-  GlTexture g_tex_, f_tex_, warp_tex_;
+  GlTexture g_tex_, f_tex_, warp_tex_, gm_tex_;
   GlBuffer beam_ssbo_, camera_ubo_, analytic_ssbo_, tri_vbo_;
   GlVertexArray tri_vao_;
   GLsizei tri_vertices_ = 0;

@@ -44,12 +44,16 @@ float march(bool line, vec3 m, vec3 v, vec3 w, float r, float ta, float tb) {
   float h = (tb - ta) / float(n);
   float sum = 0.0;
   if (u_simpson == 0) {
-    for (int k = 0; k < n; ++k) sum += f_eval(piece_distance(line, m, v, w, ta + (float(k) + 0.5) * h) / r);
+    for (int k = 0; k < n; ++k) {
+      float t = ta + (float(k) + 0.5) * h;
+      sum += f_eval(piece_distance(line, m, v, w, t) / r) * attenuation(t);
+    }
     return sum * h / r;
   }
   for (int k = 0; k <= n; ++k) {
     float wk = (k == 0 || k == n) ? 1.0 : ((k & 1) == 1 ? 4.0 : 2.0);
-    sum += wk * f_eval(piece_distance(line, m, v, w, ta + float(k) * h) / r);
+    float t = ta + float(k) * h;
+    sum += wk * f_eval(piece_distance(line, m, v, w, t) / r) * attenuation(t);
   }
   return sum * h / (3.0 * r);
 }
@@ -64,7 +68,7 @@ float sphere_energy(vec3 o, vec3 v, vec3 center, float r, float t0, float t1) {
     float h = r * sqrt((1.0 - d) * (1.0 + d));
     return march(false, -to_c, v, vec3(0.0), r, max(t0, tc - h), min(t1, tc + h));
   }
-  return g_diff(d, (t0 - tc) / r + 1.0, (t1 - tc) / r + 1.0);
+  return g_diff_seen(d, (t0 - tc) / r + 1.0, (t1 - tc) / r + 1.0, t0, r);
 }
 
 float cylinder_energy(vec3 o, vec3 v, vec3 a, vec3 w, float r, float t0, float t1) {
@@ -103,7 +107,7 @@ float cylinder_energy(vec3 o, vec3 v, vec3 a, vec3 w, float r, float t0, float t
       float q = dot(cross(w, m), ch);
       float s0 = (sin_t * t0 + q) / r + 1.0;
       float s1 = (sin_t * t1 + q) / r + 1.0;
-      e += alpha * g_diff(d, s0, s1) / sin_t;
+      e += alpha * g_diff_seen(d, s0, s1, t0, r / sin_t) / sin_t;
     }
   }
   if (alpha < 1.0) {
@@ -133,7 +137,7 @@ float cylinder_energy(vec3 o, vec3 v, vec3 a, vec3 w, float r, float t0, float t
       for (int p = 0; p < panels; ++p) {
         for (int k = 0; k < 3; ++k) {
           float t = ga + h * (float(p) + 0.5 * (1.0 + xk[k]));
-          sum += wk[k] * f_eval(piece_distance(true, m, v, w, t) / r);
+          sum += wk[k] * f_eval(piece_distance(true, m, v, w, t) / r) * attenuation(t);
         }
       }
       e += (1.0 - alpha) * 0.5 * h / r * sum;

@@ -15,6 +15,13 @@ uniform int u_shader_filter; // bilinear weights in the shader instead of the te
 uniform int u_samples;       // march: sub-intervals per piece
 uniform int u_simpson;       // march: Simpson's rule instead of the midpoint rule
 uniform int u_near_parallel; // 0: the paper's form at every angle (comparison only)
+// A medium filling the scene (docs/media.md): extinction per unit length (0:
+// none), the rule of a beam's piece (0: Gauss on the density's moments, 1:
+// midpoint) and the largest optical depth of one sub-piece.
+uniform float u_sigma_t;
+uniform int u_medium_rule;
+uniform float u_medium_step;
+layout(binding = 4) uniform sampler2DArray u_gm;  // (g, G1, G2, G3) of scenes with a medium
 
 // The density of the beam being shaded (set once per fragment).
 float g_layer;
@@ -64,22 +71,26 @@ float table_sample(vec2 texel) {
   return mix(mix(g00, g10, w.x), mix(g01, g11, w.x), w.y);
 }
 
+// The table's row coordinate of d.
+float table_row(float d) {
+  return (u_warped != 0 ? warp_eval(d) : d) * float(u_table_size.x - 1);
+}
+
+// The table's column coordinate of s on a row whose chord half-length is c.
+float table_column(float c, float s) {
+  float cols = float(u_table_size.y - 1);
+  if (u_chord != 0) return 0.5 * ((c > 0.0 ? clamp((s - 1.0) / c, -1.0, 1.0) : -1.0) + 1.0) * cols;
+  return 0.5 * clamp(s, 0.0, 2.0) * cols;
+}
+
 // g(d, s1) - g(d, s0) from the table; the row (and its warp) and the chord are
 // computed once for both ends, and an end before the chord needs no fetch
 // (g = 0 there exactly).
 float g_table_diff(float d, float s0, float s1) {
-  float row = (u_warped != 0 ? warp_eval(d) : d) * float(u_table_size.x - 1);
+  float row = table_row(d);
   float c = sqrt(max((1.0 - d) * (1.0 + d), 0.0));
-  float cols = float(u_table_size.y - 1);
-  vec2 col;
-  if (u_chord != 0) {
-    vec2 sc = c > 0.0 ? clamp((vec2(s0, s1) - 1.0) / c, -1.0, 1.0) : vec2(-1.0, 1.0);
-    col = 0.5 * (sc + 1.0) * cols;
-  } else {
-    col = 0.5 * clamp(vec2(s0, s1), 0.0, 2.0) * cols;
-  }
-  float g1 = s1 <= 1.0 - c ? 0.0 : table_sample(vec2(col.y, row));
-  float g0 = s0 <= 1.0 - c ? 0.0 : table_sample(vec2(col.x, row));
+  float g1 = s1 <= 1.0 - c ? 0.0 : table_sample(vec2(table_column(c, s1), row));
+  float g0 = s0 <= 1.0 - c ? 0.0 : table_sample(vec2(table_column(c, s0), row));
   return g1 - g0;
 }
 
@@ -131,6 +142,91 @@ float g_closed_diff(float d, float s0, float s1) {
 float g_diff(float d, float s0, float s1) {
   return u_method == 1 ? g_closed_diff(d, s0, s1) : g_table_diff(d, s0, s1);
 }
+
+// ---- A beam seen through the medium (docs/media.md) ------------------------
+
+// (g, G1, G2, G3) at s on the current density's row (row coordinate `row`,
+// chord half-length c): the integral of f and of its first three moments
+// about the chord's midpoint from the row's start to s; zero before the chord.
+vec4 moments_at(float row, float c, float s) {
+  if (s <= 1.0 - c) return vec4(0.0);
+  vec2 texel = vec2(table_column(c, s), row);
+  vec2 n = vec2(u_table_size.y, u_table_size.x);
+  return texture(u_gm, vec3((texel + 0.5) / n, g_layer));
+}
+
+// Integral of f(...) e^(-sigma_t t(s)) ds over [s0, s1] of row d, with the
+// ray distance t(s) = t0 + (s - s0) dt_ds (dt_ds > 0): a beam's piece
+// attenuated from the eye and within itself. The part inside the chord is
+// split into sub-pieces of optical depth at most u_medium_step (at most 32,
+// over the first 32 of optical depth: beyond it the rest is attenuated by
+// e^-32). Each sub-piece by the rule:
+//   0: the two-node Gauss rule whose weight is f itself (its nodes and
+//      weights from the sub-piece's moments m0..m3), e^(-sigma t) exact at
+//      the nodes: exact when the attenuation is a cubic in s, error
+//      ~ (sigma L)^4 (L the sub-piece's length);
+//   1: m0 attenuated at the sub-piece's midpoint, error ~ (sigma L)^2.
+// m0 is the method's own g difference (table or closed form); the moments
+// only place the nodes.
+float medium_piece(float d, float s0, float s1, float t0, float dt_ds) {
+  float c = sqrt(max((1.0 - d) * (1.0 + d), 0.0));
+  float a = max(s0, 1.0 - c);
+  float b = min(s1, 1.0 + c);
+  if (!(b > a)) return 0.0;
+  float ta = t0 + (a - s0) * dt_ds;
+  float k = u_sigma_t * dt_ds;  // optical depth per unit of s
+  float len = min(b - a, 32.0 / k);
+  int n = clamp(int(ceil(k * len / u_medium_step)), 1, 32);
+  float h = len / float(n);
+  float row = table_row(d);
+  vec4 g_prev = moments_at(row, c, a);
+  float sum = 0.0;
+  for (int i = 0; i < n; ++i) {
+    float sa = a + float(i) * h;
+    float sb = i == n - 1 ? a + len : sa + h;
+    vec4 g_next = moments_at(row, c, sb);
+    vec4 m = g_next - g_prev;
+    g_prev = g_next;
+    float m0 = u_method == 1 ? g_closed_diff(d, sa, sb) : m.x;
+    float mid = 0.5 * (sa + sb);
+    if (u_medium_rule == 1 || !(m.x > 0.0)) {
+      sum += m0 * exp(-u_sigma_t * ta - k * (mid - a));
+      continue;
+    }
+    // Mean, variance and third central moment of f over the sub-piece in
+    // tau = s - 1, kept to what a distribution on [lo, hi] can have
+    // (interpolated table differences of a short sub-piece are noisy).
+    float lo = sa - 1.0, hi = sb - 1.0;
+    float mean = clamp(m.y / m.x, lo, hi);
+    float e2 = m.z / m.x, e3 = m.w / m.x;
+    float var = clamp(e2 - mean * mean, 0.0, (hi - mean) * (mean - lo));
+    float k3 = e3 - 3.0 * mean * e2 + 2.0 * mean * mean * mean;
+    float x1 = mean, x2 = mean, w1 = 0.5, w2 = 0.5;
+    if (var > 1e-6 * (hi - lo) * (hi - lo)) {
+      // Nodes mean + y, y^2 - (k3 / var) y - var = 0 (roots of opposite signs).
+      float p = 0.5 * k3 / var;
+      float q = sqrt(p * p + var);
+      x1 = clamp(mean + p - q, lo, mean);
+      x2 = clamp(mean + p + q, mean, hi);
+      if (x2 > x1) {
+        w1 = (x2 - mean) / (x2 - x1);
+        w2 = 1.0 - w1;
+      }
+    }
+    sum += m0 * (w1 * exp(-u_sigma_t * ta - k * (x1 + 1.0 - a)) +
+                 w2 * exp(-u_sigma_t * ta - k * (x2 + 1.0 - a)));
+  }
+  return sum;
+}
+
+// g(d, s1) - g(d, s0), attenuated by the medium where there is one; t0 is
+// the ray distance at s0 and dt_ds the ray length per unit of s.
+float g_diff_seen(float d, float s0, float s1, float t0, float dt_ds) {
+  return u_sigma_t > 0.0 ? medium_piece(d, s0, s1, t0, dt_ds) : g_diff(d, s0, s1);
+}
+
+// e^(-sigma_t t): the attenuation from the eye to ray distance t.
+float attenuation(float t) { return u_sigma_t > 0.0 ? exp(-u_sigma_t * t) : 1.0; }
 
 // One texel of s for the table; for the closed form the width under which its
 // float cancellation (G(s1) - G(s0), divided by sin(theta)) is worse than the

@@ -12,8 +12,9 @@ namespace beamcast {
 namespace {
 
 Scene scene_with(bool beams, bool occluders, bool lit = false, bool slim = false,
-                 bool mirror = false) {
+                 bool mirror = false, bool fog = false) {
   Scene s;
+  if (fog) s.medium = Medium{.sigma_s = 0.1};
   if (beams) s.beams.emplace_back();
   if (occluders) s.occluders.push_back(Occluder{SphereOccluder{}, {0.5, 0.5, 0.5}, {}});
   if (occluders && mirror) s.occluders[0].material.type = MaterialType::kMirror;
@@ -75,10 +76,13 @@ TEST(PassPlan, EveryCatalogPassIsReachable) {
       for (bool lit : {false, true}) {
         for (bool slim : {false, true}) {
           for (bool mirror : {false, true}) {
-            for (double scale : {1.0, 0.5}) {
-              for (const auto& n :
-                   make_plan(PlanInput{scene_with(b, o, lit, slim, mirror), scale}).names()) {
-                seen.push_back(n);
+            for (bool fog : {false, true}) {
+              for (double scale : {1.0, 0.5}) {
+                for (const auto& n :
+                     make_plan(PlanInput{scene_with(b, o, lit, slim, mirror, fog), scale})
+                         .names()) {
+                  seen.push_back(n);
+                }
               }
             }
           }

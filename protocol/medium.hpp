@@ -1,0 +1,63 @@
+// A participating medium filling the scene (issue 15; docs/media.md): its
+// coefficients, its phase function and the accuracy knobs of what the
+// renderer does with it. Parsed from the scene's "medium" object.
+#pragma once
+
+#include <string_view>
+
+
+namespace beamcast {
+
+namespace json_read {
+struct Node;
+}  // namespace json_read
+
+// k of the Schlick lobe that approximates a Henyey-Greenstein lobe of mean
+// cosine g: k = 1.55 g - 0.55 g^3 (Blasi, Le Saec and Schlick 1993). It
+// reaches 1 at g = 0.938 (and peaks at 1.0015 near g = 0.97), so only
+// |g| <= kSchlickMaxG gives a valid |k| < 1.
+inline constexpr double kSchlickMaxG = 0.93;
+double schlick_k_from_g(double g);
+
+// How a beam's piece of the view ray is integrated through the medium
+// (render: shaders/beam_math.glsl, CPU: render/beam_medium.hpp).
+enum class BeamMediumRule : unsigned char {
+  // Each sub-piece of the piece by a two-node Gauss rule whose weight is the
+  // density itself (nodes and weights from the moments of f, a table per
+  // density), the attenuation evaluated exactly at the nodes.
+  kGauss2,
+  // The density's integral over each sub-piece attenuated at the
+  // sub-piece's midpoint (the simple form; for comparison).
+  kMidpoint,
+};
+
+struct Medium {
+  // Per unit of scene length; the medium fills all of space, so a ray that
+  // meets no surface sees the background through an infinite optical depth
+  // (none of it) once sigma_t > 0.
+  double sigma_s = 0.0;  // scattering
+  double sigma_a = 0.0;  // absorption
+  double k = 0.0;        // Schlick phase parameter (gi/phase.hpp's convention; > 0 forward)
+  BeamMediumRule beam_rule = BeamMediumRule::kGauss2;
+  // Largest optical depth of one sub-piece of a beam's piece (the pieces
+  // are split into ceil(depth / beam_step) sub-pieces, at most
+  // kMaxBeamSubPieces); the error falls as beam_step^4 (docs/media.md).
+  double beam_step = 1.0;
+
+  double sigma_t() const { return sigma_s + sigma_a; }
+};
+
+// The most sub-pieces a beam's piece is split into; with optical depth
+// beyond kMaxBeamSubPieces x beam_step the rest of the piece is attenuated by
+// e^-32 or more (at the default step), below any pixel's resolution.
+inline constexpr int kMaxBeamSubPieces = 32;
+
+// The fields of "medium", for `hello`'s capabilities.
+inline constexpr std::string_view kMediumFields[] = {"sigma_s", "sigma_a", "k", "g",
+                                                      "beam_rule", "beam_step"};
+
+// Throws ProtocolError (code, message, JSON path) for a bad field: negative
+// coefficients, |k| >= 1 or |g| > kSchlickMaxG, both k and g.
+Medium parse_medium(const json_read::Node& n);
+
+}  // namespace beamcast

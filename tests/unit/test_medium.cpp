@@ -1,0 +1,93 @@
+// The participating medium in the scene format (issue 15, item 1): "medium"
+// parses to the model, plans the medium pass only when it attenuates, and
+// every bad field is refused with its JSON pointer.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+
+#include "protocol/errors.hpp"
+#include "protocol/scene_json.hpp"
+#include "render/pass_plan.hpp"
+
+namespace beamcast {
+namespace {
+
+using nlohmann::json;
+
+json fogged(json medium) {
+  return {{"beams", {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1.0}}}},
+          {"medium", std::move(medium)},
+          {"cameras", {{{"position", {0, 0, 5}}, {"target", {0, 0, 0}}}}}};
+}
+
+ErrorInfo error_of(const json& j) {
+  try {
+    parse_scene(j, {});
+  } catch (const ProtocolError& e) {
+    return e.info();
+  }
+  ADD_FAILURE() << "scene was accepted: " << j.dump();
+  return {};
+}
+
+TEST(Medium, ParsesCoefficientsPhaseAndKnobs) {
+  const Scene s = parse_scene(fogged({{"sigma_s", 0.2}, {"sigma_a", 0.05}, {"g", 0.5},
+                                      {"beam_rule", "midpoint"}, {"beam_step", 0.5}}),
+                              {});
+  ASSERT_TRUE(s.medium.has_value());
+  EXPECT_DOUBLE_EQ(s.medium->sigma_t(), 0.25);
+  EXPECT_NEAR(s.medium->k, 0.70625, 1e-12);  // 1.55 g - 0.55 g^3 at g = 0.5
+  EXPECT_EQ(s.medium->beam_rule, BeamMediumRule::kMidpoint);
+  EXPECT_DOUBLE_EQ(s.medium->beam_step, 0.5);
+  const Scene k = parse_scene(fogged({{"sigma_a", 1.0}, {"k", -0.3}}), {});
+  EXPECT_DOUBLE_EQ(k.medium->k, -0.3);
+  EXPECT_EQ(k.medium->beam_rule, BeamMediumRule::kGauss2);  // the default
+}
+
+// The pass runs only when the medium attenuates: none, or a medium with
+// sigma_t = 0, plans exactly what the scene planned before media existed.
+TEST(Medium, TheMediumPassIsPlannedOnlyWhenSomethingAttenuates) {
+  json clear = fogged(json::object());
+  clear.erase("medium");
+  const auto has_medium_pass = [](const json& j) {
+    const std::vector<std::string> p = plan_passes(parse_scene(j, {}));
+    return std::find(p.begin(), p.end(), "medium") != p.end();
+  };
+  EXPECT_FALSE(has_medium_pass(clear));
+  EXPECT_FALSE(has_medium_pass(fogged({{"sigma_s", 0.0}})));
+  EXPECT_TRUE(has_medium_pass(fogged({{"sigma_s", 0.1}})));
+  EXPECT_EQ(plan_passes(parse_scene(fogged({{"sigma_a", 0.1}}), {})),
+            (std::vector<std::string>{"medium", "beams", "tonemap"}));
+}
+
+TEST(Medium, BadFieldsAreRefusedWithTheirPath) {
+  struct Case {
+    json medium;
+    std::string code, path;
+  };
+  const Case cases[] = {
+      {{{"sigma_s", -0.1}}, "out_of_range", "/medium/sigma_s"},
+      {{{"sigma_a", -1e-9}}, "out_of_range", "/medium/sigma_a"},
+      {{{"sigma_a", 1e7}}, "out_of_range", "/medium/sigma_a"},
+      {{{"g", 1.0}}, "out_of_range", "/medium/g"},
+      {{{"g", -0.95}}, "out_of_range", "/medium/g"},
+      {{{"k", 1.0}}, "out_of_range", "/medium/k"},
+      {{{"k", -1.0}}, "out_of_range", "/medium/k"},
+      {{{"k", 0.2}, {"g", 0.2}}, "invalid_value", "/medium/g"},
+      {{{"sigma_s", "thick"}}, "wrong_type", "/medium/sigma_s"},
+      {{{"beam_rule", "simpson"}}, "invalid_value", "/medium/beam_rule"},
+      {{{"beam_step", 0.0}}, "out_of_range", "/medium/beam_step"},
+      {{{"density", 1.0}}, "unknown_field", "/medium/density"},
+      {json::array(), "wrong_type", "/medium"},
+  };
+  for (const Case& c : cases) {
+    const ErrorInfo e = error_of(fogged(c.medium));
+    EXPECT_EQ(e.code, c.code) << c.medium.dump() << ": " << e.message;
+    EXPECT_EQ(e.path, c.path) << c.medium.dump() << ": " << e.message;
+    EXPECT_FALSE(e.message.empty());
+  }
+}
+
+}  // namespace
+}  // namespace beamcast
