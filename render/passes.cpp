@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -484,22 +485,29 @@ class PhotonPass final : public Pass {
 class BeamPass final : public Pass {
  public:
   BeamPass()
-      : program_("beam") {}
+      : plain_("beam") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
-    glUseProgram(program_.get(multi));
-    glUniform3i(program_.uniform(multi, "u_table_size"), ctx.resources.table_d(),
+    // Scenes with a medium use the program with it compiled in (built on
+    // first use); the others the program without, unchanged by media.
+    const Medium* medium = ctx.scene.has_medium() ? &*ctx.scene.medium : nullptr;
+    if (medium && !fogged_) fogged_.emplace("beam_medium");
+    ProgramPair& program = medium ? *fogged_ : plain_;
+    glUseProgram(program.get(multi));
+    glUniform3i(program.uniform(multi, "u_table_size"), ctx.resources.table_d(),
                 ctx.resources.table_s(), ctx.resources.table_f());
     // A ray ends at the nearest surface if any planned pass wrote view depth.
     const bool surfaces = ctx.plan.written("view_depth");
-    glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
-    if (multi) glUniform1i(program_.uniform(multi, "u_view_beams"), ctx.resources.beam_count());
+    glUniform1i(program.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
+    if (multi) glUniform1i(program.uniform(multi, "u_view_beams"), ctx.resources.beam_count());
     const RenderSettings& rs = ctx.scene.render;
-    const Medium* medium = ctx.scene.has_medium() ? &*ctx.scene.medium : nullptr;
-    glUniform1f(program_.uniform(multi, "u_sigma_t"),
-                medium ? static_cast<float>(medium->sigma_t()) : 0.0f);
-    glUniform1f(program_.uniform(multi, "u_medium_step"),
-                medium ? static_cast<float>(medium->beam_step) : 1.0f);
+    if (medium) {
+      glUniform1f(program.uniform(multi, "u_sigma_t"), static_cast<float>(medium->sigma_t()));
+      glUniform1f(program.uniform(multi, "u_medium_step"),
+                  static_cast<float>(medium->beam_step));
+      glUniform1i(program.uniform(multi, "u_medium_rule"),
+                  medium->beam_rule == BeamMediumRule::kMidpoint ? 1 : 0);
+    }
     const bool chord = rs.layout == TableLayout::kChord || rs.layout == TableLayout::kChordWarped;
     const bool warped = rs.layout == TableLayout::kWarped || rs.layout == TableLayout::kChordWarped;
     const std::pair<const char*, int> knobs[] = {
@@ -510,16 +518,15 @@ class BeamPass final : public Pass {
         {"u_shader_filter", rs.filter == TableFilter::kShader ? 1 : 0},
         {"u_samples", rs.samples},
         {"u_simpson", rs.rule == MarchRule::kSimpson ? 1 : 0},
-        {"u_near_parallel", rs.near_parallel == NearParallel::kQuadrature ? 1 : 0},
-        {"u_medium_rule", medium && medium->beam_rule == BeamMediumRule::kMidpoint ? 1 : 0}};
+        {"u_near_parallel", rs.near_parallel == NearParallel::kQuadrature ? 1 : 0}};
     for (const auto& [uniform, value] : knobs) {
-      glUniform1i(program_.uniform(multi, uniform), value);
+      glUniform1i(program.uniform(multi, uniform), value);
     }
     glBindTextureUnit(0, ctx.resources.g_texture());
     glBindTextureUnit(1, ctx.resources.f_texture());
     glBindTextureUnit(2, surfaces ? ctx.targets.texture("view_depth") : 0);
     glBindTextureUnit(3, ctx.resources.warp_texture());
-    glBindTextureUnit(4, ctx.resources.moment_texture());
+    if (medium) glBindTextureUnit(4, ctx.resources.moment_texture());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx.resources.beam_buffer());
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
@@ -530,7 +537,7 @@ class BeamPass final : public Pass {
     glEnable(GL_DEPTH_CLAMP);  // proxies past the near or far plane still cover their pixels
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(ctx.empty_vao);
-    for_each_view(ctx, self, program_, [&] {
+    for_each_view(ctx, self, program, [&] {
       glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count());
     });
     glDisable(GL_BLEND);
@@ -540,7 +547,8 @@ class BeamPass final : public Pass {
   }
 
  private:
-  ProgramPair program_;
+  ProgramPair plain_;
+  std::optional<ProgramPair> fogged_;
 };
 
 // HDR -> display values in the output's bit depth.

@@ -15,13 +15,16 @@ uniform int u_shader_filter; // bilinear weights in the shader instead of the te
 uniform int u_samples;       // march: sub-intervals per piece
 uniform int u_simpson;       // march: Simpson's rule instead of the midpoint rule
 uniform int u_near_parallel; // 0: the paper's form at every angle (comparison only)
-// A medium filling the scene (docs/media.md): extinction per unit length (0:
-// none), the rule of a beam's piece (0: Gauss on the density's moments, 1:
-// midpoint) and the largest optical depth of one sub-piece.
+#ifdef BEAMCAST_MEDIUM
+// A medium filling the scene (docs/media.md; program "beam_medium", which
+// only scenes with a medium use): extinction per unit length, the rule of a
+// beam's piece (0: Gauss on the density's moments, 1: midpoint) and the
+// largest optical depth of one sub-piece.
 uniform float u_sigma_t;
 uniform int u_medium_rule;
 uniform float u_medium_step;
-layout(binding = 4) uniform sampler2DArray u_gm;  // (g, G1, G2, G3) of scenes with a medium
+layout(binding = 4) uniform sampler2DArray u_gm;  // (g, G1, G2, G3)
+#endif
 
 // The density of the beam being shaded (set once per fragment).
 float g_layer;
@@ -144,6 +147,7 @@ float g_diff(float d, float s0, float s1) {
 }
 
 // ---- A beam seen through the medium (docs/media.md) ------------------------
+#ifdef BEAMCAST_MEDIUM
 
 // (g, G1, G2, G3) at s on the current density's row (row coordinate `row`,
 // chord half-length c): the integral of f and of its first three moments
@@ -219,14 +223,19 @@ float medium_piece(float d, float s0, float s1, float t0, float dt_ds) {
   return sum;
 }
 
-// g(d, s1) - g(d, s0), attenuated by the medium where there is one; t0 is
-// the ray distance at s0 and dt_ds the ray length per unit of s.
+// g(d, s1) - g(d, s0) attenuated by the medium; t0 is the ray distance at
+// s0 and dt_ds the ray length per unit of s.
 float g_diff_seen(float d, float s0, float s1, float t0, float dt_ds) {
-  return u_sigma_t > 0.0 ? medium_piece(d, s0, s1, t0, dt_ds) : g_diff(d, s0, s1);
+  return medium_piece(d, s0, s1, t0, dt_ds);
 }
 
 // e^(-sigma_t t): the attenuation from the eye to ray distance t.
-float attenuation(float t) { return u_sigma_t > 0.0 ? exp(-u_sigma_t * t) : 1.0; }
+float attenuation(float t) { return exp(-u_sigma_t * t); }
+#else
+// Without a medium (program "beam"): nothing is attenuated.
+float g_diff_seen(float d, float s0, float s1, float t0, float dt_ds) { return g_diff(d, s0, s1); }
+float attenuation(float t) { return 1.0; }
+#endif
 
 // One texel of s for the table; for the closed form the width under which its
 // float cancellation (G(s1) - G(s0), divided by sin(theta)) is worse than the
