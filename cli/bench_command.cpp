@@ -1,6 +1,6 @@
 // `beamcast bench accuracy`: the accuracy/time benchmark of bench/accuracy.hpp;
 // `bench views`; `bench slim` (bench/slim_bench.hpp); `bench gi` (bench/gi_bench.py, run with this binary);
-// `bench medium` (bench/medium_bench.py, likewise) and `bench medium-rule`.
+// `bench medium` (bench/medium_bench.py, likewise), `bench medium-rule` and `bench fog` (bench/fog_bench.py).
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -21,6 +21,25 @@
 #include "cli/commands.hpp"
 
 namespace beamcast::cli {
+
+namespace {
+
+// Runs bench/SCRIPT with /usr/bin/python3, this binary and --out OUT, plus
+// `extra` (already quoted); a failing script fails the command.
+void run_python_bench(const std::string& script_name, const std::string& out,
+                      const std::string& extra) {
+  const std::filesystem::path script = find_data_dir("bench") / script_name;
+  const std::string cmd =
+      "/usr/bin/python3 " + bench::shell_quote(script.string()) + " --binary " +
+      bench::shell_quote(std::filesystem::read_symlink("/proc/self/exe").string()) + " --out " +
+      bench::shell_quote(out) + extra;
+  const int status = std::system(cmd.c_str());
+  if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    throw CLI::RuntimeError(status == -1 || !WIFEXITED(status) ? 1 : WEXITSTATUS(status));
+  }
+}
+
+}  // namespace
 
 void add_bench_command(CLI::App& app) {
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks of the local renderer");
@@ -133,18 +152,12 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::Range(1, 1 << 20));
   gi->add_option("--scene", gopts->scene, "Scene (default examples/cornell_box.json)");
   gi->callback([gopts] {
-    const std::filesystem::path script = find_data_dir("bench") / "gi_bench.py";
-    std::string cmd = "/usr/bin/python3 " + bench::shell_quote(script.string()) + " --binary " +
-                      bench::shell_quote(std::filesystem::read_symlink("/proc/self/exe").string()) +
-                      " --out " + bench::shell_quote(gopts->out);
-    if (gopts->quick) cmd += " --quick";
-    if (gopts->size > 0) cmd += " --size " + std::to_string(gopts->size);
-    if (gopts->spp > 0) cmd += " --spp " + std::to_string(gopts->spp);
-    if (!gopts->scene.empty()) cmd += " --scene " + bench::shell_quote(gopts->scene);
-    const int status = std::system(cmd.c_str());
-    if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-      throw CLI::RuntimeError(status == -1 || !WIFEXITED(status) ? 1 : WEXITSTATUS(status));
-    }
+    std::string extra;
+    if (gopts->quick) extra += " --quick";
+    if (gopts->size > 0) extra += " --size " + std::to_string(gopts->size);
+    if (gopts->spp > 0) extra += " --spp " + std::to_string(gopts->spp);
+    if (!gopts->scene.empty()) extra += " --scene " + bench::shell_quote(gopts->scene);
+    run_python_bench("gi_bench.py", gopts->out, extra);
   });
 
   // Beams through a medium on the GPU against the reference, per rule and
@@ -163,15 +176,33 @@ void add_bench_command(CLI::App& app) {
   medium->add_option("--size", mopts->size, "Frame width and height (default 256)")
       ->check(CLI::Range(16, 4096));
   medium->callback([mopts] {
-    const std::filesystem::path script = find_data_dir("bench") / "medium_bench.py";
-    std::string cmd = "/usr/bin/python3 " + bench::shell_quote(script.string()) + " --binary " +
-                      bench::shell_quote(std::filesystem::read_symlink("/proc/self/exe").string()) +
-                      " --out " + bench::shell_quote(mopts->out);
-    if (mopts->size > 0) cmd += " --size " + std::to_string(mopts->size);
-    const int status = std::system(cmd.c_str());
-    if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-      throw CLI::RuntimeError(status == -1 || !WIFEXITED(status) ? 1 : WEXITSTATUS(status));
-    }
+    run_python_bench("medium_bench.py", mopts->out,
+                     mopts->size > 0 ? " --size " + std::to_string(mopts->size) : "");
+  });
+
+  // Light scattered in fog: the seed's volume estimate against the beam
+  // radiance estimate and the path tracer (bench/fog_bench.py).
+  struct FogArgs {
+    std::string out;
+    int size = 0, spp = 0;
+  };
+  auto fopts = std::make_shared<FogArgs>();
+  CLI::App* fog = bench->add_subcommand(
+      "fog",
+      "In-scattered light in a homogeneous medium on examples/fog_stage.json and a denser copy: "
+      "the seed's estimate and the beam radiance estimate against the path tracer, photon count, "
+      "GPU time; writes fog.csv, fog.md and fog.png to --out (runs bench/fog_bench.py with "
+      "/usr/bin/python3 and numpy)");
+  fog->add_option("--out,-o", fopts->out, "Output directory (created if missing)")->required();
+  fog->add_option("--size", fopts->size, "Frame width and height (default 256)")
+      ->check(CLI::Range(16, 4096));
+  fog->add_option("--spp", fopts->spp, "Reference paths per pixel per seed (default 2048)")
+      ->check(CLI::Range(1, 1 << 20));
+  fog->callback([fopts] {
+    std::string extra;
+    if (fopts->size > 0) extra += " --size " + std::to_string(fopts->size);
+    if (fopts->spp > 0) extra += " --spp " + std::to_string(fopts->spp);
+    run_python_bench("fog_bench.py", fopts->out, extra);
   });
 
   // The beam rule's own error in double (render/beam_medium.hpp), as CSV on

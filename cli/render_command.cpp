@@ -151,6 +151,7 @@ int run_render(const RenderArgs& args) {
         jf["photons"] = {{"count", fr.photons},
                          {"trace_ms", fr.photon_trace_ms},
                          {"upload_ms", fr.photon_upload_ms}};
+        if (fr.volume_photons > 0) jf["photons"]["volume"] = fr.volume_photons;
       }
     }
     if (args.hdr) {

@@ -11,6 +11,7 @@
 
 #include "gi/optics.hpp"
 #include "gi/parallel.hpp"
+#include "gi/phase.hpp"
 #include "protocol/camera.hpp"
 #include "protocol/check.hpp"
 #include "protocol/lights/sampling.hpp"
@@ -55,8 +56,33 @@ class Tracer {
     Color L{0.0, 0.0, 0.0};
     Color beta{1.0, 1.0, 1.0};  // path throughput
     bool specular = true;       // camera ray or last bounce specular: emission and background count
+    const Medium* medium = scene.has_medium() ? &*scene.medium : nullptr;
     for (int depth = 0; depth < opts_.max_depth; ++depth) {
       const std::optional<SurfaceHit> hit = gi_.intersect(o, v, t_min, t_max);
+      if (medium) {
+        // Free flight from o (the eye for the camera ray: the medium lies
+        // before the near plane too, but what scatters there is not seen).
+        // Sampled with density sigma_t e^(-sigma_t t), the event's weight is
+        // the albedo sigma_s / sigma_t; a surface reached first has weight 1.
+        const double free = -std::log1p(-uniform(rng)) / medium->sigma_t();
+        if (!hit || free < hit->t) {
+          if (free < t_min) break;
+          const Vec3 x = o + free * v;
+          beta = (medium->sigma_s / medium->sigma_t()) * beta;
+          L = L + mul(beta, in_scattered(x, v, *medium, rng));
+          v = schlick_sample_direction(medium->k, v, uniform(rng), uniform(rng));
+          specular = false;
+          if (depth >= 2) {
+            const double q = std::min(0.95, std::max({beta[0], beta[1], beta[2]}));
+            if (!(uniform(rng) < q)) break;
+            beta = (1.0 / q) * beta;
+          }
+          o = x;
+          t_min = 0.0;
+          t_max = kInf;
+          continue;
+        }
+      }
       if (!hit) {
         if (specular) L = L + mul(beta, scene.background);
         break;
@@ -138,9 +164,38 @@ class Tracer {
     if (!(s.g > 0.0) || !(cos_x > 0.0)) return {0.0, 0.0, 0.0};
     const double eps = gi_.epsilon();
     if (gi_.occluded(x, s.dir, eps, s.dist - eps)) return {0.0, 0.0, 0.0};
-    // E = flux g cos_x / pick; L_out = (albedo / pi) E.
-    const double k = s.g * cos_x / (std::numbers::pi * pick_[i]);
+    // E = flux g cos_x / pick (times the medium's transmittance); L_out = (albedo / pi) E.
+    const double k = s.g * cos_x * transmittance(s.dist) / (std::numbers::pi * pick_[i]);
     return k * mul(albedo, light.flux);
+  }
+
+  // Next-event estimation at a point x of the medium on a path travelling
+  // along v: the radiance one light sample scatters into -v,
+  // p(mu) flux g T / pick, mu = dot(s.dir, v) (the light travels along
+  // -s.dir, then towards the eye along -v: gi/phase.hpp's convention).
+  Color in_scattered(const Vec3& x, const Vec3& v, const Medium& medium,
+                     std::mt19937_64& rng) const {
+    if (pick_.empty()) return {0.0, 0.0, 0.0};
+    const Scene& scene = gi_.scene();
+    const double u = uniform(rng);
+    const LightRandom lu{uniform(rng), uniform(rng), uniform(rng), uniform(rng)};
+    std::size_t i = 0;
+    double acc = pick_[0];
+    while (u >= acc && i + 1 < pick_.size()) acc += pick_[++i];
+    if (!(pick_[i] > 0.0)) return {0.0, 0.0, 0.0};
+    const Light& light = scene.lights[i];
+    const LightSample s = std::visit([&](const auto& k) { return k.sample(x, lu); }, light.shape);
+    if (!(s.g > 0.0)) return {0.0, 0.0, 0.0};
+    if (gi_.occluded(x, s.dir, 0.0, s.dist - gi_.epsilon())) return {0.0, 0.0, 0.0};
+    const double k =
+        schlick_phase(medium.k, dot(s.dir, v)) * s.g * transmittance(s.dist) / pick_[i];
+    return k * light.flux;
+  }
+
+  // e^(-sigma_t d) of the scene's medium (1 without one).
+  double transmittance(double d) const {
+    const Scene& scene = gi_.scene();
+    return scene.has_medium() ? std::exp(-scene.medium->sigma_t() * d) : 1.0;
   }
 
   const GiScene& gi_;

@@ -112,6 +112,14 @@ std::string photon_key(const Scene& scene) {
   k.put(scene.gi.caustic_photons);
   k.put(scene.gi.seed);
   k.put(scene.gi.max_depth);
+  // The medium: the paths' free flights, absorption and phase (its beam
+  // knobs and the volume estimate's settings only shape the frame).
+  k.put(scene.has_medium());
+  if (scene.has_medium()) {
+    k.put(scene.medium->sigma_s);
+    k.put(scene.medium->sigma_a);
+    k.put(scene.medium->k);
+  }
   return k.digest();
 }
 
@@ -127,7 +135,8 @@ std::shared_ptr<const PhotonMaps> PhotonCache::get(const Scene& scene, bool* tra
   const GiScene surfaces(scene);
   auto maps = std::make_shared<const PhotonMaps>(trace_photons(scene, surfaces));
   if (traced) *traced = true;
-  const std::size_t bytes = (maps->global.size() + maps->caustic.size()) * sizeof(Photon);
+  const std::size_t bytes =
+      (maps->global.size() + maps->caustic.size() + maps->volume.size()) * sizeof(Photon);
   entries_.push_front({key, maps, bytes, {}});
   bytes_ += bytes;
   // Evict the least recently used, but keep the one just traced.

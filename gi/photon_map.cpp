@@ -12,6 +12,7 @@
 
 #include "gi/optics.hpp"
 #include "gi/parallel.hpp"
+#include "gi/phase.hpp"
 #include "protocol/lights/sampling.hpp"
 
 namespace beamcast {
@@ -77,12 +78,24 @@ Photon make_photon(const SurfaceHit& h, const Vec3& dir, const Color& power, int
 
 Color scale(const Color& a, const Color& b) { return {a[0] * b[0], a[1] * b[1], a[2] * b[2]}; }
 
+Photon make_volume_photon(const Vec3& x, const Vec3& dir, const Color& power, int events) {
+  Photon ph{};
+  for (int k = 0; k < 3; ++k) {
+    ph.p[k] = static_cast<float>(x[k]);
+    ph.power[k] = static_cast<float>(power[k]);
+    ph.dir[k] = static_cast<float>(dir[k]);
+  }
+  ph.bounces = static_cast<std::uint16_t>(std::min(events, 65535));
+  return ph;
+}
+
 // One photon's path. `global_skips_caustics`: L S+ D hits are left to the
 // caustic map. For the caustic map only L S+ D hits are stored, and the path
-// ends at its first diffuse hit.
+// ends at its first diffuse hit (or scattering in the medium). Scattering
+// events go to `volume` (global map only).
 void trace_one(const Scene& scene, const GiScene& surfaces, const LightChoice& lights,
                std::int64_t emitted, MapKind map, bool global_skips_caustics, Random& rng,
-               std::vector<Photon>* out) {
+               std::vector<Photon>* out, std::vector<Photon>* volume) {
   const std::size_t li = lights.pick(rng.next());
   const Light& light = scene.lights[li];
   const LightRandom u{rng.next(), rng.next(), rng.next(), rng.next()};
@@ -93,8 +106,25 @@ void trace_one(const Scene& scene, const GiScene& surfaces, const LightChoice& l
   Vec3 d = e.dir;
   const double eps = surfaces.epsilon();
   bool specular_only = true;  // every bounce so far was specular (or none)
+  const Medium* medium = scene.has_medium() ? &*scene.medium : nullptr;
   for (int depth = 0; depth < scene.gi.max_depth; ++depth) {
     const auto hit = surfaces.intersect(o, d, eps, std::numeric_limits<double>::infinity());
+    if (medium) {
+      // Free path: the medium fills space, so a photon that meets no surface
+      // meets the medium.
+      const double free = -std::log1p(-rng.next()) / medium->sigma_t();
+      if (!hit || free < hit->t) {
+        if (map == MapKind::kCaustic) return;
+        if (!(rng.next() * medium->sigma_t() < medium->sigma_s)) return;  // absorbed
+        o = o + free * d;
+        volume->push_back(make_volume_photon(o, d, power, depth));
+        const double u1 = rng.next();
+        const double u2 = rng.next();
+        d = schlick_sample_direction(medium->k, d, u1, u2);
+        specular_only = false;
+        continue;
+      }
+    }
     if (!hit || hit->light >= 0) return;  // leaves the scene, or absorbed by an emitter
     const Occluder& occ = scene.occluders[static_cast<std::size_t>(hit->occluder)];
     const Material& m = occ.material;
@@ -138,25 +168,34 @@ void trace_one(const Scene& scene, const GiScene& surfaces, const LightChoice& l
   }
 }
 
-std::vector<Photon> trace_map(const Scene& scene, const GiScene& surfaces, std::int64_t count,
-                              MapKind map, bool global_skips_caustics, int threads) {
-  const LightChoice lights(scene);
-  const std::int64_t chunks = (count + kChunk - 1) / kChunk;
-  std::vector<std::vector<Photon>> parts(static_cast<std::size_t>(chunks));
-  parallel_items(static_cast<int>(chunks), threads, [&](int c) {
-    Random rng(scene.gi.seed, static_cast<std::uint32_t>(map), static_cast<std::uint64_t>(c));
-    const std::int64_t n = std::min(kChunk, count - c * kChunk);
-    std::vector<Photon>& out = parts[static_cast<std::size_t>(c)];
-    for (std::int64_t i = 0; i < n; ++i) {
-      trace_one(scene, surfaces, lights, count, map, global_skips_caustics, rng, &out);
-    }
-  });
+// The chunks' photons in chunk order.
+std::vector<Photon> concatenate(const std::vector<std::vector<Photon>>& parts) {
   std::size_t total = 0;
   for (const auto& p : parts) total += p.size();
   std::vector<Photon> all;
   all.reserve(total);
   for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
   return all;
+}
+
+std::vector<Photon> trace_map(const Scene& scene, const GiScene& surfaces, std::int64_t count,
+                              MapKind map, bool global_skips_caustics, int threads,
+                              std::vector<Photon>* volume) {
+  const LightChoice lights(scene);
+  const std::int64_t chunks = (count + kChunk - 1) / kChunk;
+  std::vector<std::vector<Photon>> parts(static_cast<std::size_t>(chunks));
+  std::vector<std::vector<Photon>> volume_parts(static_cast<std::size_t>(chunks));
+  parallel_items(static_cast<int>(chunks), threads, [&](int c) {
+    Random rng(scene.gi.seed, static_cast<std::uint32_t>(map), static_cast<std::uint64_t>(c));
+    const std::int64_t n = std::min(kChunk, count - c * kChunk);
+    std::vector<Photon>& out = parts[static_cast<std::size_t>(c)];
+    std::vector<Photon>& vol = volume_parts[static_cast<std::size_t>(c)];
+    for (std::int64_t i = 0; i < n; ++i) {
+      trace_one(scene, surfaces, lights, count, map, global_skips_caustics, rng, &out, &vol);
+    }
+  });
+  if (volume) *volume = concatenate(volume_parts);
+  return concatenate(parts);
 }
 
 }  // namespace
@@ -178,15 +217,48 @@ PhotonMaps trace_photons(const Scene& scene, const GiScene& surfaces,
   const bool caustics = has_specular(scene) && scene.gi.caustic_photons > 0;
   maps.emitted_global = scene.gi.photons;
   if (maps.emitted_global > 0) {
-    maps.global = trace_map(scene, surfaces, maps.emitted_global, MapKind::kGlobal, caustics, threads);
+    maps.global = trace_map(scene, surfaces, maps.emitted_global, MapKind::kGlobal, caustics,
+                            threads, &maps.volume);
   }
   if (caustics) {
     maps.emitted_caustic = scene.gi.caustic_photons;
-    maps.caustic = trace_map(scene, surfaces, maps.emitted_caustic, MapKind::kCaustic, true, threads);
+    maps.caustic = trace_map(scene, surfaces, maps.emitted_caustic, MapKind::kCaustic, true,
+                             threads, nullptr);
   }
   maps.trace_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return maps;
+}
+
+namespace {
+
+// The bounds of the occluders (finite ones) and the lights.
+Aabb scene_box(const Scene& scene) {
+  Aabb box;
+  for (const Occluder& o : scene.occluders) {
+    const Aabb b = std::visit([](const auto& k) { return k.bounds(); }, o.shape);
+    if (std::isfinite(b.lo[0]) && std::isfinite(b.hi[0])) box.grow(b);
+  }
+  for (const Light& l : scene.lights) {
+    box.grow(std::visit([](const auto& k) { return k.bounds(); }, l.shape));
+  }
+  return box;
+}
+
+}  // namespace
+
+double default_volume_radius(const Scene& scene, std::int64_t volume_photons) {
+  const Aabb box = scene_box(scene);
+  if (box.empty() || volume_photons <= 0) return 1.0;
+  const Vec3 s = box.hi - box.lo;
+  // A flat box (the lights and a floor only) still holds a layer of fog:
+  // each side at least a tenth of the largest.
+  const double m = 0.1 * std::max({s[0], s[1], s[2]});
+  const double volume = std::max(s[0], m) * std::max(s[1], m) * std::max(s[2], m);
+  if (!(volume > 0.0)) return 1.0;
+  constexpr double kPerKernel = 50.0;
+  return std::cbrt(3.0 * kPerKernel * volume /
+                   (4.0 * std::numbers::pi * static_cast<double>(volume_photons)));
 }
 
 double default_photon_radius(const Scene& scene, std::int64_t photons) {

@@ -4,8 +4,12 @@
 // Fresnel, and are stored where they hit a diffuse surface. Two maps: the
 // global map (every diffuse hit, except L S+ D paths when a caustic map is
 // traced) and the caustic map (the first diffuse hit after one or more
-// specular bounces straight from the light). Multi-threaded; for one seed the
-// maps are identical whatever the thread count.
+// specular bounces straight from the light). In a medium (Scene::medium,
+// issue 15) photons fly free paths d = -ln xi / sigma_t between events,
+// are absorbed with probability 1 - sigma_s / sigma_t at each, else scatter
+// by Schlick's phase function and are stored in the volume map; the caustic
+// map's paths end at their first scattering. Multi-threaded; for one seed
+// the maps are identical whatever the thread count.
 #pragma once
 
 #include <algorithm>
@@ -18,10 +22,10 @@
 namespace beamcast {
 
 struct Photon {
-  float p[3];      // where it hit
+  float p[3];      // where it hit (volume map: where it scattered)
   float power[3];  // flux it carries (watts per channel)
   float dir[3];    // unit travel direction when it arrived
-  float n[3];      // unit normal of the surface it hit, facing where it came from
+  float n[3];      // unit normal of the surface it hit, facing where it came from (volume: 0)
   // Surface interactions before this one: 0 = straight from the light (direct light).
   std::uint16_t bounces;
   // Set for L S+ D paths (only specular bounces before this hit).
@@ -31,6 +35,10 @@ struct Photon {
 struct PhotonMaps {
   std::vector<Photon> global;
   std::vector<Photon> caustic;
+  // Scattering events in the medium of the global map's paths (their power
+  // as they arrived): sum p(mu) power / volume estimates sigma_s times the
+  // in-scattered radiance.
+  std::vector<Photon> volume;
   std::int64_t emitted_global = 0;   // photons sent into the scene for each map
   std::int64_t emitted_caustic = 0;
   double trace_ms = 0.0;             // wall time of tracing both
@@ -56,6 +64,11 @@ bool has_specular(const Scene& scene);
 // photons per disk at 1e5 photons, and r proportional to photons^(-1/6)
 // (the bias-variance balance of a 2D density estimate).
 double default_photon_radius(const Scene& scene, std::int64_t photons);
+
+// The volume photons' kernel radius when medium.radius is 0: `volume_photons`
+// stored photons spread evenly through the bounding box of the occluders and
+// lights, 50 in each kernel sphere.
+double default_volume_radius(const Scene& scene, std::int64_t volume_photons);
 
 // The caustic map's splat radius when gi.caustic_radius is 0: the same rule
 // at the caustic photon count (gi.caustic_photons, or the share drawn), times

@@ -35,6 +35,11 @@ Medium parse_medium(const Node& n) {
   // Below 0.05 a piece of optical depth 1.6 already needs every one of the
   // kMaxBeamSubPieces; above 8 one sub-piece spans e^-8 of attenuation.
   if (auto v = o.optional("beam_step")) m.beam_step = check_closed(*v, read_number(*v), 0.05, 8.0);
+  if (auto v = o.optional("estimator")) {
+    m.estimator = read_enum<VolumeEstimator>(
+        *v, {{"beam", VolumeEstimator::kBeam}, {"seed", VolumeEstimator::kSeed}});
+  }
+  if (auto v = o.optional("radius")) m.radius = check_closed(*v, read_number(*v), 0.0, 1e6);
   return m;
 }
 

@@ -31,6 +31,19 @@ enum class BeamMediumRule : unsigned char {
   kMidpoint,
 };
 
+// How the volume photons' in-scattered light along a view ray is estimated
+// (pass "volume_photons", shaders/volume_splat.frag).
+enum class VolumeEstimator : unsigned char {
+  // The beam radiance estimate: each photon's sphere kernel (radius r)
+  // integrated along the visible part of the ray (clipped by the near plane
+  // and the surface), attenuated exactly within it.
+  kBeam,
+  // The seed's: each photon's whole contribution from the point of the view
+  // ray nearest to it, attenuated from there to the eye, over the disk of
+  // radius r about the photon facing the camera.
+  kSeed,
+};
+
 struct Medium {
   // Per unit of scene length; the medium fills all of space, so a ray that
   // meets no surface sees the background through an infinite optical depth
@@ -43,6 +56,11 @@ struct Medium {
   // are split into ceil(depth / beam_step) sub-pieces, at most
   // kMaxBeamSubPieces); the error falls as beam_step^4 (docs/media.md).
   double beam_step = 1.0;
+  VolumeEstimator estimator = VolumeEstimator::kBeam;
+  // The volume photons' kernel radius; 0: about 50 photons per kernel sphere
+  // for the stored photons spread evenly through the scene's bounding box
+  // (default_volume_radius, gi/photon_map.hpp).
+  double radius = 0.0;
 
   double sigma_t() const { return sigma_s + sigma_a; }
 };
@@ -53,8 +71,8 @@ struct Medium {
 inline constexpr int kMaxBeamSubPieces = 32;
 
 // The fields of "medium", for `hello`'s capabilities.
-inline constexpr std::string_view kMediumFields[] = {"sigma_s", "sigma_a", "k", "g",
-                                                      "beam_rule", "beam_step"};
+inline constexpr std::string_view kMediumFields[] = {
+    "sigma_s", "sigma_a", "k", "g", "beam_rule", "beam_step", "estimator", "radius"};
 
 // Throws ProtocolError (code, message, JSON path) for a bad field: negative
 // coefficients, |k| >= 1 or |g| > kSchlickMaxG, both k and g.

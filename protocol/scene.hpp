@@ -101,6 +101,16 @@ struct GiSettings {
   // on the Cornell box 2 costs no error over 1 at 0.5x the frame time
   // (docs/gi.md).
   int splat_scale = 2;
+  // Level of detail (seed 001, section 6; gi.lod): photons in `lod_groups`
+  // groups by storage order (index mod groups); at distance D from the
+  // viewpoint the share Q = smoothstep(lod_near, lod_far, D) of the groups
+  // is dropped (1 - smoothstep(lod_far, lod_near, D) when near > far, the
+  // seed's convention: near photons dropped), one group fading at a time,
+  // and the kept photons' power is scaled by 1 / (1 - Q), so the expected
+  // flux is unchanged. 0 groups: off. Surface and volume photons alike.
+  int lod_groups = 0;
+  double lod_near = 0.0;
+  double lod_far = 0.0;
   // Not in JSON: the share of each cached map the photon pass draws (the
   // first photons in storage order, i.e. whole paths of the first chunks,
   // their power scaled by 1 / share, the default radii taken at the drawn

@@ -301,7 +301,7 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "gi settings");
   o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth", "direct",
                 "direct_samples", "shadow_size", "edge_correction", "splat_scale",
-                "light_antialias", "caustic_radius", "specular_samples"});
+                "light_antialias", "caustic_radius", "specular_samples", "lod"});
   GiSettings g;
   std::int64_t total = 0;
   auto count = [&](const Node& v) {
@@ -363,6 +363,19 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   if (auto v = o.optional("light_antialias")) g.light_antialias = read_bool(*v);
   if (auto v = o.optional("splat_scale")) g.splat_scale = read_int_in(*v, 1, 8);
   if (auto v = o.optional("specular_samples")) g.specular_samples = read_int_in(*v, 1, 8);
+  if (auto v = o.optional("lod")) {
+    ObjectReader lod(*v, "photon level of detail");
+    lod.allow_only({"near", "far", "groups"});
+    const Node near = lod.required("near");
+    const Node far = lod.required("far");
+    g.lod_near = check_closed(near, read_number(near), 0.0, limits.max_abs_coordinate);
+    g.lod_far = check_closed(far, read_number(far), 0.0, limits.max_abs_coordinate);
+    if (g.lod_near == g.lod_far) {
+      fail("invalid_value", far.path, "far must differ from near (the detail's ramp has a width)");
+    }
+    g.lod_groups = 16;
+    if (auto a = lod.optional("groups")) g.lod_groups = read_int_in(*a, 1, 1024);
+  }
   return g;
 }
 

@@ -1,7 +1,11 @@
 #include "render/medium_pass.hpp"
 
+#include <cmath>
+
+#include "gi/photon_map.hpp"
 #include "render/gl_util.hpp"
 #include "render/passes.hpp"
+#include "render/scene_resources.hpp"
 
 namespace beamcast {
 
@@ -33,8 +37,54 @@ class MediumPass final : public Pass {
   ProgramPair program_;
 };
 
+// The volume photons' in-scattered light (shaders/volume_splat.frag): one
+// instanced camera-facing quad per photon over its kernel sphere, added to
+// hdr. gi.display_fraction draws the first share of the photons at 1/share
+// power, as the surface photons.
+class VolumePhotonPass final : public Pass {
+ public:
+  VolumePhotonPass() : program_("volume_splat") {}
+  void execute(FrameContext& ctx, const PassDecl& self) override {
+    if (!ctx.scene.medium) throw GlError("volume photon pass: the scene has no medium");
+    const Medium& medium = *ctx.scene.medium;
+    const double share = display_share(ctx.scene.gi.display_fraction);
+    const auto count = static_cast<GLsizei>(
+        std::llround(share * static_cast<double>(ctx.resources.volume_count())));
+    if (count == 0) return;
+    const bool multi = ctx.views > 0;
+    glUseProgram(program_.get(multi));
+    const bool surfaces = ctx.plan.written("view_depth");
+    glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
+    glUniform1f(program_.uniform(multi, "u_radius"),
+                static_cast<float>(ctx.resources.volume_radius()));
+    glUniform1f(program_.uniform(multi, "u_sigma_t"), static_cast<float>(medium.sigma_t()));
+    glUniform1f(program_.uniform(multi, "u_k"), static_cast<float>(medium.k));
+    glUniform1i(program_.uniform(multi, "u_estimator"),
+                medium.estimator == VolumeEstimator::kSeed ? 1 : 0);
+    glUniform1i(program_.uniform(multi, "u_first"), 0);
+    glUniform1f(program_.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
+    set_photon_lod(program_, multi, ctx.scene.gi);
+    glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, ctx.resources.volume_buffer());
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glBindVertexArray(ctx.empty_vao);
+    for_each_view_offset(ctx, self, program_, "u_photon_offset", ctx.resources.volume_anchor(),
+                         [&] { glDrawArraysInstanced(GL_TRIANGLES, 0, 6, count); });
+    glDisable(GL_BLEND);
+    gl_check("volume photon pass");
+  }
+
+ private:
+  ProgramPair program_;
+};
+
 }  // namespace
 
 std::unique_ptr<Pass> make_medium_pass() { return std::make_unique<MediumPass>(); }
+std::unique_ptr<Pass> make_volume_photon_pass() { return std::make_unique<VolumePhotonPass>(); }
 
 }  // namespace beamcast

@@ -127,6 +127,15 @@ const std::vector<PassDecl>& pass_catalog() {
       // the beams attenuate their own light.
       {PassId::kMedium, "medium", [](const PlanInput& in) { return in.scene.has_medium(); },
        {"hdr"}, {"view_depth"}, {"hdr"}, {}},
+      // Light the medium scatters towards the eye in a lit scene: the volume
+      // photons (the global map's scattering events), each a camera-facing
+      // quad over its kernel, added to hdr up to the nearest surface
+      // (render/medium_pass.hpp; medium.estimator picks the estimate).
+      {PassId::kVolumePhotons, "volume_photons",
+       [](const PlanInput& in) {
+         return in.scene.has_medium() && in.scene.has_gi() && in.scene.medium->sigma_s > 0.0;
+       },
+       {"hdr"}, {"view_depth"}, {"hdr"}, {"volume_photons"}},
       // Beams: energy added to hdr; a ray ends at the nearest surface if
       // anything wrote view_depth.
       {PassId::kBeams, "beams", [](const PlanInput& in) { return !in.scene.beams.empty(); },

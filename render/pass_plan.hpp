@@ -32,11 +32,12 @@ enum class PassId {
   kGiResolve,
   kSpecular,
   kMedium,
+  kVolumePhotons,
   kBeams,
   kTonemap,
   kUpscale
 };
-inline constexpr std::size_t kPassCount = 14;
+inline constexpr std::size_t kPassCount = 15;
 
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {

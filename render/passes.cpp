@@ -249,6 +249,8 @@ class DirectPass final : public Pass {
     glUniform1i(program_.uniform(multi, "u_point_count"), count);
     glUniform1f(program_.uniform(multi, "u_far"), far_);
     glUniform1f(program_.uniform(multi, "u_texel"), 2.0f / static_cast<float>(size_));
+    glUniform1f(program_.uniform(multi, "u_sigma_t"),
+                ctx.scene.has_medium() ? static_cast<float>(ctx.scene.medium->sigma_t()) : 0.0f);
     glUniform1i(program_.uniform(multi, "u_count"), res.analytic_count());
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
@@ -366,6 +368,7 @@ class GiResolvePass final : public Pass {
     glUniform1i(program_.uniform(multi, "u_kernel"), static_cast<int>(ctx.scene.gi.kernel));
     glUniform1f(program_.uniform(multi, "u_min_cos"), kSplatMinCos);
     glUniform1f(program_.uniform(multi, "u_max_plane"), kSplatMaxPlane);
+    set_photon_lod(program_, multi, ctx.scene.gi);
     glUniform1i(program_.uniform(multi, "u_correct"), ctx.scene.gi.edge_correction ? 1 : 0);
     glUniform1i(program_.uniform(multi, "u_splat_scale"), ctx.plan.splat_scale);
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
@@ -427,6 +430,7 @@ class PhotonPass final : public Pass {
     glUniform1i(program_.uniform(multi, "u_kernel"), static_cast<int>(ctx.scene.gi.kernel));
     glUniform1f(program_.uniform(multi, "u_min_cos"), kSplatMinCos);
     glUniform1f(program_.uniform(multi, "u_max_plane"), kSplatMaxPlane);
+    set_photon_lod(program_, multi, ctx.scene.gi);
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
     glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
@@ -596,6 +600,12 @@ class UpscalePass final : public Pass {
 
 }  // namespace
 
+void set_photon_lod(ProgramPair& program, bool multiview, const GiSettings& gi) {
+  glUniform1i(program.uniform(multiview, "u_lod_groups"), gi.lod_groups);
+  glUniform1f(program.uniform(multiview, "u_lod_near"), static_cast<float>(gi.lod_near));
+  glUniform1f(program.uniform(multiview, "u_lod_far"), static_cast<float>(gi.lod_far));
+}
+
 std::unique_ptr<Pass> make_pass(PassId id) {
   switch (id) {
     case PassId::kSurfaces:
@@ -616,6 +626,8 @@ std::unique_ptr<Pass> make_pass(PassId id) {
       return make_specular_pass();
     case PassId::kMedium:
       return make_medium_pass();
+    case PassId::kVolumePhotons:
+      return make_volume_photon_pass();
     case PassId::kBeams:
       return std::make_unique<BeamPass>();
     case PassId::kTonemap:

@@ -156,6 +156,10 @@ void for_each_view_offset(FrameContext& ctx, const PassDecl& self, ProgramPair& 
   });
 }
 
+// The photon LOD uniforms of shaders/photon_splat.vert (GiSettings::lod_*),
+// for the passes that draw photons with it.
+void set_photon_lod(ProgramPair& program, bool multiview, const GiSettings& gi);
+
 // The executor of a catalog pass; programs are compiled here, so a GL context
 // must be current. Multi-view programs are compiled on first use.
 std::unique_ptr<Pass> make_pass(PassId id);

@@ -329,9 +329,10 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
         const double lambert = light.ambient + light.intensity * std::max(0.0, dot(n, to_light));
         for (int k = 0; k < 3; ++k) c[k] = (*hit.albedo)[k] * light.color[k] * lambert;
       }
-      if (sigma_t > 0.0) {
+      if (sigma_t > 0.0 && !gi) {
         // The medium fills space: the surface (or the background, at
-        // infinity) attenuated by the distance to it.
+        // infinity) attenuated by the distance to it (the path tracer
+        // follows lit scenes' paths through the medium itself).
         const double tr = surface ? std::exp(-sigma_t * t_end) : 0.0;
         for (int k = 0; k < 3; ++k) c[k] *= tr;
       }

@@ -26,8 +26,9 @@ struct ReferenceOptions {
 // (surfaces lit by the lights, background where its paths leave the scene);
 // the beams are added on top, clipped at the surface the pixel's centre sees.
 // A medium (Scene::has_medium) attenuates the surface by e^(-sigma_t t) (the
-// background, at infinity, entirely) and each beam within itself; it does not
-// yet scatter light into the ray (issue 15, items 2, 3 and 7).
+// background, at infinity, entirely) and each beam within itself; in lit
+// scenes the path tracer follows paths through it (free flights, single and
+// multiple scattering, transmittance to the lights).
 HdrImage render_reference(const Scene& scene, const Camera& cam, const ReferenceOptions& opts = {});
 
 // The energy one beam adds along a ray for t in [t0, t1] (world units), i.e.

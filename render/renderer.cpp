@@ -514,6 +514,7 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
   }
   for (FrameResult& f : frames) {
     f.photons = res.photon_count();
+    f.volume_photons = res.volume_count();
     f.photon_trace_ms = res.photon_trace_ms();
     f.photon_upload_ms = res.photon_upload_ms();
   }

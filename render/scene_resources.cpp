@@ -152,6 +152,11 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
     // carries direct light.
     upload_photons(*photons, plan.uploads_group("shadows"));
   }
+  if (plan.uploads_group("volume_photons")) {
+    if (!photons)
+      throw GlError("the plan splats volume photons but the renderer has no photon cache");
+    upload_volume_photons(*photons);
+  }
   if (plan.uploads_group("shadows")) upload_direct();
   if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene);
   if (plan.uploads_group("specular")) {
@@ -286,6 +291,54 @@ void SceneResources::upload_photons(PhotonCache& cache, bool skip_direct) {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() -
       photon_trace_ms_;
   gl_check("upload photons");
+}
+
+void SceneResources::upload_volume_photons(PhotonCache& cache) {
+  const auto t0 = std::chrono::steady_clock::now();
+  double traced_ms = 0.0;
+  if (!maps_) {
+    bool traced = false;
+    maps_ = cache.get(scene_, &traced);
+    traced_ms = traced ? maps_->trace_ms : 0.0;
+    photon_trace_ms_ += traced_ms;
+  }
+  Aabb box;
+  for (const Photon& p : maps_->volume) box.grow(Vec3{p.p[0], p.p[1], p.p[2]});
+  volume_anchor_ = box.empty() ? Vec3{0.0, 0.0, 0.0} : box.centre();
+  struct VolumeData {
+    float position[4];
+    float power[4];
+    float dir[4];
+  };
+  std::vector<VolumeData> data(maps_->volume.size());
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const Photon& p = maps_->volume[i];
+    for (int k = 0; k < 3; ++k) {
+      data[i].position[k] =
+          static_cast<float>(p.p[k] - volume_anchor_[static_cast<std::size_t>(k)]);
+      data[i].power[k] = p.power[k];
+      data[i].dir[k] = p.dir[k];
+    }
+  }
+  volume_count_ = static_cast<GLsizei>(data.size());
+  if (!data.empty()) {
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    volume_ssbo_ = GlBuffer(id);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(VolumeData)),
+                         data.data(), 0);
+  }
+  // The drawn share (gi.display_fraction) sets the default radius, as for the surface maps.
+  const double share = display_share(scene_.gi.display_fraction);
+  const auto drawn = std::max<std::int64_t>(
+      1, std::llround(share * static_cast<double>(maps_->volume.size())));
+  volume_radius_ = scene_.medium && scene_.medium->radius > 0.0
+                       ? scene_.medium->radius
+                       : default_volume_radius(scene_, drawn);
+  photon_upload_ms_ +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() -
+      traced_ms;
+  gl_check("upload volume photons");
 }
 
 void SceneResources::upload_direct() {

@@ -80,6 +80,13 @@ class SceneResources {
   // the caustic map's, splatted with caustic_radius().
   GLsizei photon_caustic_first() const { return photon_caustic_first_; }
   double caustic_radius() const { return caustic_radius_; }
+  // Volume photons (group "volume_photons": the medium's scattering events of
+  // the global map), positions relative to volume_anchor(), the photon's
+  // travel direction in the normal slot; volume_radius() their kernel radius.
+  GLuint volume_buffer() const { return volume_ssbo_.get(); }
+  GLsizei volume_count() const { return volume_count_; }
+  const Vec3& volume_anchor() const { return volume_anchor_; }
+  double volume_radius() const { return volume_radius_; }
   // Direct light (group "shadows"): the lights' DirectPoints, each with its
   // light's flux folded in, positions relative to direct_anchor(); the key
   // names the geometry and points the shadow maps are rendered for.
@@ -119,6 +126,7 @@ class SceneResources {
   void upload_beams(TableCache& tables);
   void upload_occluders();
   void upload_photons(PhotonCache& cache, bool skip_direct);
+  void upload_volume_photons(PhotonCache& cache);
   void upload_direct();
   GlBuffer direct_ssbo_;
   std::vector<DirectPoint> direct_points_;
@@ -134,6 +142,10 @@ class SceneResources {
   double caustic_radius_ = 1.0;
   double photon_trace_ms_ = 0.0;
   double photon_upload_ms_ = 0.0;
+  GlBuffer volume_ssbo_;
+  GLsizei volume_count_ = 0;
+  Vec3 volume_anchor_{};
+  double volume_radius_ = 1.0;
   std::unique_ptr<SlimResources> slim_;
   std::unique_ptr<GiScene> gi_scene_;
   std::shared_ptr<const PhotonGather> photon_gather_;

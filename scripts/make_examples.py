@@ -228,6 +228,31 @@ def main():
              "color": [0.3, 0.55, 1.0], "intensity": 3.0,
              "density": {"type": "gaussian", "sigma": 0.4}, "emit": True},
         ]))
+    # Seed 001's stage in fog (its fig 6.3: a spot light in a homogeneous
+    # medium, 50 000 photons at 512x512): a floor, a back wall and two side
+    # walls open to the camera, a sphere and a box, the spot from above.
+    wall = [0.75, 0.75, 0.75]
+    write("fog_stage.json", {
+        "lights": [{"type": "spot", "position": [0.0, 5.5, 1.0], "direction": [0.0, -5.5, -1.0],
+                    "inner_deg": 15.0, "outer_deg": 25.0, "power": 600.0}],
+        "occluders": [
+            {"type": "quad", "corner": [-5, 0, 5], "edge_u": [10, 0, 0], "edge_v": [0, 0, -10],
+             "albedo": wall},
+            {"type": "quad", "corner": [-5, 0, -5], "edge_u": [10, 0, 0], "edge_v": [0, 6, 0],
+             "albedo": wall},
+            {"type": "quad", "corner": [-5, 0, 5], "edge_u": [0, 0, -10], "edge_v": [0, 6, 0],
+             "albedo": [0.7, 0.3, 0.25]},
+            {"type": "quad", "corner": [5, 0, -5], "edge_u": [0, 0, 10], "edge_v": [0, 6, 0],
+             "albedo": [0.3, 0.45, 0.7]},
+            {"type": "sphere", "center": [-1.2, 0.8, -0.5], "radius": 0.8, "albedo": [0.8, 0.7, 0.3]},
+            {"type": "box", "center": [1.5, 0.6, -1.0], "size": [1.2, 1.2, 1.2],
+             "rotation": [0.9238795, 0.0, 0.3826834, 0.0], "albedo": [0.6, 0.6, 0.65]},
+        ],
+        "medium": {"sigma_s": 0.05, "sigma_a": 0.01, "g": 0.3},
+        "gi": {"photons": 50000},
+        "cameras": [camera("view", [0.0, 2.2, 9.0], [0.0, 1.5, 0.0], fov_y=45)],
+        "output": {"exposure": 0.8},
+    })
 
 
 if __name__ == "__main__":

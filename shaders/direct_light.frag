@@ -4,7 +4,8 @@
 //   L = albedo / pi * sum_i flux_i * angular_i(c) * max(0, n.l) * V_i / d^2,
 // V_i from point i's cube shadow map of the triangles (distance compared,
 // bilinear percentage-closer filtering) and from shadow rays to the analytic
-// occluders. Mirrors, glass, emitters and the background are left alone.
+// occluders, times e^(-sigma_t d) in a medium. Mirrors, glass, emitters and
+// the background are left alone.
 struct DirectPoint {
   vec4 position;  // xyz: relative to the direct anchor; w: mode (0 isotropic, 1 cosine, 2 cone)
   vec4 axis;      // xyz: unit axis; w: cos_outer
@@ -19,6 +20,7 @@ uniform vec3 u_point_offset;  // direct anchor minus eye
 uniform int u_point_count;
 uniform float u_far;    // shadow-map distances are stored over this
 uniform float u_texel;  // a texel's angular size at a face centre (2 / size)
+uniform float u_sigma_t;  // a medium's extinction: the light is attenuated on its way (0: none)
 
 layout(location = 0) out vec4 out_color;
 
@@ -85,7 +87,8 @@ void main() {
     float visible = texture(u_shadows, vec4(v, float(i)), (length(v) - 0.5 * foot) / u_far);
     if (visible <= 0.0) continue;
     if (u_count > 0 && analytic_blocked(x + (1e-4 * dist) * n, l, dist)) continue;
-    e += p.flux.rgb * (angular * cos_x * visible / d2);
+    float transmitted = u_sigma_t > 0.0 ? exp(-u_sigma_t * dist) : 1.0;
+    e += p.flux.rgb * (angular * cos_x * visible * transmitted / d2);
   }
   out_color = vec4(albedo.rgb / kPi * e, 0.0);
 }

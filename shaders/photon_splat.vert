@@ -9,19 +9,47 @@ struct PhotonData {
 layout(std430, binding = 3) readonly buffer Photons { PhotonData photons[]; };
 uniform vec3 u_photon_offset;  // photon anchor minus eye
 uniform float u_radius;
-uniform int u_first;
-uniform float u_power_scale;  // 1 / the share of the maps drawn (gi.display_fraction)  // the draw's first photon (the caustic map's follow the global map's)
+uniform int u_first;  // the draw's first photon (the caustic map's follow the global map's)
+uniform float u_power_scale;  // 1 / the share of the maps drawn (gi.display_fraction)
+
+// Level of detail (seed 001, section 6; GiSettings::lod_*): 0 groups: off.
+uniform int u_lod_groups;
+uniform float u_lod_near;
+uniform float u_lod_far;
 
 flat out vec3 v_center;  // camera-relative
 flat out vec3 v_power;
 flat out vec3 v_normal;
+
+// The LOD weight of photon `index` at camera-relative position c: the share
+// Q of the groups dropped at its distance (smoothstep(near, far, D), or
+// 1 - smoothstep(far, near, D) when near > far), group g = index mod A kept
+// whole while g / A >= Q, fading out over the next 1 / A, the kept ones
+// scaled by 1 / (1 - Q): the expected flux stays.
+float lod_weight(vec3 c, int index) {
+  if (u_lod_groups <= 0) return 1.0;
+  float d = length(c);
+  float q = u_lod_near < u_lod_far ? smoothstep(u_lod_near, u_lod_far, d)
+                                   : 1.0 - smoothstep(u_lod_far, u_lod_near, d);
+  if (q >= 1.0) return 0.0;
+  float a = float(u_lod_groups);
+  float kept = clamp((float(index % u_lod_groups) + 1.0) - q * a, 0.0, 1.0);
+  return kept / (1.0 - q);
+}
 
 void main() {
   select_view(view_index());
   PhotonData p = photons[gl_InstanceID + u_first];
   vec3 c = p.position.xyz + u_photon_offset;
   v_center = c;
-  v_power = p.power.rgb * u_power_scale;
+  float lod = lod_weight(c, gl_InstanceID + u_first);
+  if (lod <= 0.0) {  // dropped: a degenerate quad outside the clip volume
+    gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+    v_power = vec3(0.0);
+    v_normal = vec3(0.0);
+    return;
+  }
+  v_power = p.power.rgb * (u_power_scale * lod);
   v_normal = p.normal.xyz;
   // Corner of two triangles: (-1,-1) (1,-1) (1,1) / (-1,-1) (1,1) (-1,1).
   const vec2 corners[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1), vec2(1, 1),

@@ -59,6 +59,35 @@ TEST(Medium, TheMediumPassIsPlannedOnlyWhenSomethingAttenuates) {
   EXPECT_TRUE(has_medium_pass(fogged({{"sigma_s", 0.1}})));
   EXPECT_EQ(plan_passes(parse_scene(fogged({{"sigma_a", 0.1}}), {})),
             (std::vector<std::string>{"medium", "beams", "tonemap"}));
+  // Volume photons: only a lit scene whose medium scatters.
+  json lit = fogged({{"sigma_s", 0.1}});
+  lit["lights"] = {{{"type", "point"}, {"position", {0, 3, 0}}, {"power", 10}}};
+  const auto has_volume_pass = [](const json& j) {
+    const std::vector<std::string> p = plan_passes(parse_scene(j, {}));
+    return std::find(p.begin(), p.end(), "volume_photons") != p.end();
+  };
+  EXPECT_TRUE(has_volume_pass(lit));
+  lit["medium"] = {{"sigma_a", 0.1}};
+  EXPECT_FALSE(has_volume_pass(lit));
+  EXPECT_FALSE(has_volume_pass(fogged({{"sigma_s", 0.1}})));
+}
+
+TEST(Medium, PhotonLodParsesWithItsDefaults) {
+  json j = fogged({{"sigma_s", 0.1}});
+  j["gi"] = {{"lod", {{"near", 25}, {"far", 3}}}};
+  const Scene s = parse_scene(j, {});
+  EXPECT_EQ(s.gi.lod_groups, 16);
+  EXPECT_DOUBLE_EQ(s.gi.lod_near, 25.0);
+  EXPECT_DOUBLE_EQ(s.gi.lod_far, 3.0);
+  EXPECT_EQ(parse_scene(fogged({{"sigma_s", 0.1}}), {}).gi.lod_groups, 0);  // off unless asked
+  j["gi"]["lod"] = {{"near", 3}, {"far", 3}};
+  EXPECT_EQ(error_of(j).path, "/gi/lod/far");
+  j["gi"]["lod"] = {{"near", 3}, {"far", 5}, {"groups", 0}};
+  EXPECT_EQ(error_of(j).path, "/gi/lod/groups");
+  j["gi"]["lod"] = {{"near", -1}, {"far", 5}};
+  EXPECT_EQ(error_of(j).path, "/gi/lod/near");
+  j["gi"]["lod"] = {{"far", 5}};
+  EXPECT_EQ(error_of(j).code, "missing_field");
 }
 
 TEST(Medium, BadFieldsAreRefusedWithTheirPath) {
@@ -78,6 +107,8 @@ TEST(Medium, BadFieldsAreRefusedWithTheirPath) {
       {{{"sigma_s", "thick"}}, "wrong_type", "/medium/sigma_s"},
       {{{"beam_rule", "simpson"}}, "invalid_value", "/medium/beam_rule"},
       {{{"beam_step", 0.0}}, "out_of_range", "/medium/beam_step"},
+      {{{"estimator", "grid"}}, "invalid_value", "/medium/estimator"},
+      {{{"radius", -1.0}}, "out_of_range", "/medium/radius"},
       {{{"density", 1.0}}, "unknown_field", "/medium/density"},
       {json::array(), "wrong_type", "/medium"},
   };
