@@ -56,21 +56,34 @@ class Tracer {
     Color L{0.0, 0.0, 0.0};
     Color beta{1.0, 1.0, 1.0};  // path throughput
     bool specular = true;       // camera ray or last bounce specular: emission and background count
-    const Medium* medium = scene.has_medium() ? &*scene.medium : nullptr;
+    const MediumField medium = scene.medium_field();
     for (int depth = 0; depth < opts_.max_depth; ++depth) {
       const std::optional<SurfaceHit> hit = gi_.intersect(o, v, t_min, t_max);
-      if (medium) {
+      if (!medium.empty()) {
         // Free flight from o (the eye for the camera ray: the medium lies
-        // before the near plane too, but what scatters there is not seen).
-        // Sampled with density sigma_t e^(-sigma_t t), the event's weight is
-        // the albedo sigma_s / sigma_t; a surface reached first has weight 1.
-        const double free = -std::log1p(-uniform(rng)) / medium->sigma_t();
-        if (!hit || free < hit->t) {
-          if (free < t_min) break;
-          const Vec3 x = o + free * v;
-          beta = (medium->sigma_s / medium->sigma_t()) * beta;
-          L = L + mul(beta, in_scattered(x, v, *medium, rng));
-          v = schlick_sample_direction(medium->k, v, uniform(rng), uniform(rng));
+        // before the near plane too, but what scatters there is not seen),
+        // by delta tracking against the majorant (every tentative event is
+        // real in a homogeneous medium). An event's weight is the albedo
+        // sigma_s / sigma_t there; a surface reached first has weight 1.
+        const double t_hit = std::min(hit ? hit->t : kInf, medium.last_exit(o, v));
+        double t = 0.0;
+        bool event = false;
+        for (;;) {
+          t += -std::log1p(-uniform(rng)) / medium.majorant();
+          if (!(t < t_hit)) break;
+          if (medium.homogeneous() ||
+              uniform(rng) * medium.majorant() < medium.sigma_t(o + t * v)) {
+            event = true;
+            break;
+          }
+        }
+        if (event) {
+          if (t < t_min) break;
+          const Vec3 x = o + t * v;
+          beta = (medium.sigma_s(x) / medium.sigma_t(x)) * beta;
+          const double k = medium.k(x);
+          L = L + mul(beta, in_scattered(x, v, k, rng));
+          v = schlick_sample_direction(k, v, uniform(rng), uniform(rng));
           specular = false;
           if (depth >= 2) {
             const double q = std::min(0.95, std::max({beta[0], beta[1], beta[2]}));
@@ -165,7 +178,8 @@ class Tracer {
     const double eps = gi_.epsilon();
     if (gi_.occluded(x, s.dir, eps, s.dist - eps)) return {0.0, 0.0, 0.0};
     // E = flux g cos_x / pick (times the medium's transmittance); L_out = (albedo / pi) E.
-    const double k = s.g * cos_x * transmittance(s.dist) / (std::numbers::pi * pick_[i]);
+    const double k =
+        s.g * cos_x * transmittance(x, s.dir, s.dist) / (std::numbers::pi * pick_[i]);
     return k * mul(albedo, light.flux);
   }
 
@@ -173,8 +187,7 @@ class Tracer {
   // along v: the radiance one light sample scatters into -v,
   // p(mu) flux g T / pick, mu = dot(s.dir, v) (the light travels along
   // -s.dir, then towards the eye along -v: gi/phase.hpp's convention).
-  Color in_scattered(const Vec3& x, const Vec3& v, const Medium& medium,
-                     std::mt19937_64& rng) const {
+  Color in_scattered(const Vec3& x, const Vec3& v, double phase_k, std::mt19937_64& rng) const {
     if (pick_.empty()) return {0.0, 0.0, 0.0};
     const Scene& scene = gi_.scene();
     const double u = uniform(rng);
@@ -188,14 +201,14 @@ class Tracer {
     if (!(s.g > 0.0)) return {0.0, 0.0, 0.0};
     if (gi_.occluded(x, s.dir, 0.0, s.dist - gi_.epsilon())) return {0.0, 0.0, 0.0};
     const double k =
-        schlick_phase(medium.k, dot(s.dir, v)) * s.g * transmittance(s.dist) / pick_[i];
+        schlick_phase(phase_k, dot(s.dir, v)) * s.g * transmittance(x, s.dir, s.dist) / pick_[i];
     return k * light.flux;
   }
 
-  // e^(-sigma_t d) of the scene's medium (1 without one).
-  double transmittance(double d) const {
+  // e^(-optical depth) of the scene's medium along x + t l, t in [0, d] (1 without one).
+  double transmittance(const Vec3& x, const Vec3& l, double d) const {
     const Scene& scene = gi_.scene();
-    return scene.has_medium() ? std::exp(-scene.medium->sigma_t() * d) : 1.0;
+    return scene.has_medium() ? std::exp(-scene.medium_field().optical_depth(x, l, 0.0, d)) : 1.0;
   }
 
   const GiScene& gi_;

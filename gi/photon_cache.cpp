@@ -114,11 +114,22 @@ std::string photon_key(const Scene& scene) {
   k.put(scene.gi.max_depth);
   // The medium: the paths' free flights, absorption and phase (its beam
   // knobs and the volume estimate's settings only shape the frame).
-  k.put(scene.has_medium());
-  if (scene.has_medium()) {
-    k.put(scene.medium->sigma_s);
-    k.put(scene.medium->sigma_a);
-    k.put(scene.medium->k);
+  const Medium* global = scene.global_medium();
+  k.put(global != nullptr);
+  if (global) {
+    k.put(global->sigma_s);
+    k.put(global->sigma_a);
+    k.put(global->k);
+  }
+  k.put(scene.media.size());
+  for (const MediumRegion& r : scene.media) {
+    k.put(static_cast<int>(r.shape));
+    k.put(r.lo);
+    k.put(r.hi);
+    k.put(r.radius);
+    k.put(r.sigma_s);
+    k.put(r.sigma_a);
+    k.put(r.k);
   }
   return k.digest();
 }

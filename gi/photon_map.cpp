@@ -106,21 +106,35 @@ void trace_one(const Scene& scene, const GiScene& surfaces, const LightChoice& l
   Vec3 d = e.dir;
   const double eps = surfaces.epsilon();
   bool specular_only = true;  // every bounce so far was specular (or none)
-  const Medium* medium = scene.has_medium() ? &*scene.medium : nullptr;
+  const MediumField medium = scene.medium_field();
   for (int depth = 0; depth < scene.gi.max_depth; ++depth) {
     const auto hit = surfaces.intersect(o, d, eps, std::numeric_limits<double>::infinity());
-    if (medium) {
-      // Free path: the medium fills space, so a photon that meets no surface
-      // meets the medium.
-      const double free = -std::log1p(-rng.next()) / medium->sigma_t();
-      if (!hit || free < hit->t) {
+    if (!medium.empty()) {
+      // Free path by delta tracking against the majorant (exact for the
+      // homogeneous medium, where every tentative event is real): the
+      // medium fills space, so a photon that meets no surface meets it.
+      const double t_hit = std::min(hit ? hit->t : std::numeric_limits<double>::infinity(),
+                                    medium.last_exit(o, d));
+      double t = 0.0;
+      bool event = false;
+      for (;;) {
+        t += -std::log1p(-rng.next()) / medium.majorant();
+        if (!(t < t_hit)) break;
+        if (medium.homogeneous() || rng.next() * medium.majorant() < medium.sigma_t(o + t * d)) {
+          event = true;
+          break;
+        }
+      }
+      if (event) {
         if (map == MapKind::kCaustic) return;
-        if (!(rng.next() * medium->sigma_t() < medium->sigma_s)) return;  // absorbed
-        o = o + free * d;
+        const Vec3 x = o + t * d;
+        // Scattered with probability sigma_s / sigma_t there, else absorbed.
+        if (!(rng.next() * medium.sigma_t(x) < medium.sigma_s(x))) return;
+        o = x;
         volume->push_back(make_volume_photon(o, d, power, depth));
         const double u1 = rng.next();
         const double u2 = rng.next();
-        d = schlick_sample_direction(medium->k, d, u1, u2);
+        d = schlick_sample_direction(medium.k(x), d, u1, u2);
         specular_only = false;
         continue;
       }

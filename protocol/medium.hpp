@@ -4,6 +4,9 @@
 #pragma once
 
 #include <string_view>
+#include <vector>
+
+#include "protocol/vec.hpp"
 
 
 namespace beamcast {
@@ -65,17 +68,75 @@ struct Medium {
   double sigma_t() const { return sigma_s + sigma_a; }
 };
 
+// A region of heterogeneous medium (seed 001 section 5.7; "media" in JSON):
+// its own coefficients inside an axis-aligned box or a sphere, added to
+// the scene-wide medium and to any region it overlaps (the seed's fig 5.6:
+// where A and B overlap, sigma = sigma_A + sigma_B).
+struct MediumRegion {
+  enum class Shape : unsigned char { kBox, kSphere };
+  Shape shape = Shape::kBox;
+  Vec3 lo{};            // box: the low corner; sphere: the centre
+  Vec3 hi{};            // box: the high corner
+  double radius = 0.0;  // sphere
+  double sigma_s = 0.0;
+  double sigma_a = 0.0;
+  double k = 0.0;
+  double sigma_t() const { return sigma_s + sigma_a; }
+  bool contains(const Vec3& x) const;
+  // The length of o + t v (|v| = 1), t in [t0, t1], inside the region.
+  double chord(const Vec3& o, const Vec3& v, double t0, double t1) const;
+  // The ray parameter where o + t v (t >= 0) last leaves the region; -1 if
+  // it never is inside.
+  double exit(const Vec3& o, const Vec3& v) const;
+
+ private:
+  // [a, b]: the part of [t0, t1] inside (empty if b <= a).
+  void clip(const Vec3& o, const Vec3& v, double* a, double* b) const;
+};
+
+// Regions per scene (the shaders hold them in uniform arrays of this size).
+inline constexpr int kMaxMediumRegions = 16;
+
+// The scene-wide medium and the regions together: coefficients at a point,
+// optical depth along a segment (exact: chords of boxes and spheres), and
+// the majorant extinction for delta tracking. Either may be absent.
+class MediumField {
+ public:
+  MediumField(const Medium* global, const std::vector<MediumRegion>& regions);
+  bool empty() const { return majorant_ <= 0.0; }
+  bool homogeneous() const { return regions_->empty(); }
+  double sigma_t(const Vec3& x) const;
+  double sigma_s(const Vec3& x) const;
+  // The phase parameter at x: the scattering-weighted mean of the k of
+  // the global medium and the regions containing x.
+  double k(const Vec3& x) const;
+  double optical_depth(const Vec3& o, const Vec3& v, double t0, double t1) const;
+  double majorant() const { return majorant_; }
+  // Beyond this ray parameter o + t v meets no medium: infinite with the
+  // scene-wide medium, else the last exit from a region (-1: none).
+  double last_exit(const Vec3& o, const Vec3& v) const;
+
+ private:
+  const Medium* global_;
+  const std::vector<MediumRegion>* regions_;
+  double majorant_ = 0.0;
+};
+
 // The most sub-pieces a beam's piece is split into; with optical depth
 // beyond kMaxBeamSubPieces x beam_step the rest of the piece is attenuated by
 // e^-32 or more (at the default step), below any pixel's resolution.
 inline constexpr int kMaxBeamSubPieces = 32;
 
 // The fields of "medium", for `hello`'s capabilities.
+inline constexpr std::string_view kMediumRegionFields[] = {
+    "type", "min", "max", "center", "radius", "sigma_s", "sigma_a", "k", "g"};
 inline constexpr std::string_view kMediumFields[] = {
     "sigma_s", "sigma_a", "k", "g", "beam_rule", "beam_step", "estimator", "radius"};
 
 // Throws ProtocolError (code, message, JSON path) for a bad field: negative
 // coefficients, |k| >= 1 or |g| > kSchlickMaxG, both k and g.
 Medium parse_medium(const json_read::Node& n);
+// One entry of "media"; `max_abs` bounds coordinates and radius.
+MediumRegion parse_medium_region(const json_read::Node& n, double max_abs);
 
 }  // namespace beamcast

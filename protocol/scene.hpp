@@ -237,14 +237,29 @@ struct Scene {
   RenderSettings render;
   GiSettings gi;
   SlimSettings slim;
-  // A participating medium filling the scene ("medium"; issue 15).
+  // A participating medium filling the scene ("medium"; issue 15), and
+  // regions of heterogeneous medium ("media") added to it.
   std::optional<Medium> medium;
+  std::vector<MediumRegion> media;
 
   // Global illumination runs when a light of "lights" lights the scene;
   // otherwise the directional light shades it.
   bool has_gi() const { return !lights.empty(); }
-  // The medium passes run when the medium attenuates (sigma_t > 0).
-  bool has_medium() const { return medium && medium->sigma_t() > 0.0; }
+  // The medium passes run when the medium attenuates (sigma_t > 0) or a
+  // region of medium exists.
+  bool has_medium() const { return (medium && medium->sigma_t() > 0.0) || !media.empty(); }
+  // Whether the medium scatters anywhere (the volume photon pass runs).
+  bool medium_scatters() const {
+    bool any = medium && medium->sigma_s > 0.0;
+    for (const MediumRegion& r : media) any = any || r.sigma_s > 0.0;
+    return any;
+  }
+  // The scene-wide medium when it attenuates, else null; and the field of
+  // it and the regions.
+  const Medium* global_medium() const {
+    return medium && medium->sigma_t() > 0.0 ? &*medium : nullptr;
+  }
+  MediumField medium_field() const { return MediumField(global_medium(), media); }
 };
 
 }  // namespace beamcast

@@ -833,7 +833,7 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   ObjectReader o(root, "a scene");
   o.allow_only(
       {"version", "background", "light", "lights", "gi", "beams", "occluders", "cameras", "output",
-       "render", "slim", "medium"});
+       "render", "slim", "medium", "media"});
   Scene scene;
   if (auto v = o.optional("version")) {
     const std::int64_t version = read_integer(*v);
@@ -848,6 +848,11 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   if (auto v = o.optional("render")) scene.render = parse_render(*v, limits);
   if (auto v = o.optional("slim")) scene.slim = parse_slim_settings(*v);
   if (auto v = o.optional("medium")) scene.medium = parse_medium(*v);
+  if (auto v = o.optional("media")) {
+    for (const Node& r : read_array(*v, kMaxMediumRegions, "max_medium_regions")) {
+      scene.media.push_back(parse_medium_region(r, limits.max_abs_coordinate));
+    }
+  }
   if (auto v = o.optional("lights")) {
     for (const Node& l : read_array(*v, limits.max_lights, "max_lights")) {
       scene.lights.push_back(parse_gi_light(l, limits));
@@ -932,7 +937,10 @@ nlohmann::json scene_capabilities() {
            std::vector<std::string_view>(kSlimSettingFields.begin(), kSlimSettingFields.end())},
           {"medium_fields", std::vector<std::string_view>(std::begin(kMediumFields),
                                                           std::end(kMediumFields))},
-          {"medium_beam_rules", {"gauss2", "midpoint"}}};
+          {"medium_beam_rules", {"gauss2", "midpoint"}},
+          {"medium_region_fields", std::vector<std::string_view>(std::begin(kMediumRegionFields),
+                                                                 std::end(kMediumRegionFields))},
+          {"medium_region_types", {"box", "sphere"}}};
 }
 
 }  // namespace beamcast

@@ -15,20 +15,26 @@ class MediumPass final : public Pass {
  public:
   MediumPass() : program_("medium_attenuate") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
-    if (!ctx.scene.medium) throw GlError("medium pass: the scene has no medium");
+    if (!ctx.scene.has_medium()) throw GlError("medium pass: the scene has no medium");
     const bool multi = ctx.views > 0;
     glUseProgram(program_.get(multi));
     const bool surfaces = ctx.plan.written("view_depth");
     glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
+    const Medium* global = ctx.scene.global_medium();
     glUniform1f(program_.uniform(multi, "u_sigma_t"),
-                static_cast<float>(ctx.scene.medium->sigma_t()));
+                global ? static_cast<float>(global->sigma_t()) : 0.0f);
+    const GLint region_eye = set_medium_regions(program_, multi, ctx.scene);
     glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ZERO, GL_SRC_COLOR);  // hdr *= transmittance
     glBlendEquation(GL_FUNC_ADD);
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(ctx.empty_vao);
-    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    int view = 0;
+    for_each_view(ctx, self, program_, [&] {
+      set_region_eye(ctx, region_eye, view++);
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+    });
     glDisable(GL_BLEND);
     gl_check("medium pass");
   }
@@ -45,8 +51,9 @@ class VolumePhotonPass final : public Pass {
  public:
   VolumePhotonPass() : program_("volume_splat") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
-    if (!ctx.scene.medium) throw GlError("volume photon pass: the scene has no medium");
-    const Medium& medium = *ctx.scene.medium;
+    if (!ctx.scene.has_medium()) throw GlError("volume photon pass: the scene has no medium");
+    const Medium medium = ctx.scene.medium.value_or(Medium{});
+    const Medium* global = ctx.scene.global_medium();
     const double share = display_share(ctx.scene.gi.display_fraction);
     const auto count = static_cast<GLsizei>(
         std::llround(share * static_cast<double>(ctx.resources.volume_count())));
@@ -57,8 +64,9 @@ class VolumePhotonPass final : public Pass {
     glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
     glUniform1f(program_.uniform(multi, "u_radius"),
                 static_cast<float>(ctx.resources.volume_radius()));
-    glUniform1f(program_.uniform(multi, "u_sigma_t"), static_cast<float>(medium.sigma_t()));
-    glUniform1f(program_.uniform(multi, "u_k"), static_cast<float>(medium.k));
+    glUniform1f(program_.uniform(multi, "u_sigma_t"),
+                global ? static_cast<float>(global->sigma_t()) : 0.0f);
+    const GLint region_eye = set_medium_regions(program_, multi, ctx.scene);
     glUniform1i(program_.uniform(multi, "u_estimator"),
                 medium.estimator == VolumeEstimator::kSeed ? 1 : 0);
     glUniform1i(program_.uniform(multi, "u_first"), 0);
@@ -72,8 +80,12 @@ class VolumePhotonPass final : public Pass {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glBindVertexArray(ctx.empty_vao);
+    int view = 0;
     for_each_view_offset(ctx, self, program_, "u_photon_offset", ctx.resources.volume_anchor(),
-                         [&] { glDrawArraysInstanced(GL_TRIANGLES, 0, 6, count); });
+                         [&] {
+                           set_region_eye(ctx, region_eye, view++);
+                           glDrawArraysInstanced(GL_TRIANGLES, 0, 6, count);
+                         });
     glDisable(GL_BLEND);
     gl_check("volume photon pass");
   }

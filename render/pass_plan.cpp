@@ -133,7 +133,7 @@ const std::vector<PassDecl>& pass_catalog() {
       // (render/medium_pass.hpp; medium.estimator picks the estimate).
       {PassId::kVolumePhotons, "volume_photons",
        [](const PlanInput& in) {
-         return in.scene.has_medium() && in.scene.has_gi() && in.scene.medium->sigma_s > 0.0;
+         return in.scene.has_gi() && in.scene.medium_scatters();
        },
        {"hdr"}, {"view_depth"}, {"hdr"}, {"volume_photons"}},
       // Beams: energy added to hdr; a ray ends at the nearest surface if

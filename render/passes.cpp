@@ -249,8 +249,10 @@ class DirectPass final : public Pass {
     glUniform1i(program_.uniform(multi, "u_point_count"), count);
     glUniform1f(program_.uniform(multi, "u_far"), far_);
     glUniform1f(program_.uniform(multi, "u_texel"), 2.0f / static_cast<float>(size_));
+    const Medium* global = ctx.scene.global_medium();
     glUniform1f(program_.uniform(multi, "u_sigma_t"),
-                ctx.scene.has_medium() ? static_cast<float>(ctx.scene.medium->sigma_t()) : 0.0f);
+                global ? static_cast<float>(global->sigma_t()) : 0.0f);
+    const GLint region_eye = set_medium_regions(program_, multi, ctx.scene);
     glUniform1i(program_.uniform(multi, "u_count"), res.analytic_count());
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
@@ -264,8 +266,11 @@ class DirectPass final : public Pass {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glBindVertexArray(ctx.empty_vao);
-    for_each_view_offset(ctx, self, program_, "u_point_offset", res.direct_anchor(),
-                         [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    int view = 0;
+    for_each_view_offset(ctx, self, program_, "u_point_offset", res.direct_anchor(), [&] {
+      set_region_eye(ctx, region_eye, view++);
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+    });
     glDisable(GL_BLEND);
     gl_check("direct pass");
   }
@@ -494,7 +499,9 @@ class BeamPass final : public Pass {
     const bool multi = ctx.views > 0;
     // Scenes with a medium use the program with it compiled in (built on
     // first use); the others the program without, unchanged by media.
-    const Medium* medium = ctx.scene.has_medium() ? &*ctx.scene.medium : nullptr;
+    const bool fog = ctx.scene.has_medium();
+    const Medium settings = ctx.scene.medium.value_or(Medium{});
+    const Medium* medium = fog ? &settings : nullptr;
     if (medium && !fogged_) fogged_.emplace("beam_medium");
     ProgramPair& program = medium ? *fogged_ : plain_;
     glUseProgram(program.get(multi));
@@ -505,8 +512,12 @@ class BeamPass final : public Pass {
     glUniform1i(program.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
     if (multi) glUniform1i(program.uniform(multi, "u_view_beams"), ctx.resources.beam_count());
     const RenderSettings& rs = ctx.scene.render;
+    GLint region_eye = -1;
     if (medium) {
-      glUniform1f(program.uniform(multi, "u_sigma_t"), static_cast<float>(medium->sigma_t()));
+      const Medium* global = ctx.scene.global_medium();
+      glUniform1f(program.uniform(multi, "u_sigma_t"),
+                  global ? static_cast<float>(global->sigma_t()) : 0.0f);
+      region_eye = set_medium_regions(program, multi, ctx.scene);
       glUniform1f(program.uniform(multi, "u_medium_step"),
                   static_cast<float>(medium->beam_step));
       glUniform1i(program.uniform(multi, "u_medium_rule"),
@@ -541,7 +552,9 @@ class BeamPass final : public Pass {
     glEnable(GL_DEPTH_CLAMP);  // proxies past the near or far plane still cover their pixels
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(ctx.empty_vao);
+    int view = 0;
     for_each_view(ctx, self, program, [&] {
+      if (medium) set_region_eye(ctx, region_eye, view++);
       glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count());
     });
     glDisable(GL_BLEND);
@@ -599,6 +612,34 @@ class UpscalePass final : public Pass {
 };
 
 }  // namespace
+
+GLint set_medium_regions(ProgramPair& program, bool multiview, const Scene& scene) {
+  const int n = std::min<int>(static_cast<int>(scene.media.size()), kMaxMediumRegions);
+  std::array<float, 4 * kMaxMediumRegions> a{}, b{};
+  for (int i = 0; i < n; ++i) {
+    const MediumRegion& r = scene.media[static_cast<std::size_t>(i)];
+    const bool sphere = r.shape == MediumRegion::Shape::kSphere;
+    for (std::size_t k = 0; k < 3; ++k) {
+      a[4 * i + k] = static_cast<float>(r.lo[k]);
+      b[4 * i + k] = static_cast<float>(sphere ? (k == 0 ? r.radius : 0.0) : r.hi[k]);
+    }
+    a[4 * i + 3] = sphere ? 1.0f : 0.0f;
+    b[4 * i + 3] = static_cast<float>(r.sigma_t());
+  }
+  glUniform1i(program.uniform(multiview, "u_region_count"), n);
+  if (n > 0) {
+    glUniform4fv(program.uniform(multiview, "u_region_a"), n, a.data());
+    glUniform4fv(program.uniform(multiview, "u_region_b"), n, b.data());
+  }
+  return program.uniform(multiview, "u_region_eye");
+}
+
+void set_region_eye(const FrameContext& ctx, GLint location, int view) {
+  const Vec3& eye = ctx.views > 0 && view >= 0 ? ctx.view_eyes[static_cast<std::size_t>(view)]
+                                               : ctx.basis.eye;
+  glUniform3f(location, static_cast<float>(eye[0]), static_cast<float>(eye[1]),
+              static_cast<float>(eye[2]));
+}
 
 void set_photon_lod(ProgramPair& program, bool multiview, const GiSettings& gi) {
   glUniform1i(program.uniform(multiview, "u_lod_groups"), gi.lod_groups);

@@ -88,13 +88,18 @@ class Points {
 
 constexpr int kMaxGrading = 16;  // 4^14 > 0.25 / 1e-8: enough levels
 
-// A medium's attenuation along the ray, e^(-(base + kappa sigma)) at parameter
-// sigma: base = sigma_t t_ref, kappa = sigma_t r, so the exponent is
-// sigma_t times the ray distance (>= 0 on the visible part: no overflow).
+// A medium's attenuation along the ray at parameter sigma (world distance
+// t = t_ref + r sigma from the ray's origin o, direction v): e^(-optical
+// depth over [0, t]) (>= 0 on the visible part: no overflow). Null field:
+// none.
 struct Attenuation {
-  double base = 0.0;
-  double kappa = 0.0;
-  bool on() const { return base != 0.0 || kappa != 0.0; }
+  const MediumField* field = nullptr;
+  Vec3 o{}, v{};
+  double t_ref = 0.0, r = 1.0;
+  bool on() const { return field != nullptr; }
+  double at(double sigma) const {
+    return std::exp(-field->optical_depth(o, v, 0.0, std::max(0.0, t_ref + r * sigma)));
+  }
 };
 
 // Integral of f(sqrt(d2 + k2 * (sigma - sc)^2)) over [lo, hi], split at the
@@ -140,8 +145,8 @@ double integrate_radial(const PreparedBeam& pb, double d2, double k2, double inv
   if (at.on()) {
     // Relative to the light that arrives: the floor scaled by the attenuation
     // at the piece's near end (the most any of it keeps).
-    opt.abs_tol *= std::exp(-(at.base + at.kappa * lo));
-    auto seen = [&](double s) { return integrand(s) * std::exp(-(at.base + at.kappa * s)); };
+    opt.abs_tol *= at.at(lo);
+    auto seen = [&](double s) { return integrand(s) * at.at(s); };
     return quad::integrate_pieces(seen, pts.data(), pts.size(), opt).value;
   }
   return quad::integrate_pieces(integrand, pts.data(), pts.size(), opt).value;
@@ -178,9 +183,11 @@ double integrate_line(const PreparedBeam& pb, const Vec3& q, const Vec3& v, cons
     const double rho2 = dot(mp, mp);
     if (!(rho2 < 1.0)) return 0.0;
     const double f = (*pb.density)(std::sqrt(rho2));
-    if (at.kappa > 0.0) {  // integral of e^(-(base + kappa s)) over [lo, hi]
-      return f * std::exp(-(at.base + at.kappa * lo)) * -std::expm1(-at.kappa * (hi - lo)) /
-             at.kappa;
+    if (at.on()) {  // f times the attenuation's integral over [lo, hi]
+      quad::Options opt;
+      opt.rel_tol = rel_tol;
+      const double pts[2] = {lo, hi};
+      return f * quad::integrate_pieces([&at](double s) { return at.at(s); }, pts, 2, opt).value;
     }
     return (hi - lo) * f;
   }
@@ -217,9 +224,10 @@ class RayIntegrals final : public RadialIntegrals {
   Attenuation at_;
 };
 
-// (1/r) * integral of f e^(-sigma_t t) along o + t v, t in [t0, t1], |v| = 1.
+// (1/r) * integral of f e^(-optical depth from o) along o + t v, t in
+// [t0, t1], |v| = 1 (no medium: null field).
 double beam_energy_prepared(const PreparedBeam& pb, const Vec3& o, const Vec3& v, double t0,
-                            double t1, double rel_tol, double sigma_t = 0.0) {
+                            double t1, double rel_tol, const MediumField* medium = nullptr) {
   if (!(t1 > t0)) return 0.0;
   const Vec3 oc = o - pb.c;
   const double t_ref = -dot(oc, v);
@@ -231,7 +239,7 @@ double beam_energy_prepared(const PreparedBeam& pb, const Vec3& o, const Vec3& v
   const double s1 = std::min((t1 - t_ref) * pb.inv_r, h);
   if (!(s1 > s0)) return 0.0;
 
-  const RayIntegrals f(pb, q, v, rel_tol, Attenuation{sigma_t * t_ref, sigma_t * pb.r});
+  const RayIntegrals f(pb, q, v, rel_tol, Attenuation{medium, o, v, t_ref, pb.r});
   return std::visit(
       [&](const auto& shape) { return shape.reference_energy(f, q, v, s0, s1, pb.r); },
       *pb.shape);
@@ -269,8 +277,11 @@ double beam_energy_reference(const Beam& beam, const Vec3& origin, const Vec3& d
   const PreparedBeam pb = prepare_beam(beam);
   // The integral is over the parameter t; with a non-unit direction the world
   // distance is t * |dir|, hence the rescaling.
+  const Medium m{.sigma_a = sigma_t};
+  const std::vector<MediumRegion> none;
+  const MediumField field(&m, none);
   return beam_energy_prepared(pb, origin, (1.0 / len) * dir, t0 * len, t1 * len, rel_tol,
-                              sigma_t) /
+                              sigma_t > 0.0 ? &field : nullptr) /
          len;
 }
 
@@ -291,7 +302,8 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
     beam_src.push_back(&b);
   }
 
-  const double sigma_t = scene.has_medium() ? scene.medium->sigma_t() : 0.0;
+  const MediumField medium = scene.medium_field();
+  const MediumField* field = scene.has_medium() ? &medium : nullptr;
   const DirectionalLight& light = scene.light;
   const double llen = length(light.direction);
   const Vec3 to_light = llen > 0.0 ? (-1.0 / llen) * light.direction : Vec3{0.0, 0.0, 0.0};
@@ -329,16 +341,18 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
         const double lambert = light.ambient + light.intensity * std::max(0.0, dot(n, to_light));
         for (int k = 0; k < 3; ++k) c[k] = (*hit.albedo)[k] * light.color[k] * lambert;
       }
-      if (sigma_t > 0.0 && !gi) {
-        // The medium fills space: the surface (or the background, at
-        // infinity) attenuated by the distance to it (the path tracer
-        // follows lit scenes' paths through the medium itself).
-        const double tr = surface ? std::exp(-sigma_t * t_end) : 0.0;
+      if (field && !gi) {
+        // The surface (or the background, at infinity) attenuated by the
+        // optical depth to it (the path tracer follows lit scenes' paths
+        // through the medium itself).
+        const double tau = surface ? field->optical_depth(ray.origin, ray.dir, 0.0, t_end)
+                                   : field->optical_depth(ray.origin, ray.dir, 0.0, kInf);
+        const double tr = std::exp(-tau);
         for (int k = 0; k < 3; ++k) c[k] *= tr;
       }
       for (std::size_t b = 0; b < beams.size(); ++b) {
         const double e = beam_energy_prepared(beams[b], ray.origin, ray.dir, ray.t_min, t_end,
-                                              opts.rel_tol, sigma_t);
+                                              opts.rel_tol, field);
         if (e == 0.0) continue;
         const Beam& src = *beam_src[b];
         for (int k = 0; k < 3; ++k) c[k] += src.color[k] * src.intensity * e;

@@ -311,6 +311,7 @@ void SceneResources::upload_volume_photons(PhotonCache& cache) {
     float dir[4];
   };
   std::vector<VolumeData> data(maps_->volume.size());
+  const MediumField field = scene_.medium_field();
   for (std::size_t i = 0; i < data.size(); ++i) {
     const Photon& p = maps_->volume[i];
     for (int k = 0; k < 3; ++k) {
@@ -319,6 +320,10 @@ void SceneResources::upload_volume_photons(PhotonCache& cache) {
       data[i].power[k] = p.power[k];
       data[i].dir[k] = p.dir[k];
     }
+    // The phase parameter and extinction where the photon scattered.
+    const Vec3 x{p.p[0], p.p[1], p.p[2]};
+    data[i].position[3] = static_cast<float>(field.k(x));
+    data[i].dir[3] = static_cast<float>(field.sigma_t(x));
   }
   volume_count_ = static_cast<GLsizei>(data.size());
   if (!data.empty()) {

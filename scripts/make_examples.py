@@ -232,7 +232,7 @@ def main():
     # medium, 50 000 photons at 512x512): a floor, a back wall and two side
     # walls open to the camera, a sphere and a box, the spot from above.
     wall = [0.75, 0.75, 0.75]
-    write("fog_stage.json", {
+    stage = {
         "lights": [{"type": "spot", "position": [0.0, 5.5, 1.0], "direction": [0.0, -5.5, -1.0],
                     "inner_deg": 15.0, "outer_deg": 25.0, "power": 600.0}],
         "occluders": [
@@ -252,7 +252,13 @@ def main():
         "gi": {"photons": 50000},
         "cameras": [camera("view", [0.0, 2.2, 9.0], [0.0, 1.5, 0.0], fov_y=45)],
         "output": {"exposure": 0.8},
-    })
+    }
+    write("fog_stage.json", stage)
+    # Its fig 5.9: heterogeneous fog, a dense layer near the floor (a box
+    # region of medium) under the thin fog of the stage.
+    write("ground_fog.json", dict(stage, media=[
+        {"type": "box", "min": [-5.0, 0.0, -5.0], "max": [5.0, 0.8, 5.0],
+         "sigma_s": 0.6, "sigma_a": 0.05, "g": 0.3}]))
 
 
 if __name__ == "__main__":

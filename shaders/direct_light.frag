@@ -4,7 +4,7 @@
 //   L = albedo / pi * sum_i flux_i * angular_i(c) * max(0, n.l) * V_i / d^2,
 // V_i from point i's cube shadow map of the triangles (distance compared,
 // bilinear percentage-closer filtering) and from shadow rays to the analytic
-// occluders, times e^(-sigma_t d) in a medium. Mirrors, glass, emitters and
+// occluders, times e^(-optical depth) to the point in a medium. Mirrors, glass, emitters and
 // the background are left alone.
 struct DirectPoint {
   vec4 position;  // xyz: relative to the direct anchor; w: mode (0 isotropic, 1 cosine, 2 cone)
@@ -87,7 +87,9 @@ void main() {
     float visible = texture(u_shadows, vec4(v, float(i)), (length(v) - 0.5 * foot) / u_far);
     if (visible <= 0.0) continue;
     if (u_count > 0 && analytic_blocked(x + (1e-4 * dist) * n, l, dist)) continue;
-    float transmitted = u_sigma_t > 0.0 ? exp(-u_sigma_t * dist) : 1.0;
+    float transmitted = u_sigma_t > 0.0 || u_region_count > 0
+                            ? exp(-(u_sigma_t * dist + region_depth(x, l, 0.0, dist)))
+                            : 1.0;
     e += p.flux.rgb * (angular * cos_x * visible * transmitted / d2);
   }
   out_color = vec4(albedo.rgb / kPi * e, 0.0);

@@ -20,6 +20,7 @@ uniform float u_lod_far;
 flat out vec3 v_center;  // camera-relative
 flat out vec3 v_power;
 flat out vec3 v_normal;
+flat out vec2 v_extra;  // position.w and normal.w (volume photons: local k and sigma_t)
 
 // The LOD weight of photon `index` at camera-relative position c: the share
 // Q of the groups dropped at its distance (smoothstep(near, far, D), or
@@ -42,6 +43,7 @@ void main() {
   PhotonData p = photons[gl_InstanceID + u_first];
   vec3 c = p.position.xyz + u_photon_offset;
   v_center = c;
+  v_extra = vec2(p.position.w, p.normal.w);
   float lod = lod_weight(c, gl_InstanceID + u_first);
   if (lod <= 0.0) {  // dropped: a degenerate quad outside the clip volume
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0);

@@ -16,13 +16,13 @@
 layout(binding = 0) uniform VIEW_SAMPLER u_view_depth;  // surfaces' view depth (huge: none)
 uniform int u_has_surfaces;
 uniform float u_radius;
-uniform float u_sigma_t;
-uniform float u_k;  // Schlick phase parameter
+uniform float u_sigma_t;  // the scene-wide medium's (regions: medium_regions.glsl)
 uniform int u_estimator;
 
 flat in vec3 v_center;  // camera-relative
 flat in vec3 v_power;
 flat in vec3 v_normal;  // the photon's travel direction
+flat in vec2 v_extra;   // x: Schlick k at the photon; y: sigma_t at the photon
 
 layout(location = 0) out vec4 out_color;
 
@@ -45,19 +45,23 @@ void main() {
   float w;
   if (u_estimator == 1) {
     if (tc < t0 || tc > t1) discard;
-    w = exp(-u_sigma_t * tc) / (kPi * r2);
+    w = exp(-(u_sigma_t * tc + region_depth(ray.origin, ray.dir, 0.0, tc))) / (kPi * r2);
   } else {
     float h = sqrt(r2 - d2);
     float a = max(tc - h, t0);
     float b = min(tc + h, t1);
     if (!(b > a)) discard;
-    float x = u_sigma_t * (b - a);
+    // Within the kernel the extinction is taken as the photon's own
+    // (exact in a homogeneous medium).
+    float x = v_extra.y * (b - a);
     // (e^(-s a) - e^(-s b)) / s = e^(-s a) (b - a) (1 - e^-x) / x; its series where x is small.
     float ratio = x < 1e-3 ? 1.0 - 0.5 * x : (1.0 - exp(-x)) / x;
-    w = exp(-u_sigma_t * a) * (b - a) * ratio / (4.0 / 3.0 * kPi * r2 * u_radius);
+    w = exp(-(u_sigma_t * a + region_depth(ray.origin, ray.dir, 0.0, a))) * (b - a) * ratio /
+        (4.0 / 3.0 * kPi * r2 * u_radius);
   }
+  float k = v_extra.x;
   float mu = dot(v_normal, -ray.dir);
-  float q = 1.0 - u_k * mu;
-  float phase = (1.0 - u_k * u_k) / (4.0 * kPi * q * q);
+  float q = 1.0 - k * mu;
+  float phase = (1.0 - k * k) / (4.0 * kPi * q * q);
   out_color = vec4(v_power * (phase * w), 0.0);
 }

@@ -90,6 +90,38 @@ TEST(Medium, PhotonLodParsesWithItsDefaults) {
   EXPECT_EQ(error_of(j).code, "missing_field");
 }
 
+// Regions of medium ("media"): parsed, planned, and their optical depth is
+// the sum of sigma_t times exact chords (a box and a sphere against a
+// midpoint sum over 1e5 steps: 1e-9 covers the sum's own error).
+TEST(Medium, RegionsParseAndTheirOpticalDepthIsExact) {
+  json j = fogged(json::object());
+  j.erase("medium");
+  j["media"] = {{{"type", "box"}, {"min", {-1, -1, -1}}, {"max", {1, 0.5, 2}}, {"sigma_a", 0.5}},
+                {{"type", "sphere"}, {"center", {0.5, 0, 0}}, {"radius", 1.0}, {"sigma_s", 2.0},
+                 {"g", 0.3}}};
+  const Scene s = parse_scene(j, {});
+  ASSERT_EQ(s.media.size(), 2u);
+  EXPECT_TRUE(s.has_medium());
+  EXPECT_FALSE(s.global_medium());
+  const std::vector<std::string> p = plan_passes(s);
+  EXPECT_NE(std::find(p.begin(), p.end(), "medium"), p.end());
+  const MediumField field = s.medium_field();
+  EXPECT_DOUBLE_EQ(field.majorant(), 2.5);
+  EXPECT_DOUBLE_EQ(field.sigma_t({0.5, 0.0, 0.0}), 2.5);   // both
+  EXPECT_DOUBLE_EQ(field.sigma_t({0.5, 0.9, 0.0}), 2.0);   // the sphere only
+  EXPECT_DOUBLE_EQ(field.sigma_t({-0.9, -0.9, 1.5}), 0.5);  // the box only
+  EXPECT_NEAR(field.k({0.5, 0.0, 0.0}), 1.55 * 0.3 - 0.55 * 0.027, 1e-12);
+  const Vec3 o{-3.0, 0.2, 0.1};
+  const Vec3 v = normalize(Vec3{1.0, -0.05, 0.02});
+  const int n = 100000;
+  const double len = 6.0;
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i) sum += field.sigma_t(o + ((i + 0.5) * len / n) * v);
+  EXPECT_NEAR(field.optical_depth(o, v, 0.0, len), sum * len / n, 1e-4);
+  EXPECT_GT(field.optical_depth(o, v, 0.0, len), 1.0);
+  EXPECT_DOUBLE_EQ(field.last_exit(o, v) > 3.0, true);
+}
+
 TEST(Medium, BadFieldsAreRefusedWithTheirPath) {
   struct Case {
     json medium;
@@ -112,6 +144,34 @@ TEST(Medium, BadFieldsAreRefusedWithTheirPath) {
       {{{"density", 1.0}}, "unknown_field", "/medium/density"},
       {json::array(), "wrong_type", "/medium"},
   };
+  struct RegionCase {
+    json region;
+    std::string code, path;
+  };
+  const RegionCase region_cases[] = {
+      {{{"type", "box"}, {"min", {0, 0, 0}}, {"max", {1, 0, 1}}}, "invalid_value", "/media/0/max"},
+      {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", -1}}, "out_of_range",
+       "/media/0/radius"},
+      {{{"type", "cone"}}, "invalid_value", "/media/0/type"},
+      {{{"type", "box"}, {"min", {0, 0, 0}}}, "missing_field", "/media/0/max"},
+      {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1}, {"sigma_s", -2}},
+       "out_of_range", "/media/0/sigma_s"},
+      {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1}, {"min", {0, 0, 0}}},
+       "unknown_field", "/media/0/min"},
+  };
+  for (const RegionCase& c : region_cases) {
+    json j = fogged(json::object());
+    j["media"] = {c.region};
+    const ErrorInfo e = error_of(j);
+    EXPECT_EQ(e.code, c.code) << c.region.dump() << ": " << e.message;
+    EXPECT_EQ(e.path, c.path) << c.region.dump() << ": " << e.message;
+  }
+  json many = fogged(json::object());
+  many["media"] = json::array();
+  for (int i = 0; i <= kMaxMediumRegions; ++i) {
+    many["media"].push_back({{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1}});
+  }
+  EXPECT_EQ(error_of(many).code, "limit_exceeded");
   for (const Case& c : cases) {
     const ErrorInfo e = error_of(fogged(c.medium));
     EXPECT_EQ(e.code, c.code) << c.medium.dump() << ": " << e.message;
