@@ -126,7 +126,8 @@ double beam_rule_worst_error(const Density& f, double kappa, BeamMediumRule rule
     lcg = lcg * 1664525u + 1013904223u;
     return (lcg >> 8) / 16777216.0;
   };
-  for (double d = 0.0; d < 0.995; d += 0.09) {
+  for (int row = 0; row <= 11; ++row) {  // d = 0, 0.09, ..., 0.99
+    const double d = 0.09 * row;
     const double h = std::sqrt((1.0 - d) * (1.0 + d));
     const double chord = beam_piece_exact(f, d, -h, h, 0.0);
     for (int piece = 0; piece < 3; ++piece) {
