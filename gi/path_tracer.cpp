@@ -160,27 +160,40 @@ class Tracer {
   }
 
  private:
-  // Next-event estimation at a diffuse point x (normal n facing the viewer):
-  // reflected radiance from one light sample, picked by pick_.
-  Color direct(const Vec3& x, const Vec3& n, const Color& albedo, std::mt19937_64& rng) const {
-    if (pick_.empty()) return {0.0, 0.0, 0.0};
-    const Scene& scene = gi_.scene();
+  // One light picked by pick_ and a point on it seen from x (the uniforms
+  // drawn in one order for every caller); empty if the pick has no weight.
+  struct LightPick {
+    const Light* light = nullptr;
+    double probability = 0.0;
+    LightSample sample;
+  };
+  std::optional<LightPick> pick_light(const Vec3& x, std::mt19937_64& rng) const {
+    if (pick_.empty()) return std::nullopt;
     const double u = uniform(rng);
     const LightRandom lu{uniform(rng), uniform(rng), uniform(rng), uniform(rng)};
     std::size_t i = 0;
     double acc = pick_[0];
     while (u >= acc && i + 1 < pick_.size()) acc += pick_[++i];
-    if (!(pick_[i] > 0.0)) return {0.0, 0.0, 0.0};
-    const Light& light = scene.lights[i];
-    const LightSample s = std::visit([&](const auto& k) { return k.sample(x, lu); }, light.shape);
+    if (!(pick_[i] > 0.0)) return std::nullopt;
+    const Light& light = gi_.scene().lights[i];
+    return LightPick{&light, pick_[i],
+                     std::visit([&](const auto& k) { return k.sample(x, lu); }, light.shape)};
+  }
+
+  // Next-event estimation at a diffuse point x (normal n facing the viewer):
+  // reflected radiance from one light sample, picked by pick_.
+  Color direct(const Vec3& x, const Vec3& n, const Color& albedo, std::mt19937_64& rng) const {
+    const std::optional<LightPick> p = pick_light(x, rng);
+    if (!p) return {0.0, 0.0, 0.0};
+    const LightSample& s = p->sample;
     const double cos_x = dot(n, s.dir);
     if (!(s.g > 0.0) || !(cos_x > 0.0)) return {0.0, 0.0, 0.0};
     const double eps = gi_.epsilon();
     if (gi_.occluded(x, s.dir, eps, s.dist - eps)) return {0.0, 0.0, 0.0};
     // E = flux g cos_x / pick (times the medium's transmittance); L_out = (albedo / pi) E.
     const double k =
-        s.g * cos_x * transmittance(x, s.dir, s.dist) / (std::numbers::pi * pick_[i]);
-    return k * mul(albedo, light.flux);
+        s.g * cos_x * transmittance(x, s.dir, s.dist) / (std::numbers::pi * p->probability);
+    return k * mul(albedo, p->light->flux);
   }
 
   // Next-event estimation at a point x of the medium on a path travelling
@@ -188,21 +201,14 @@ class Tracer {
   // p(mu) flux g T / pick, mu = dot(s.dir, v) (the light travels along
   // -s.dir, then towards the eye along -v: gi/phase.hpp's convention).
   Color in_scattered(const Vec3& x, const Vec3& v, double phase_k, std::mt19937_64& rng) const {
-    if (pick_.empty()) return {0.0, 0.0, 0.0};
-    const Scene& scene = gi_.scene();
-    const double u = uniform(rng);
-    const LightRandom lu{uniform(rng), uniform(rng), uniform(rng), uniform(rng)};
-    std::size_t i = 0;
-    double acc = pick_[0];
-    while (u >= acc && i + 1 < pick_.size()) acc += pick_[++i];
-    if (!(pick_[i] > 0.0)) return {0.0, 0.0, 0.0};
-    const Light& light = scene.lights[i];
-    const LightSample s = std::visit([&](const auto& k) { return k.sample(x, lu); }, light.shape);
+    const std::optional<LightPick> p = pick_light(x, rng);
+    if (!p) return {0.0, 0.0, 0.0};
+    const LightSample& s = p->sample;
     if (!(s.g > 0.0)) return {0.0, 0.0, 0.0};
     if (gi_.occluded(x, s.dir, 0.0, s.dist - gi_.epsilon())) return {0.0, 0.0, 0.0};
-    const double k =
-        schlick_phase(phase_k, dot(s.dir, v)) * s.g * transmittance(x, s.dir, s.dist) / pick_[i];
-    return k * light.flux;
+    const double k = schlick_phase(phase_k, dot(s.dir, v)) * s.g * transmittance(x, s.dir, s.dist) /
+                     p->probability;
+    return k * p->light->flux;
   }
 
   // e^(-optical depth) of the scene's medium along x + t l, t in [0, d] (1 without one).

@@ -276,14 +276,7 @@ double default_volume_radius(const Scene& scene, std::int64_t volume_photons) {
 }
 
 double default_photon_radius(const Scene& scene, std::int64_t photons) {
-  Aabb box;
-  for (const Occluder& o : scene.occluders) {
-    const Aabb b = std::visit([](const auto& k) { return k.bounds(); }, o.shape);
-    if (std::isfinite(b.lo[0]) && std::isfinite(b.hi[0])) box.grow(b);
-  }
-  for (const Light& l : scene.lights) {
-    box.grow(std::visit([](const auto& k) { return k.bounds(); }, l.shape));
-  }
+  const Aabb box = scene_box(scene);
   if (box.empty() || photons <= 0) return 1.0;
   const Vec3 s = box.hi - box.lo;
   const double area = 2.0 * (s[0] * s[1] + s[1] * s[2] + s[2] * s[0]);

@@ -45,6 +45,28 @@ json beams_in_fog(double sigma_t, json medium_extra = json::object()) {
              {"height", 96}}}}};
 }
 
+// An example scene at size x size (its first camera only).
+Scene example_at(const char* file, int size) {
+  const auto dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
+  Scene scene = load_scene_file(dir / file, {});
+  scene.cameras.resize(1);
+  scene.cameras[0].width = scene.cameras[0].height = size;
+  return scene;
+}
+
+// The path tracer's image of a lit scene at 1024 paths a pixel.
+HdrImage path_traced(const Scene& scene) {
+  ReferenceOptions ro;
+  ro.gi_spp = 1024;
+  return render_reference(scene, scene.cameras[0], ro);
+}
+
+double image_mean(const HdrImage& img) {
+  double s = 0.0;
+  for (float v : img.rgb) s += v;
+  return s / static_cast<double>(img.rgb.size());
+}
+
 HdrError against_reference(const json& j) {
   const Scene scene = parse_scene(j, {});
   const HdrImage ref = render_reference(scene, scene.cameras[0]);
@@ -127,23 +149,14 @@ TEST(Medium, SurfacesAreAttenuatedAndTheBackgroundVanishes) {
 // bias. Relative L1 under 0.3: most of it is the reference's own noise at
 // 1024 paths (0.17 measured between two seeds).
 TEST(Medium, TheFogStageMatchesThePathTracer) {
-  const auto dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
-  Scene scene = load_scene_file(dir / "fog_stage.json", {});
-  scene.cameras[0].width = scene.cameras[0].height = 64;
-  ReferenceOptions ro;
-  ro.gi_spp = 1024;
-  const HdrImage ref = render_reference(scene, scene.cameras[0], ro);
-  auto mean = [](const HdrImage& img) {
-    double s = 0.0;
-    for (float v : img.rgb) s += v;
-    return s / static_cast<double>(img.rgb.size());
-  };
-  const double want = mean(ref);
+  Scene scene = example_at("fog_stage.json", 64);
+  const HdrImage ref = path_traced(scene);
+  const double want = image_mean(ref);
   for (VolumeEstimator est : {VolumeEstimator::kBeam, VolumeEstimator::kSeed}) {
     scene.medium->estimator = est;
     const auto frames = renderer().render(scene, FrameOptions{.read_hdr = true});
     const HdrError e = compare_hdr(frames[0].hdr, ref);
-    const double got = mean(frames[0].hdr);
+    const double got = image_mean(frames[0].hdr);
     std::printf("estimator %s: mean %.4f (reference %.4f), rel L1 %.3f\n",
                 est == VolumeEstimator::kBeam ? "beam" : "seed", got, want, e.rel_l1);
     EXPECT_EQ(e.nonfinite, 0);
@@ -160,17 +173,11 @@ TEST(Medium, TheFogStageMatchesThePathTracer) {
 // stage setting (near 25, far 3: photons within 3 of the camera dropped
 // whole) the mean may only fall.
 TEST(Medium, PhotonLodKeepsTheFluxWhereNothingIsDroppedWhole) {
-  const auto dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
-  Scene scene = load_scene_file(dir / "fog_stage.json", {});
-  scene.cameras[0].width = scene.cameras[0].height = 64;
+  Scene scene = example_at("fog_stage.json", 64);
   auto render = [&] {
     return renderer().render(scene, FrameOptions{.read_hdr = true})[0].hdr;
   };
-  auto mean = [](const HdrImage& img) {
-    double s = 0.0;
-    for (float v : img.rgb) s += v;
-    return s / static_cast<double>(img.rgb.size());
-  };
+  const auto mean = image_mean;
   const HdrImage full = render();
   scene.gi.lod_groups = 16;
   scene.gi.lod_near = 0.0;
@@ -211,18 +218,10 @@ TEST(Medium, RegionsAttenuateSurfacesExactlyAndBeamsClosely) {
 // floor of the stage) against the path tracer, as the stage above: the
 // image's mean within 5% (measured 0.6% at 128x128, docs/media.md).
 TEST(Medium, TheGroundFogMatchesThePathTracer) {
-  const auto dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
-  Scene scene = load_scene_file(dir / "ground_fog.json", {});
-  scene.cameras[0].width = scene.cameras[0].height = 48;
-  ReferenceOptions ro;
-  ro.gi_spp = 1024;
-  const HdrImage ref = render_reference(scene, scene.cameras[0], ro);
-  const auto frames = renderer().render(scene, FrameOptions{.read_hdr = true});
-  double got = 0.0, want = 0.0;
-  for (std::size_t i = 0; i < ref.rgb.size(); ++i) {
-    got += frames[0].hdr.rgb[i];
-    want += ref.rgb[i];
-  }
+  const Scene scene = example_at("ground_fog.json", 48);
+  const double want = image_mean(path_traced(scene));
+  const double got =
+      image_mean(renderer().render(scene, FrameOptions{.read_hdr = true})[0].hdr);
   std::printf("ground fog: mean ratio %.4f\n", got / want);
   EXPECT_NEAR(got / want, 1.0, 0.05);
 }
