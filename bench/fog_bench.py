@@ -16,7 +16,9 @@ kernel integrated along the visible ray) at 1/4, 1 and 4 times the scene's
 photon count; and at the scene's count with the seed's photon level of
 detail (gi.lod near 25, far 3, 16 groups: its fig 6.3 setting, photons near
 the camera dropped; and near 0, far 20: its fig 6.4 setting, far photons
-dropped). Per row: relative L1 against the reference (sum |gpu - ref| /
+dropped); and, as the alternative to LOD, the volume kernels capped at 16
+and 8 pixels on screen (medium.radius_pixels: nearer photons get smaller
+kernels, none is dropped). Per row: relative L1 against the reference (sum |gpu - ref| /
 sum ref), the image mean's ratio to the reference's, the volume photons
 stored, the GPU time of the frame and of the volume_photons pass (median of
 the scene's copies of its camera). Writes DIR/fog.csv, DIR/fog.md and
@@ -83,19 +85,23 @@ def main():
         noise = 0.5 * float(np.abs(refs[0] - refs[1]).sum() / ref.sum())
         print("%s: reference noise (rel L1 of the mean of two) %.3f" % (name, noise), flush=True)
         photons = scene["gi"]["photons"]
-        runs = [(est, n, None) for est in ("seed", "beam")
+        runs = [(est, n, None, 0) for est in ("seed", "beam")
                 for n in (photons // 4, photons, photons * 4)]
-        runs += [("beam", photons, (25.0, 3.0, 16)), ("beam", photons, (0.0, 20.0, 16))]
-        for est, n, lod in runs:
+        runs += [("beam", photons, (25.0, 3.0, 16), 0), ("beam", photons, (0.0, 20.0, 16), 0)]
+        runs += [("beam", photons, None, px) for px in (16, 8)]
+        for est, n, lod, radius_px in runs:
             s = json.loads(json.dumps(scene))
             s["medium"]["estimator"] = est
             s["gi"]["photons"] = n
             if lod:
                 s["gi"]["lod"] = {"near": lod[0], "far": lod[1], "groups": lod[2]}
+            if radius_px:
+                s["medium"]["radius_pixels"] = radius_px
             s["cameras"] = [dict(s["cameras"][0], name="c%d" % i) for i in range(args.copies)]
             img, frames = render(args.binary, s, os.path.join(work, "gpu"), [])
             row = {"scene": name, "estimator": est, "photons": n,
-                   "lod": "n=%g f=%g A=%d" % lod if lod else "off",
+                   "lod": ("n=%g f=%g A=%d" % lod if lod else
+                           "radius <= %d px" % radius_px if radius_px else "off"),
                    "volume_photons": frames[0].get("photons", {}).get("volume", 0),
                    "rel_l1": float(np.abs(img - ref).sum() / ref.sum()),
                    "mean_ratio": float(img.mean() / ref.mean()),
@@ -112,7 +118,7 @@ def main():
         w.writeheader()
         w.writerows(rows)
     with open(os.path.join(args.out, "fog.md"), "w") as f:
-        f.write("| scene | estimator | photons | LOD | volume photons | rel L1 | mean / reference | "
+        f.write("| scene | estimator | photons | LOD or kernel cap | volume photons | rel L1 | mean / reference | "
                 "frame ms | frames/s | volume pass ms |\n|---|---|---|---|---|---|---|---|---|---|\n")
         for r in rows:
             f.write("| %s | %s | %d | %s | %d | %.3f | %.3f | %.0f | %.2f | %.0f |\n" %

@@ -195,6 +195,20 @@ Color LitShading::trace(const Vec3& o, const Vec3& d, double t_min, double t_max
 Color LitShading::trace(const Vec3& o, const Vec3& d, double t_min, double t_max, int depth,
                         double weight) const {
   const auto hit = surfaces_.intersect(o, d, t_min, t_max);
+  const Color c = shade(hit, d, depth, weight);
+  // Beyond a mirror or through glass (depth > 0) the medium attenuates the
+  // segment (the background, at infinity, by the optical depth to it); the
+  // camera's own segment is the medium pass's. Light scattered into these
+  // segments is not added.
+  if (depth == 0 || !scene_.has_medium()) return c;
+  // (From the surface the ray leaves, t = 0, not from its t_min offset.)
+  const double seen = std::exp(-scene_.medium_field().optical_depth(
+      o, d, 0.0, hit ? hit->t : std::numeric_limits<double>::infinity()));
+  return seen * c;
+}
+
+Color LitShading::shade(const std::optional<SurfaceHit>& hit, const Vec3& d, int depth,
+                        double weight) const {
   if (!hit) return scene_.background;
   if (hit->light >= 0) {  // a quad light seen from its front: its radiance
     const Light& l = scene_.lights[static_cast<std::size_t>(hit->light)];

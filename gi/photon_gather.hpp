@@ -77,6 +77,9 @@ class LitShading {
   };
   Color trace(const Vec3& o, const Vec3& d, double t_min, double t_max, int depth,
               double weight) const;
+  // What the ray along d sees at `hit` (none: the background).
+  Color shade(const std::optional<SurfaceHit>& hit, const Vec3& d, int depth,
+              double weight) const;
   Color diffuse(const Vec3& p, const Vec3& n, const Color& albedo) const;
   const Scene& scene_;
   const GiScene& surfaces_;

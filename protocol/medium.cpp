@@ -181,6 +181,9 @@ Medium parse_medium(const Node& n) {
         *v, {{"beam", VolumeEstimator::kBeam}, {"seed", VolumeEstimator::kSeed}});
   }
   if (auto v = o.optional("radius")) m.radius = check_closed(*v, read_number(*v), 0.0, 1e6);
+  if (auto v = o.optional("radius_pixels")) {
+    m.radius_pixels = check_closed(*v, read_number(*v), 0.0, 4096.0);
+  }
   return m;
 }
 

@@ -64,6 +64,12 @@ struct Medium {
   // for the stored photons spread evenly through the scene's bounding box
   // (default_volume_radius, gi/photon_map.hpp).
   double radius = 0.0;
+  // The alternative to photon LOD (gi.lod): a cap on a volume photon's
+  // kernel radius on screen, in pixels (0: none). Photons nearer the camera
+  // than where their kernel would exceed it get a kernel that just does
+  // (normalized to it: the estimate stays unbiased, noisier there), so each
+  // photon costs at most ~4 cap^2 fragments; none is dropped.
+  double radius_pixels = 0.0;
 
   double sigma_t() const { return sigma_s + sigma_a; }
 };
@@ -131,7 +137,8 @@ inline constexpr int kMaxBeamSubPieces = 32;
 inline constexpr std::string_view kMediumRegionFields[] = {
     "type", "min", "max", "center", "radius", "sigma_s", "sigma_a", "k", "g"};
 inline constexpr std::string_view kMediumFields[] = {
-    "sigma_s", "sigma_a", "k", "g", "beam_rule", "beam_step", "estimator", "radius"};
+    "sigma_s", "sigma_a",   "k",      "g",
+    "beam_rule", "beam_step", "estimator", "radius", "radius_pixels"};
 
 // Throws ProtocolError (code, message, JSON path) for a bad field: negative
 // coefficients, |k| >= 1 or |g| > kSchlickMaxG, both k and g.

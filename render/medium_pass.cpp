@@ -13,17 +13,18 @@ namespace {
 
 class MediumPass final : public Pass {
  public:
-  MediumPass() : program_("medium_attenuate") {}
+  MediumPass() : programs_("medium_attenuate") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     if (!ctx.scene.has_medium()) throw GlError("medium pass: the scene has no medium");
     const bool multi = ctx.views > 0;
-    glUseProgram(program_.get(multi));
+    ProgramPair& program = programs_.get(ctx.scene);
+    glUseProgram(program.get(multi));
     const bool surfaces = ctx.plan.written("view_depth");
-    glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
+    glUniform1i(program.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
     const Medium* global = ctx.scene.global_medium();
-    glUniform1f(program_.uniform(multi, "u_sigma_t"),
+    glUniform1f(program.uniform(multi, "u_sigma_t"),
                 global ? static_cast<float>(global->sigma_t()) : 0.0f);
-    const GLint region_eye = set_medium_regions(program_, multi, ctx.scene);
+    const GLint region_eye = set_medium_regions(program, multi, ctx.scene);
     glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ZERO, GL_SRC_COLOR);  // hdr *= transmittance
@@ -31,7 +32,7 @@ class MediumPass final : public Pass {
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(ctx.empty_vao);
     int view = 0;
-    for_each_view(ctx, self, program_, [&] {
+    for_each_view(ctx, self, program, [&] {
       set_region_eye(ctx, region_eye, view++);
       glDrawArrays(GL_TRIANGLES, 0, 3);
     });
@@ -40,7 +41,7 @@ class MediumPass final : public Pass {
   }
 
  private:
-  ProgramPair program_;
+  RegionProgram programs_;
 };
 
 // The volume photons' in-scattered light (shaders/volume_splat.frag): one
@@ -49,7 +50,7 @@ class MediumPass final : public Pass {
 // power, as the surface photons.
 class VolumePhotonPass final : public Pass {
  public:
-  VolumePhotonPass() : program_("volume_splat") {}
+  VolumePhotonPass() : programs_("volume_splat") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     if (!ctx.scene.has_medium()) throw GlError("volume photon pass: the scene has no medium");
     const Medium medium = ctx.scene.medium.value_or(Medium{});
@@ -59,19 +60,22 @@ class VolumePhotonPass final : public Pass {
         std::llround(share * static_cast<double>(ctx.resources.volume_count())));
     if (count == 0) return;
     const bool multi = ctx.views > 0;
-    glUseProgram(program_.get(multi));
+    ProgramPair& program = programs_.get(ctx.scene);
+    glUseProgram(program.get(multi));
     const bool surfaces = ctx.plan.written("view_depth");
-    glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
-    glUniform1f(program_.uniform(multi, "u_radius"),
+    glUniform1i(program.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
+    glUniform1f(program.uniform(multi, "u_radius"),
                 static_cast<float>(ctx.resources.volume_radius()));
-    glUniform1f(program_.uniform(multi, "u_sigma_t"),
+    glUniform1f(program.uniform(multi, "u_radius_pixels"),
+                static_cast<float>(medium.radius_pixels));
+    glUniform1f(program.uniform(multi, "u_sigma_t"),
                 global ? static_cast<float>(global->sigma_t()) : 0.0f);
-    const GLint region_eye = set_medium_regions(program_, multi, ctx.scene);
-    glUniform1i(program_.uniform(multi, "u_estimator"),
+    const GLint region_eye = set_medium_regions(program, multi, ctx.scene);
+    glUniform1i(program.uniform(multi, "u_estimator"),
                 medium.estimator == VolumeEstimator::kSeed ? 1 : 0);
-    glUniform1i(program_.uniform(multi, "u_first"), 0);
-    glUniform1f(program_.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
-    set_photon_lod(program_, multi, ctx.scene.gi);
+    glUniform1i(program.uniform(multi, "u_first"), 0);
+    glUniform1f(program.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
+    set_photon_lod(program, multi, ctx.scene.gi);
     glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, ctx.resources.volume_buffer());
     glEnable(GL_BLEND);
@@ -81,7 +85,7 @@ class VolumePhotonPass final : public Pass {
     glDisable(GL_CULL_FACE);
     glBindVertexArray(ctx.empty_vao);
     int view = 0;
-    for_each_view_offset(ctx, self, program_, "u_photon_offset", ctx.resources.volume_anchor(),
+    for_each_view_offset(ctx, self, program, "u_photon_offset", ctx.resources.volume_anchor(),
                          [&] {
                            set_region_eye(ctx, region_eye, view++);
                            glDrawArraysInstanced(GL_TRIANGLES, 0, 6, count);
@@ -91,7 +95,7 @@ class VolumePhotonPass final : public Pass {
   }
 
  private:
-  ProgramPair program_;
+  RegionProgram programs_;
 };
 
 }  // namespace

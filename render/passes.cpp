@@ -238,22 +238,23 @@ std::array<float, 16> cube_face_matrix(int face, float near) {
 // (SceneResources::shadow_key), so a camera-only change renders none.
 class DirectPass final : public Pass {
  public:
-  DirectPass() : program_("direct_light"), shadow_("shadow_depth") {}
+  DirectPass() : programs_("direct_light"), shadow_("shadow_depth") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     SceneResources& res = ctx.resources;
     const auto count = static_cast<GLsizei>(res.direct_points().size());
     if (count == 0) return;
     if (res.shadow_key() != key_) render_shadows(ctx);
     const bool multi = ctx.views > 0;
-    glUseProgram(program_.get(multi));
-    glUniform1i(program_.uniform(multi, "u_point_count"), count);
-    glUniform1f(program_.uniform(multi, "u_far"), far_);
-    glUniform1f(program_.uniform(multi, "u_texel"), 2.0f / static_cast<float>(size_));
+    ProgramPair& program = programs_.get(ctx.scene);
+    glUseProgram(program.get(multi));
+    glUniform1i(program.uniform(multi, "u_point_count"), count);
+    glUniform1f(program.uniform(multi, "u_far"), far_);
+    glUniform1f(program.uniform(multi, "u_texel"), 2.0f / static_cast<float>(size_));
     const Medium* global = ctx.scene.global_medium();
-    glUniform1f(program_.uniform(multi, "u_sigma_t"),
+    glUniform1f(program.uniform(multi, "u_sigma_t"),
                 global ? static_cast<float>(global->sigma_t()) : 0.0f);
-    const GLint region_eye = set_medium_regions(program_, multi, ctx.scene);
-    glUniform1i(program_.uniform(multi, "u_count"), res.analytic_count());
+    const GLint region_eye = set_medium_regions(program, multi, ctx.scene);
+    glUniform1i(program.uniform(multi, "u_count"), res.analytic_count());
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
     glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
@@ -267,7 +268,7 @@ class DirectPass final : public Pass {
     glDisable(GL_CULL_FACE);
     glBindVertexArray(ctx.empty_vao);
     int view = 0;
-    for_each_view_offset(ctx, self, program_, "u_point_offset", res.direct_anchor(), [&] {
+    for_each_view_offset(ctx, self, program, "u_point_offset", res.direct_anchor(), [&] {
       set_region_eye(ctx, region_eye, view++);
       glDrawArrays(GL_TRIANGLES, 0, 3);
     });
@@ -341,7 +342,7 @@ class DirectPass final : public Pass {
     gl_check("direct pass: shadow maps");
   }
 
-  ProgramPair program_;
+  RegionProgram programs_;
   ProgramPair shadow_;
   std::string key_;  // the SceneResources::shadow_key the maps are for
   GlTexture cubes_;  // depth cube-map array, 6 layers per direct point
@@ -494,7 +495,7 @@ class PhotonPass final : public Pass {
 class BeamPass final : public Pass {
  public:
   BeamPass()
-      : plain_("beam") {}
+      : plain_("beam"), fogged_("beam_medium") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
     // Scenes with a medium use the program with it compiled in (built on
@@ -502,8 +503,7 @@ class BeamPass final : public Pass {
     const bool fog = ctx.scene.has_medium();
     const Medium settings = ctx.scene.medium.value_or(Medium{});
     const Medium* medium = fog ? &settings : nullptr;
-    if (medium && !fogged_) fogged_.emplace("beam_medium");
-    ProgramPair& program = medium ? *fogged_ : plain_;
+    ProgramPair& program = medium ? fogged_.get(ctx.scene) : plain_;
     glUseProgram(program.get(multi));
     glUniform3i(program.uniform(multi, "u_table_size"), ctx.resources.table_d(),
                 ctx.resources.table_s(), ctx.resources.table_f());
@@ -565,7 +565,7 @@ class BeamPass final : public Pass {
 
  private:
   ProgramPair plain_;
-  std::optional<ProgramPair> fogged_;
+  RegionProgram fogged_;
 };
 
 // HDR -> display values in the output's bit depth.

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -120,6 +121,23 @@ class ProgramPair {
   }
   std::string name_;
   GlProgram single_, multi_;
+};
+
+// A program and its "<name>_regions" variant (shaders/medium_regions.glsl
+// compiled in, for scenes with regions of medium; built on first use).
+class RegionProgram {
+ public:
+  explicit RegionProgram(std::string name) : plain_(name), name_(std::move(name)) {}
+  ProgramPair& get(const Scene& scene) {
+    if (scene.media.empty()) return plain_;
+    if (!regions_) regions_.emplace(name_ + "_regions");
+    return *regions_;
+  }
+
+ private:
+  ProgramPair plain_;
+  std::string name_;
+  std::optional<ProgramPair> regions_;
 };
 
 // Issues `draw` into `fbo(view)` once per view of a multi-view batch (with

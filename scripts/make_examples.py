@@ -256,6 +256,15 @@ def main():
     write("fog_stage.json", stage)
     # Its fig 5.9: heterogeneous fog, a dense layer near the floor (a box
     # region of medium) under the thin fog of the stage.
+    # Glowing beams that light the fog around them (issue 15, item 4): the
+    # stage without its spot, an emitting capsule and sphere in the fog.
+    glow = dict(stage, beams=[
+        {"type": "capsule", "p0": [0.6, 0.3, 0.8], "p1": [0.6, 3.6, 0.8], "radius": 0.25,
+         "color": [1.0, 0.55, 0.2], "intensity": 12.0, "density": "quadratic", "emit": True},
+        {"type": "sphere", "center": [-2.2, 2.6, -1.0], "radius": 0.5, "color": [0.3, 0.55, 1.0],
+         "intensity": 15.0, "density": {"type": "gaussian", "sigma": 0.4}, "emit": True}])
+    del glow["lights"]
+    write("beam_fog.json", glow)
     write("ground_fog.json", dict(stage, media=[
         {"type": "box", "min": [-5.0, 0.0, -5.0], "max": [5.0, 0.8, 5.0],
          "sigma_s": 0.6, "sigma_a": 0.05, "g": 0.3}]))

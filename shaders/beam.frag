@@ -202,15 +202,13 @@ void main() {
       e += sphere_energy(ray.origin, ray.dir, p0 + len * w, r, sa, sb);
     }
   }
-#ifdef BEAMCAST_MEDIUM
+#ifdef BEAMCAST_MEDIUM_REGIONS
   // Regions of medium (medium_regions.glsl): their optical depth to the
   // ray's point nearest the beam's centre (the scene-wide medium is exact,
   // in medium_piece; the regions' variation across the beam is not).
-  if (u_region_count > 0) {
-    vec3 centre = b.caps_kind.z < 0.5 ? p0 : p0 + 0.5 * b.axis_length.w * b.axis_length.xyz;
-    float tm = clamp(dot(centre - ray.origin, ray.dir), t0, t1);
-    e *= exp(-region_depth(ray.origin, ray.dir, 0.0, tm));
-  }
+  vec3 centre = b.caps_kind.z < 0.5 ? p0 : p0 + 0.5 * b.axis_length.w * b.axis_length.xyz;
+  float tm = clamp(dot(centre - ray.origin, ray.dir), t0, t1);
+  e *= exp(-region_depth(ray.origin, ray.dir, 0.0, tm));
 #endif
   out_energy = vec4(b.color_layer.rgb * max(e, 0.0), 0.0);
 }

@@ -87,9 +87,11 @@ void main() {
     float visible = texture(u_shadows, vec4(v, float(i)), (length(v) - 0.5 * foot) / u_far);
     if (visible <= 0.0) continue;
     if (u_count > 0 && analytic_blocked(x + (1e-4 * dist) * n, l, dist)) continue;
-    float transmitted = u_sigma_t > 0.0 || u_region_count > 0
-                            ? exp(-(u_sigma_t * dist + region_depth(x, l, 0.0, dist)))
-                            : 1.0;
+#ifdef BEAMCAST_MEDIUM_REGIONS
+    float transmitted = exp(-(u_sigma_t * dist + region_depth(x, l, 0.0, dist)));
+#else
+    float transmitted = u_sigma_t > 0.0 ? exp(-u_sigma_t * dist) : 1.0;
+#endif
     e += p.flux.rgb * (angular * cos_x * visible * transmitted / d2);
   }
   out_color = vec4(albedo.rgb / kPi * e, 0.0);

@@ -20,7 +20,11 @@ uniform float u_lod_far;
 flat out vec3 v_center;  // camera-relative
 flat out vec3 v_power;
 flat out vec3 v_normal;
-flat out vec2 v_extra;  // position.w and normal.w (volume photons: local k and sigma_t)
+flat out vec2 v_extra;
+flat out float v_radius;  // the photon's kernel radius (u_radius, capped by u_radius_pixels)
+// Volume photons (medium.radius_pixels): the kernel's radius on screen at
+// most this many pixels (0: no cap).
+uniform float u_radius_pixels;  // position.w and normal.w (volume photons: local k and sigma_t)
 
 // The LOD weight of photon `index` at camera-relative position c: the share
 // Q of the groups dropped at its distance (smoothstep(near, far, D), or
@@ -61,10 +65,18 @@ void main() {
   // quad in its centre's plane facing the camera covers that cone with half
   // size r D / sqrt(D^2 - r^2) (here along the view axis, the worst case
   // for screen-aligned axes is within the same bound for the pixels it needs).
-  float s = u_radius;
+  float radius = u_radius;
+  if (u_radius_pixels > 0.0) {
+    // World size of a pixel at the photon's view depth.
+    float half_height = is_orthographic() ? cam.cam_right.w
+                                          : max(dot(c, cam.cam_forward.xyz), 0.0) * cam.cam_right.w;
+    radius = min(radius, max(u_radius_pixels * 2.0 * half_height / cam.viewport.y, 1e-6 * radius));
+  }
+  v_radius = radius;
+  float s = radius;
   if (!is_orthographic()) {
     float d2 = dot(c, c);
-    s = u_radius * sqrt(d2 / max(d2 - u_radius * u_radius, 0.01 * d2));
+    s = radius * sqrt(d2 / max(d2 - radius * radius, 0.01 * d2));
   }
   vec3 corner = c + s * (k.x * cam.cam_right.xyz + k.y * cam.cam_up.xyz);
   gl_Position = cam.view_proj * vec4(corner, 1.0);

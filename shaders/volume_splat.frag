@@ -1,7 +1,8 @@
 // In-scattered light from the volume photons (pass "volume_photons",
 // render/medium_pass.hpp). Each photon, stored where it scattered with the
 // power it arrived with and its travel direction, adds to the pixel whose
-// ray passes within the kernel radius r of it
+// ray passes within the kernel radius r of it (medium.radius, or less near
+// the camera with medium.radius_pixels)
 //   p(mu) power K,   mu = dot(travel, -ray.dir) (gi/phase.hpp's convention),
 // the light scattered towards the eye, with K the kernel's weight along the
 // visible part of the ray [t0, t1] (near plane to nearest surface):
@@ -15,7 +16,7 @@
 // surfaces; they differ where the kernel meets a surface or the near plane.
 layout(binding = 0) uniform VIEW_SAMPLER u_view_depth;  // surfaces' view depth (huge: none)
 uniform int u_has_surfaces;
-uniform float u_radius;
+flat in float v_radius;  // the photon's kernel radius (photon_splat.vert)
 uniform float u_sigma_t;  // the scene-wide medium's (regions: medium_regions.glsl)
 uniform int u_estimator;
 
@@ -35,7 +36,7 @@ void main() {
   float tc = dot(to_c, ray.dir);
   vec3 perp = to_c - tc * ray.dir;
   float d2 = dot(perp, perp);
-  float r2 = u_radius * u_radius;
+  float r2 = v_radius * v_radius;
   if (d2 >= r2) discard;
   float t0 = ray.t_min;
   float t1 = ray.t_max;
@@ -57,7 +58,7 @@ void main() {
     // (e^(-s a) - e^(-s b)) / s = e^(-s a) (b - a) (1 - e^-x) / x; its series where x is small.
     float ratio = x < 1e-3 ? 1.0 - 0.5 * x : (1.0 - exp(-x)) / x;
     w = exp(-(u_sigma_t * a + region_depth(ray.origin, ray.dir, 0.0, a))) * (b - a) * ratio /
-        (4.0 / 3.0 * kPi * r2 * u_radius);
+        (4.0 / 3.0 * kPi * r2 * v_radius);
   }
   float k = v_extra.x;
   float mu = dot(v_normal, -ray.dir);

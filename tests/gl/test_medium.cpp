@@ -3,13 +3,16 @@
 // each ray by adaptive quadrature in double (render/reference.hpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
+#include "render/pass_plan.hpp"
 #include "render/reference.hpp"
 #include "render/renderer.hpp"
 
@@ -212,6 +215,21 @@ TEST(Medium, RegionsAttenuateSurfacesExactlyAndBeamsClosely) {
   std::printf("regions: surfaces rel L1 %.2e, with beams %.2e\n", e.rel_l1, b.rel_l1);
   EXPECT_EQ(b.nonfinite, 0);
   EXPECT_LT(b.rel_l1, 0.02);
+}
+
+// examples/beam_fog.json: glowing beams that emit light into the fog (their
+// photons scatter in it like a lamp's): the volume photon pass runs, and the
+// frame's mean matches the path tracer's (its beams added on top, as the
+// GPU's) within 5%, the bound of the stage above.
+TEST(Medium, EmittingBeamsLightTheFogAroundThem) {
+  const Scene scene = example_at("beam_fog.json", 48);
+  const std::vector<std::string> passes = plan_passes(scene);
+  EXPECT_NE(std::find(passes.begin(), passes.end(), "volume_photons"), passes.end());
+  const double want = image_mean(path_traced(scene));
+  const double got =
+      image_mean(renderer().render(scene, FrameOptions{.read_hdr = true})[0].hdr);
+  std::printf("beam fog: mean ratio %.4f\n", got / want);
+  EXPECT_NEAR(got / want, 1.0, 0.05);
 }
 
 // examples/ground_fog.json (the seed's fig 5.9: a dense layer of fog on the

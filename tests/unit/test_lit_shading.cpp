@@ -4,6 +4,8 @@
 // glass followed, no sampling).
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "gi/gi_scene.hpp"
 #include "gi/photon_gather.hpp"
 #include "gi/photon_map.hpp"
@@ -82,6 +84,25 @@ TEST(LitShading, ADiffuseWallInAMirrorLooksAsItDoesDirectly) {
   const Color mirrored = shading.trace({0.0, 2.0, 0.0}, normalize(Vec3{1.0, -2.0, 0.0}), 0.0, 1e9);
   ASSERT_GT(direct[0], 0.0);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(mirrored[k], 0.5 * direct[k], 1e-9 * direct[k]) << k;
+}
+
+// In a medium (issue 15) the segment beyond the mirror is attenuated: the
+// light in the mirror of AMirrorShowsTheLightTimesItsReflectance, times
+// e^(-sigma_t d), d = the distance from the mirror point to the light's
+// centre, sqrt(8) (the camera's own segment is the medium pass's, not
+// LitShading's).
+TEST(LitShading, BeyondAMirrorTheMediumAttenuates) {
+  const Color L{1.0, 2.0, 3.0}, reflectance{0.9, 0.5, 0.25};
+  Scene scene = test::mirror_floor_and_light(L, reflectance);
+  const Vec3 o{-2.0, 2.0, 0.0}, d = normalize(Vec3{1.0, -1.0, 0.0});
+  const Color clear = trace_in(scene, o, d);
+  scene.medium = Medium{.sigma_a = 0.2};
+  const Color fogged = trace_in(scene, o, d);
+  const double t = std::exp(-0.2 * std::sqrt(8.0));
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_GT(clear[k], 0.0);
+    EXPECT_NEAR(fogged[k], t * clear[k], 1e-12 * clear[k]) << k;
+  }
 }
 
 }  // namespace
