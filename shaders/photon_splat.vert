@@ -20,11 +20,16 @@ uniform float u_lod_far;
 flat out vec3 v_center;  // camera-relative
 flat out vec3 v_power;
 flat out vec3 v_normal;
-flat out vec2 v_extra;
-flat out float v_radius;  // the photon's kernel radius (u_radius, capped by u_radius_pixels)
-// Volume photons (medium.radius_pixels): the kernel's radius on screen at
-// most this many pixels (0: no cap).
-uniform float u_radius_pixels;  // position.w and normal.w (volume photons: local k and sigma_t)
+#ifdef BEAMCAST_VOLUME_PHOTONS
+// Volume photons only (program "volume_splat", prelude volume_photons_on.glsl;
+// the surface photons' program stays without these outputs, which cost
+// llvmpipe ~5% of a lit frame):
+flat out vec2 v_extra;    // position.w and normal.w: the local k and sigma_t
+flat out float v_radius;  // the kernel radius (u_radius, capped by u_radius_pixels)
+// medium.radius_pixels: the kernel's radius on screen at most this many
+// pixels (0: no cap).
+uniform float u_radius_pixels;
+#endif
 
 // The LOD weight of photon `index` at camera-relative position c: the share
 // Q of the groups dropped at its distance (smoothstep(near, far, D), or
@@ -47,7 +52,9 @@ void main() {
   PhotonData p = photons[gl_InstanceID + u_first];
   vec3 c = p.position.xyz + u_photon_offset;
   v_center = c;
+#ifdef BEAMCAST_VOLUME_PHOTONS
   v_extra = vec2(p.position.w, p.normal.w);
+#endif
   float lod = lod_weight(c, gl_InstanceID + u_first);
   if (lod <= 0.0) {  // dropped: a degenerate quad outside the clip volume
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
@@ -66,6 +73,7 @@ void main() {
   // size r D / sqrt(D^2 - r^2) (here along the view axis, the worst case
   // for screen-aligned axes is within the same bound for the pixels it needs).
   float radius = u_radius;
+#ifdef BEAMCAST_VOLUME_PHOTONS
   if (u_radius_pixels > 0.0) {
     // World size of a pixel at the photon's view depth.
     float half_height = is_orthographic() ? cam.cam_right.w
@@ -73,6 +81,7 @@ void main() {
     radius = min(radius, max(u_radius_pixels * 2.0 * half_height / cam.viewport.y, 1e-6 * radius));
   }
   v_radius = radius;
+#endif
   float s = radius;
   if (!is_orthographic()) {
     float d2 = dot(c, c);
