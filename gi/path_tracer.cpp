@@ -37,7 +37,8 @@ std::uint64_t mix64(std::uint64_t x) {
 // probabilities for next-event estimation.
 class Tracer {
  public:
-  Tracer(const GiScene& gi, const PathTraceOptions& opts) : gi_(gi), opts_(opts) {
+  Tracer(const GiScene& gi, const PathTraceOptions& opts)
+      : gi_(gi), opts_(opts), medium_(gi.scene().medium_field()) {
     const Scene& s = gi.scene();
     // One light per diffuse hit, picked in proportion to its flux luminance
     // (uniformly when every flux is black).
@@ -56,7 +57,7 @@ class Tracer {
     Color L{0.0, 0.0, 0.0};
     Color beta{1.0, 1.0, 1.0};  // path throughput
     bool specular = true;       // camera ray or last bounce specular: emission and background count
-    const MediumField medium = scene.medium_field();
+    const MediumField& medium = medium_;
     for (int depth = 0; depth < opts_.max_depth; ++depth) {
       const std::optional<SurfaceHit> hit = gi_.intersect(o, v, t_min, t_max);
       if (!medium.empty()) {
@@ -213,12 +214,12 @@ class Tracer {
 
   // e^(-optical depth) of the scene's medium along x + t l, t in [0, d] (1 without one).
   double transmittance(const Vec3& x, const Vec3& l, double d) const {
-    const Scene& scene = gi_.scene();
-    return scene.has_medium() ? std::exp(-scene.medium_field().optical_depth(x, l, 0.0, d)) : 1.0;
+    return medium_.empty() ? 1.0 : std::exp(-medium_.optical_depth(x, l, 0.0, d));
   }
 
   const GiScene& gi_;
   const PathTraceOptions& opts_;
+  MediumField medium_;  // the scene's medium (empty without one)
   std::vector<double> pick_;
 };
 

@@ -21,10 +21,7 @@ class MediumPass final : public Pass {
     glUseProgram(program.get(multi));
     const bool surfaces = ctx.plan.written("view_depth");
     glUniform1i(program.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
-    const Medium* global = ctx.scene.global_medium();
-    glUniform1f(program.uniform(multi, "u_sigma_t"),
-                global ? static_cast<float>(global->sigma_t()) : 0.0f);
-    const GLint region_eye = set_medium_regions(program, multi, ctx.scene);
+    const GLint region_eye = set_medium_uniforms(program, multi, ctx.scene);
     glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ZERO, GL_SRC_COLOR);  // hdr *= transmittance
@@ -54,7 +51,6 @@ class VolumePhotonPass final : public Pass {
   void execute(FrameContext& ctx, const PassDecl& self) override {
     if (!ctx.scene.has_medium()) throw GlError("volume photon pass: the scene has no medium");
     const Medium medium = ctx.scene.medium.value_or(Medium{});
-    const Medium* global = ctx.scene.global_medium();
     const double share = display_share(ctx.scene.gi.display_fraction);
     const auto count = static_cast<GLsizei>(
         std::llround(share * static_cast<double>(ctx.resources.volume_count())));
@@ -68,9 +64,7 @@ class VolumePhotonPass final : public Pass {
                 static_cast<float>(ctx.resources.volume_radius()));
     glUniform1f(program.uniform(multi, "u_radius_pixels"),
                 static_cast<float>(medium.radius_pixels));
-    glUniform1f(program.uniform(multi, "u_sigma_t"),
-                global ? static_cast<float>(global->sigma_t()) : 0.0f);
-    const GLint region_eye = set_medium_regions(program, multi, ctx.scene);
+    const GLint region_eye = set_medium_uniforms(program, multi, ctx.scene);
     glUniform1i(program.uniform(multi, "u_estimator"),
                 medium.estimator == VolumeEstimator::kSeed ? 1 : 0);
     glUniform1i(program.uniform(multi, "u_first"), 0);

@@ -250,10 +250,7 @@ class DirectPass final : public Pass {
     glUniform1i(program.uniform(multi, "u_point_count"), count);
     glUniform1f(program.uniform(multi, "u_far"), far_);
     glUniform1f(program.uniform(multi, "u_texel"), 2.0f / static_cast<float>(size_));
-    const Medium* global = ctx.scene.global_medium();
-    glUniform1f(program.uniform(multi, "u_sigma_t"),
-                global ? static_cast<float>(global->sigma_t()) : 0.0f);
-    const GLint region_eye = set_medium_regions(program, multi, ctx.scene);
+    const GLint region_eye = set_medium_uniforms(program, multi, ctx.scene);
     glUniform1i(program.uniform(multi, "u_count"), res.analytic_count());
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
@@ -514,10 +511,7 @@ class BeamPass final : public Pass {
     const RenderSettings& rs = ctx.scene.render;
     GLint region_eye = -1;
     if (medium) {
-      const Medium* global = ctx.scene.global_medium();
-      glUniform1f(program.uniform(multi, "u_sigma_t"),
-                  global ? static_cast<float>(global->sigma_t()) : 0.0f);
-      region_eye = set_medium_regions(program, multi, ctx.scene);
+      region_eye = set_medium_uniforms(program, multi, ctx.scene);
       glUniform1f(program.uniform(multi, "u_medium_step"),
                   static_cast<float>(medium->beam_step));
       glUniform1i(program.uniform(multi, "u_medium_rule"),
@@ -613,7 +607,10 @@ class UpscalePass final : public Pass {
 
 }  // namespace
 
-GLint set_medium_regions(ProgramPair& program, bool multiview, const Scene& scene) {
+GLint set_medium_uniforms(ProgramPair& program, bool multiview, const Scene& scene) {
+  const Medium* global = scene.global_medium();
+  glUniform1f(program.uniform(multiview, "u_sigma_t"),
+              global ? static_cast<float>(global->sigma_t()) : 0.0f);
   const int n = std::min<int>(static_cast<int>(scene.media.size()), kMaxMediumRegions);
   std::array<float, 4 * kMaxMediumRegions> a{}, b{};
   for (int i = 0; i < n; ++i) {
