@@ -79,10 +79,12 @@ void encode_table(Renderer& renderer, const Scene& scene, int rounds) {
   }
 }
 
-void level_table(Renderer& renderer, const Scene& scene, const std::string& name, int rounds) {
+void level_table(Renderer& renderer, const Scene& scene, const std::string& name, int rounds,
+                 bool lod) {
   Camera cam = scene.cameras[0];
   cam.width = cam.height = 512;
-  const auto ladder = make_accuracy_ladder(scene.render, scene.has_gi());
+  const auto ladder =
+      lod ? preview_ladder(scene) : make_accuracy_ladder(scene.render, scene.has_gi());
   const Image full = renderer.render(scene, {cam})[0].image;
   struct Row {
     std::vector<double> render_ms, encode_ms, readback_ms;
@@ -94,8 +96,7 @@ void level_table(Renderer& renderer, const Scene& scene, const std::string& name
   for (int r = 0; r < rounds + 1; ++r) {
     for (std::size_t l = 0; l < ladder.size(); ++l) {
       Scene s = scene;
-      s.render = ladder[l].render;
-      s.gi.display_fraction = ladder[l].photon_fraction;
+      apply_accuracy_level(ladder[l], &s);
       FrameOptions fo;
       fo.resolution_scale = ladder[l].scale;
       auto t = Clock::now();
@@ -152,9 +153,10 @@ void level_table(Renderer& renderer, const Scene& scene, const std::string& name
 
 }  // namespace
 
-// beamcast_bench_preview [ROUNDS [EXAMPLE]]: the encoding table and the
-// controller levels of the 10-set scene, or only the levels of EXAMPLE
-// (e.g. cornell_box: a lit scene's ladder splats a quarter of the photons).
+// beamcast_bench_preview [ROUNDS [EXAMPLE [nolod]]]: the encoding table and
+// the controller levels of the 10-set scene, or only the levels of EXAMPLE
+// (e.g. cornell_box: a lit scene's ladder splats a quarter of the photons
+// and thins them by the preview's LOD; "nolod": the ladder without LOD).
 int main(int argc, char** argv) {
   const int rounds = argc > 1 ? std::max(1, std::atoi(argv[1])) : 15;
   const std::string name = argc > 2 ? argv[2] : "paper_10sets";
@@ -162,6 +164,6 @@ int main(int argc, char** argv) {
   std::printf("renderer: %s\n", renderer.description().c_str());
   const Scene scene = demo_scene(name);
   if (name == "paper_10sets") encode_table(renderer, scene, rounds);
-  level_table(renderer, scene, name, rounds);
+  level_table(renderer, scene, name, rounds, !(argc > 3 && std::string(argv[3]) == "nolod"));
   return 0;
 }

@@ -130,6 +130,10 @@ std::string photon_key(const Scene& scene) {
     k.put(r.sigma_s);
     k.put(r.sigma_a);
     k.put(r.k);
+    k.put(r.triangles.size());
+    for (const auto& t : r.triangles) {
+      for (const Vec3& p : t) k.put(p);
+    }
   }
   return k.digest();
 }

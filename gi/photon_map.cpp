@@ -14,6 +14,7 @@
 #include "gi/parallel.hpp"
 #include "gi/phase.hpp"
 #include "protocol/lights/sampling.hpp"
+#include "protocol/scene_bounds.hpp"
 
 namespace beamcast {
 namespace {
@@ -244,22 +245,6 @@ PhotonMaps trace_photons(const Scene& scene, const GiScene& surfaces,
   return maps;
 }
 
-namespace {
-
-// The bounds of the occluders (finite ones) and the lights.
-Aabb scene_box(const Scene& scene) {
-  Aabb box;
-  for (const Occluder& o : scene.occluders) {
-    const Aabb b = std::visit([](const auto& k) { return k.bounds(); }, o.shape);
-    if (std::isfinite(b.lo[0]) && std::isfinite(b.hi[0])) box.grow(b);
-  }
-  for (const Light& l : scene.lights) {
-    box.grow(std::visit([](const auto& k) { return k.bounds(); }, l.shape));
-  }
-  return box;
-}
-
-}  // namespace
 
 double default_volume_radius(const Scene& scene, std::int64_t volume_photons) {
   const Aabb box = scene_box(scene);

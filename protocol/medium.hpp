@@ -3,6 +3,8 @@
 // renderer does with it. Parsed from the scene's "medium" object.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <string_view>
 #include <vector>
 
@@ -14,6 +16,7 @@ namespace beamcast {
 namespace json_read {
 struct Node;
 }  // namespace json_read
+struct SceneLoadOptions;
 
 // k of the Schlick lobe that approximates a Henyey-Greenstein lobe of mean
 // cosine g: k = 1.55 g - 0.55 g^3 (Blasi, Le Saec and Schlick 1993). It
@@ -70,20 +73,35 @@ struct Medium {
   // (normalized to it: the estimate stays unbiased, noisier there), so each
   // photon costs at most ~4 cap^2 fragments; none is dropped.
   double radius_pixels = 0.0;
+  // The seed's S (section 5.7): the volume photons' attenuation by the
+  // regions ("media") taken not where each photon's light leaves the view
+  // ray but at the centre of the one of S equal segments of the ray's
+  // visible part that holds that point. 0: exactly there (the default).
+  // Only the regions' optical depth is quantized; the scene-wide medium's
+  // is exact either way, as in the seed's homogeneous case.
+  int segments = 0;
 
   double sigma_t() const { return sigma_s + sigma_a; }
 };
 
 // A region of heterogeneous medium (seed 001 section 5.7; "media" in JSON):
-// its own coefficients inside an axis-aligned box or a sphere, added to
-// the scene-wide medium and to any region it overlaps (the seed's fig 5.6:
-// where A and B overlap, sigma = sigma_A + sigma_B).
+// its own coefficients inside an axis-aligned box, a sphere or a closed
+// triangle mesh, added to the scene-wide medium and to any region it
+// overlaps (the seed's fig 5.6: where A and B overlap, sigma = sigma_A +
+// sigma_B).
 struct MediumRegion {
-  enum class Shape : unsigned char { kBox, kSphere };
+  enum class Shape : unsigned char { kBox, kSphere, kMesh };
   Shape shape = Shape::kBox;
-  Vec3 lo{};            // box: the low corner; sphere: the centre
-  Vec3 hi{};            // box: the high corner
+  Vec3 lo{};            // box: the low corner; sphere: the centre; mesh: its bounds' low corner
+  Vec3 hi{};            // box: the high corner; mesh: its bounds' high corner
   double radius = 0.0;  // sphere
+  // Mesh: world-space triangles of a closed, consistently wound surface,
+  // wound so their normals (p1 - p0) x (p2 - p0) point outwards. Along a
+  // line the region is where more boundaries were entered (against a
+  // normal) than left (the seed's section 5.7: front faces enter, back
+  // faces leave); a line through an edge or vertex counts one crossing
+  // there (mesh_crossings in medium.cpp).
+  std::vector<std::array<Vec3, 3>> triangles;
   double sigma_s = 0.0;
   double sigma_a = 0.0;
   double k = 0.0;
@@ -102,6 +120,11 @@ struct MediumRegion {
 
 // Regions per scene (the shaders hold them in uniform arrays of this size).
 inline constexpr int kMaxMediumRegions = 16;
+// Triangles of all mesh regions of a scene together: a shader evaluating
+// optical depth tests every triangle of each mesh whose bounds the ray
+// meets, several times per pixel, so a region boundary is a coarse hull
+// (an icosphere of 320 triangles, a box of 12), not a detailed model.
+inline constexpr std::int64_t kMaxMediumMeshTriangles = 1024;
 
 // The scene-wide medium and the regions together: coefficients at a point,
 // optical depth along a segment (exact: chords of boxes and spheres), and
@@ -135,15 +158,23 @@ inline constexpr int kMaxBeamSubPieces = 32;
 
 // The fields of "medium", for `hello`'s capabilities.
 inline constexpr std::string_view kMediumRegionFields[] = {
-    "type", "min", "max", "center", "radius", "sigma_s", "sigma_a", "k", "g"};
+    "type",     "min",      "max",       "center",    "radius",   "vertices", "triangles",
+    "file",     "translate", "scale",    "rotation",  "sigma_s",  "sigma_a",  "k",
+    "g"};
+inline constexpr std::string_view kMediumRegionTypes[] = {"box", "sphere", "mesh"};
 inline constexpr std::string_view kMediumFields[] = {
     "sigma_s", "sigma_a",   "k",      "g",
-    "beam_rule", "beam_step", "estimator", "radius", "radius_pixels"};
+    "beam_rule", "beam_step", "estimator", "radius", "radius_pixels", "segments"};
 
 // Throws ProtocolError (code, message, JSON path) for a bad field: negative
 // coefficients, |k| >= 1 or |g| > kSchlickMaxG, both k and g.
 Medium parse_medium(const json_read::Node& n);
-// One entry of "media"; `max_abs` bounds coordinates and radius.
-MediumRegion parse_medium_region(const json_read::Node& n, double max_abs);
+// One entry of "media": coordinates and radius bounded by the limits'
+// max_abs_coordinate; a mesh from an OBJ file below the options' assets
+// directory or inline (vertices, triangles), refused ("bad_mesh", with the
+// path) unless closed and consistently wound; `mesh_triangles` counts the
+// scene's mesh-region triangles against kMaxMediumMeshTriangles.
+MediumRegion parse_medium_region(const json_read::Node& n, const SceneLoadOptions& opts,
+                                 std::int64_t* mesh_triangles);
 
 }  // namespace beamcast

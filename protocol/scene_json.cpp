@@ -849,8 +849,9 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   if (auto v = o.optional("slim")) scene.slim = parse_slim_settings(*v);
   if (auto v = o.optional("medium")) scene.medium = parse_medium(*v);
   if (auto v = o.optional("media")) {
+    std::int64_t mesh_triangles = 0;
     for (const Node& r : read_array(*v, kMaxMediumRegions, "max_medium_regions")) {
-      scene.media.push_back(parse_medium_region(r, limits.max_abs_coordinate));
+      scene.media.push_back(parse_medium_region(r, opts, &mesh_triangles));
     }
   }
   if (auto v = o.optional("lights")) {
@@ -940,7 +941,8 @@ nlohmann::json scene_capabilities() {
           {"medium_beam_rules", {"gauss2", "midpoint"}},
           {"medium_region_fields", std::vector<std::string_view>(std::begin(kMediumRegionFields),
                                                                  std::end(kMediumRegionFields))},
-          {"medium_region_types", {"box", "sphere"}}};
+          {"medium_region_types", std::vector<std::string_view>(std::begin(kMediumRegionTypes),
+                                                                std::end(kMediumRegionTypes))}};
 }
 
 }  // namespace beamcast

@@ -63,4 +63,27 @@ std::array<double, 4> read_quaternion(const Node& n) {
   return q;
 }
 
+MeshTransform parse_mesh_transform(const ObjectReader& o, const SceneLimits& limits) {
+  MeshTransform xf;
+  if (auto t = o.optional("translate")) xf.translate = read_point(*t, limits);
+  if (auto s = o.optional("scale")) {
+    if (s->json().is_number()) {
+      const double v = read_number(*s);
+      xf.scale = {v, v, v};
+    } else {
+      xf.scale = read_vec3(*s);
+    }
+    // Negative factors mirror the mesh (allowed); zero flattens it (refused).
+    for (double v : xf.scale) {
+      if (!(std::abs(v) > 0.0) || std::abs(v) > limits.max_abs_coordinate) {
+        fail("out_of_range", s->path,
+             "scale factors must be nonzero with magnitude <= max_abs_coordinate, got " +
+                 format_number(v));
+      }
+    }
+  }
+  if (auto r = o.optional("rotation")) xf.rotation = read_quaternion(*r);
+  return xf;
+}
+
 }  // namespace beamcast::json_read

@@ -6,6 +6,7 @@
 #include <array>
 
 #include "protocol/json_reader.hpp"
+#include "protocol/mesh_obj.hpp"
 #include "protocol/scene_json.hpp"
 
 namespace beamcast::json_read {
@@ -24,5 +25,8 @@ Color read_color(const Node& n);
 Color read_albedo(const Node& n);
 // [w, x, y, z] with finite nonzero norm, returned normalized.
 std::array<double, 4> read_quaternion(const Node& n);
+// A mesh's "translate", "scale" (a number or three, nonzero) and "rotation"
+// (a quaternion) from its object, as occluders and medium regions give them.
+MeshTransform parse_mesh_transform(const ObjectReader& o, const SceneLimits& limits);
 
 }  // namespace beamcast::json_read

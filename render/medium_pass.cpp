@@ -21,7 +21,7 @@ class MediumPass final : public Pass {
     glUseProgram(program.get(multi));
     const bool surfaces = ctx.plan.written("view_depth");
     glUniform1i(program.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
-    const GLint region_eye = set_medium_uniforms(program, multi, ctx.scene);
+    const GLint region_eye = set_medium_uniforms(program, multi, ctx);
     glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ZERO, GL_SRC_COLOR);  // hdr *= transmittance
@@ -64,9 +64,10 @@ class VolumePhotonPass final : public Pass {
                 static_cast<float>(ctx.resources.volume_radius()));
     glUniform1f(program.uniform(multi, "u_radius_pixels"),
                 static_cast<float>(medium.radius_pixels));
-    const GLint region_eye = set_medium_uniforms(program, multi, ctx.scene);
+    const GLint region_eye = set_medium_uniforms(program, multi, ctx);
     glUniform1i(program.uniform(multi, "u_estimator"),
                 medium.estimator == VolumeEstimator::kSeed ? 1 : 0);
+    glUniform1i(program.uniform(multi, "u_segments"), medium.segments);
     glUniform1i(program.uniform(multi, "u_first"), 0);
     glUniform1f(program.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
     set_photon_lod(program, multi, ctx.scene.gi);

@@ -250,7 +250,7 @@ class DirectPass final : public Pass {
     glUniform1i(program.uniform(multi, "u_point_count"), count);
     glUniform1f(program.uniform(multi, "u_far"), far_);
     glUniform1f(program.uniform(multi, "u_texel"), 2.0f / static_cast<float>(size_));
-    const GLint region_eye = set_medium_uniforms(program, multi, ctx.scene);
+    const GLint region_eye = set_medium_uniforms(program, multi, ctx);
     glUniform1i(program.uniform(multi, "u_count"), res.analytic_count());
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
@@ -511,7 +511,7 @@ class BeamPass final : public Pass {
     const RenderSettings& rs = ctx.scene.render;
     GLint region_eye = -1;
     if (medium) {
-      region_eye = set_medium_uniforms(program, multi, ctx.scene);
+      region_eye = set_medium_uniforms(program, multi, ctx);
       glUniform1f(program.uniform(multi, "u_medium_step"),
                   static_cast<float>(medium->beam_step));
       glUniform1i(program.uniform(multi, "u_medium_rule"),
@@ -607,12 +607,15 @@ class UpscalePass final : public Pass {
 
 }  // namespace
 
-GLint set_medium_uniforms(ProgramPair& program, bool multiview, const Scene& scene) {
+GLint set_medium_uniforms(ProgramPair& program, bool multiview, const FrameContext& ctx) {
+  const Scene& scene = ctx.scene;
   const Medium* global = scene.global_medium();
   glUniform1f(program.uniform(multiview, "u_sigma_t"),
               global ? static_cast<float>(global->sigma_t()) : 0.0f);
   const int n = std::min<int>(static_cast<int>(scene.media.size()), kMaxMediumRegions);
   std::array<float, 4 * kMaxMediumRegions> a{}, b{};
+  std::array<GLint, 2 * kMaxMediumRegions> tris{};
+  GLint first = 0;
   for (int i = 0; i < n; ++i) {
     const MediumRegion& r = scene.media[static_cast<std::size_t>(i)];
     const bool sphere = r.shape == MediumRegion::Shape::kSphere;
@@ -620,13 +623,21 @@ GLint set_medium_uniforms(ProgramPair& program, bool multiview, const Scene& sce
       a[4 * i + k] = static_cast<float>(r.lo[k]);
       b[4 * i + k] = static_cast<float>(sphere ? (k == 0 ? r.radius : 0.0) : r.hi[k]);
     }
-    a[4 * i + 3] = sphere ? 1.0f : 0.0f;
+    a[4 * i + 3] = sphere ? 1.0f : (r.shape == MediumRegion::Shape::kMesh ? 2.0f : 0.0f);
     b[4 * i + 3] = static_cast<float>(r.sigma_t());
+    const auto count = static_cast<GLint>(r.triangles.size());
+    tris[2 * i] = first;
+    tris[2 * i + 1] = count;
+    first += count;
   }
   glUniform1i(program.uniform(multiview, "u_region_count"), n);
   if (n > 0) {
     glUniform4fv(program.uniform(multiview, "u_region_a"), n, a.data());
     glUniform4fv(program.uniform(multiview, "u_region_b"), n, b.data());
+  }
+  if (first > 0) {
+    glUniform2iv(program.uniform(multiview, "u_region_tris"), n, tris.data());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, ctx.resources.medium_triangle_buffer());
   }
   return program.uniform(multiview, "u_region_eye");
 }

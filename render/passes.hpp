@@ -176,9 +176,10 @@ void for_each_view_offset(FrameContext& ctx, const PassDecl& self, ProgramPair& 
 
 // The medium's uniforms: u_sigma_t (the scene-wide medium's extinction, 0
 // without one) and the regions of shaders/medium_regions.glsl (Scene::media,
-// at most kMaxMediumRegions); returns the location of u_region_eye, which
+// at most kMaxMediumRegions; mesh regions' triangles from the scene
+// resources, SSBO binding 7); returns the location of u_region_eye, which
 // each view's draw sets with set_region_eye.
-GLint set_medium_uniforms(ProgramPair& program, bool multiview, const Scene& scene);
+GLint set_medium_uniforms(ProgramPair& program, bool multiview, const FrameContext& ctx);
 // The eye of view `view` (-1 or the only view: ctx.basis.eye) into u_region_eye.
 void set_region_eye(const FrameContext& ctx, GLint location, int view);
 

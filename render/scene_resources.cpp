@@ -159,6 +159,7 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
   }
   if (plan.uploads_group("shadows")) upload_direct();
   if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene);
+  upload_medium_meshes();
   if (plan.uploads_group("specular")) {
     if (!photons)
       throw GlError("the plan traces specular rays but the renderer has no photon cache");
@@ -171,6 +172,24 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
   camera_ubo_ = GlBuffer(id);
   glNamedBufferStorage(id, sizeof(CameraBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   gl_check("create scene buffers");
+}
+
+void SceneResources::upload_medium_meshes() {
+  std::vector<float> data;
+  for (const MediumRegion& r : scene_.media) {
+    for (const auto& t : r.triangles) {
+      for (const Vec3& p : t) {
+        data.insert(data.end(), {static_cast<float>(p[0]), static_cast<float>(p[1]),
+                                 static_cast<float>(p[2]), 0.0f});
+      }
+    }
+  }
+  if (data.empty()) return;
+  GLuint id = 0;
+  glCreateBuffers(1, &id);
+  medium_tri_ssbo_ = GlBuffer(id);
+  glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(float)), data.data(), 0);
+  gl_check("upload medium meshes");
 }
 
 void SceneResources::upload_beams(TableCache& tables) {

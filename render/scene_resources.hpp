@@ -101,6 +101,10 @@ class SceneResources {
   // photon maps' search structures; null without the group.
   const GiScene* gi_scene() const { return gi_scene_.get(); }
   const PhotonGather* photon_gather() const { return photon_gather_.get(); }
+  // The mesh regions' triangles (Scene::media), world space, three vec4 per
+  // triangle in the regions' order, for shaders/medium_regions.glsl; 0
+  // without mesh regions.
+  GLuint medium_triangle_buffer() const { return medium_tri_ssbo_.get(); }
   // SLIM surfaces (group "slim"); null without them.
   SlimResources* slim() const { return slim_.get(); }
   // Time spent tracing the maps for this render (0 when they came from the
@@ -129,6 +133,8 @@ class SceneResources {
   void upload_volume_photons(PhotonCache& cache);
   void upload_direct();
   GlBuffer direct_ssbo_;
+  GlBuffer medium_tri_ssbo_;
+  void upload_medium_meshes();
   std::vector<DirectPoint> direct_points_;
   std::vector<Color> direct_flux_;  // each point's light's flux
   Vec3 direct_anchor_{};

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "protocol/scene_bounds.hpp"
+
 namespace beamcast {
 namespace {
 
@@ -27,7 +29,29 @@ std::string settings_label(const RenderSettings& r) {
 
 }  // namespace
 
-std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full, bool lit) {
+PhotonLod preview_lod(const GiSettings& gi, double scene_size) {
+  if (gi.lod_groups > 0 || !(scene_size > 0.0) || !std::isfinite(scene_size)) return {};
+  return {16, scene_size, 0.0};
+}
+
+std::vector<AccuracyLevel> preview_ladder(const Scene& scene) {
+  const Aabb box = scene_box(scene);
+  const double size = box.empty() ? 0.0 : length(box.hi - box.lo);
+  return make_accuracy_ladder(scene.render, scene.has_gi(), preview_lod(scene.gi, size));
+}
+
+void apply_accuracy_level(const AccuracyLevel& level, Scene* scene) {
+  scene->render = level.render;
+  scene->gi.display_fraction = level.photon_fraction;
+  if (level.lod.groups > 0) {
+    scene->gi.lod_groups = level.lod.groups;
+    scene->gi.lod_near = level.lod.near;
+    scene->gi.lod_far = level.lod.far;
+  }
+}
+
+std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full, bool lit,
+                                                const PhotonLod& lod) {
   // The cheap integration: a 32x32 table (the paper's size) with the chord and
   // warped layouts, which keep it accurate where g varies fastest
   // (docs/accuracy.md); a scene already at or below that keeps its own.
@@ -52,6 +76,10 @@ std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full, bool
   ladder.push_back({fast_name + "@3/4", 0.75, fast, 85, photons});
   ladder.push_back({fast_name + "@1/2", 0.5, fast, 80, photons});
   ladder.push_back({fast_name + "@1/4", 0.25, fast, 75, photons});
+  // Photon LOD last: on the fog stage it costs more error than a step of
+  // resolution at equal time (docs/media.md), so it only extends the
+  // ladder below its cheapest level.
+  if (lit && lod.groups > 0) ladder.push_back({fast_name + "+lod@1/4", 0.25, fast, 75, photons, lod});
   return ladder;
 }
 

@@ -16,6 +16,14 @@
 
 namespace beamcast {
 
+// Photon level of detail for a level (GiSettings::lod_*, seed 001 section
+// 6); 0 groups: none.
+struct PhotonLod {
+  int groups = 0;
+  double near = 0.0;
+  double far = 0.0;
+};
+
 // One rung of the ladder: how a frame is rendered.
 struct AccuracyLevel {
   std::string label;      // e.g. "full", "table32", "table32@1/2"
@@ -25,6 +33,8 @@ struct AccuracyLevel {
   // Lit scenes: the share of the cached photon maps splatted
   // (GiSettings::display_fraction; nothing is traced again).
   double photon_fraction = 1.0;
+  // Lit scenes: the photon LOD of this level (replaces the scene's gi.lod).
+  PhotonLod lod;
 };
 
 // The ladder for a scene whose full-accuracy settings are `full`, ordered from
@@ -33,8 +43,32 @@ struct AccuracyLevel {
 // of its cached photons (at 4x their power and the default radius of that
 // count) on every level below the full one: 4x fewer splats for about 2x
 // the photon noise (docs/gi.md, "Preview").
+// With `lod` (groups > 0) a lit scene's ladder ends with one level more:
+// the cheapest one thinned by that LOD as well (docs/media.md, "LOD in the
+// preview": there LOD costs more error than a resolution step at equal
+// time, so it comes last).
 inline constexpr double kPreviewPhotonFraction = 0.25;
-std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full, bool lit = false);
+std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full, bool lit = false,
+                                                const PhotonLod& lod = {});
+
+// The LOD a lit scene's preview uses while the camera moves: none when the
+// scene sets its own gi.lod (it applies to every frame already); else the
+// seed's near-photons-dropped form (near > far: Q = 1 - smoothstep(far,
+// near, d)) over the scene's size `scene_size` (its bounds' diagonal):
+// near = scene_size, far = 0, 16 groups, so a photon at distance d from
+// the eye survives with probability about smoothstep(0, scene_size, d) and
+// carries 1 / that of its power; the nearest photons, whose splats cover
+// the most pixels, go first (seed fig 6.1: about 2x frames/s).
+PhotonLod preview_lod(const GiSettings& gi, double scene_size);
+
+// make_accuracy_ladder for a scene: lit or not, with preview_lod over the
+// diagonal of its bounds (protocol/scene_bounds.hpp).
+std::vector<AccuracyLevel> preview_ladder(const Scene& scene);
+
+// The scene as `level` renders it: its integration settings, the share of
+// photons drawn and, where the level has one, its photon LOD (the
+// resolution scale is the frame's, FrameOptions::resolution_scale).
+void apply_accuracy_level(const AccuracyLevel& level, Scene* scene);
 
 struct ControllerConfig {
   double budget_ms = 33.0;  // frame-time budget while the camera moves

@@ -169,7 +169,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     if (!st.controller || st.scene_key != key) {
       ControllerConfig cfg;
       st.controller =
-          std::make_unique<AccuracyController>(make_accuracy_ladder(scene->render, scene->has_gi()), cfg);
+          std::make_unique<AccuracyController>(preview_ladder(*scene), cfg);
       st.scene_key = key;
     }
     st.controller->set_budget(q.budget_ms);
@@ -183,8 +183,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     budget_ms = q.budget_ms;
     if (decision->level != 0) {
       auto copy = std::make_shared<Scene>(*scene);
-      copy->render = level.render;
-      copy->gi.display_fraction = level.photon_fraction;
+      apply_accuracy_level(level, copy.get());
       scene = std::move(copy);
     }
   }

@@ -14,11 +14,16 @@
 //     in [t0, t1].
 // Both integrate to the same over the image plane for a photon far from
 // surfaces; they differ where the kernel meets a surface or the near plane.
+// Regions of medium: their optical depth to t_c (seed) or a (beam) is
+// exact, or with u_segments = S > 0 (medium.segments, the seed's section
+// 5.7) taken at the centre of the one of S equal segments of [0, t1] that
+// holds that point.
 layout(binding = 0) uniform VIEW_SAMPLER u_view_depth;  // surfaces' view depth (huge: none)
 uniform int u_has_surfaces;
 flat in float v_radius;  // the photon's kernel radius (photon_splat.vert)
 uniform float u_sigma_t;  // the scene-wide medium's (regions: medium_regions.glsl)
 uniform int u_estimator;
+uniform int u_segments;
 
 flat in vec3 v_center;  // camera-relative
 flat in vec3 v_power;
@@ -28,6 +33,16 @@ flat in vec2 v_extra;   // x: Schlick k at the photon; y: sigma_t at the photon
 layout(location = 0) out vec4 out_color;
 
 const float kPi = 3.14159265358979;
+
+// The regions' optical depth from the eye to t on the view ray, or to the
+// centre of t's segment of [0, t_end] (u_segments of them).
+float regions_to(ViewRay ray, float t, float t_end) {
+  if (u_segments > 0) {
+    float step = t_end / float(u_segments);
+    t = (min(floor(t / step), float(u_segments - 1)) + 0.5) * step;
+  }
+  return region_depth(ray.origin, ray.dir, 0.0, t);
+}
 
 void main() {
   select_view(view_index());
@@ -46,7 +61,7 @@ void main() {
   float w;
   if (u_estimator == 1) {
     if (tc < t0 || tc > t1) discard;
-    w = exp(-(u_sigma_t * tc + region_depth(ray.origin, ray.dir, 0.0, tc))) / (kPi * r2);
+    w = exp(-(u_sigma_t * tc + regions_to(ray, tc, t1))) / (kPi * r2);
   } else {
     float h = sqrt(r2 - d2);
     float a = max(tc - h, t0);
@@ -57,7 +72,7 @@ void main() {
     float x = v_extra.y * (b - a);
     // (e^(-s a) - e^(-s b)) / s = e^(-s a) (b - a) (1 - e^-x) / x; its series where x is small.
     float ratio = x < 1e-3 ? 1.0 - 0.5 * x : (1.0 - exp(-x)) / x;
-    w = exp(-(u_sigma_t * a + region_depth(ray.origin, ray.dir, 0.0, a))) * (b - a) * ratio /
+    w = exp(-(u_sigma_t * a + regions_to(ray, a, t1))) * (b - a) * ratio /
         (4.0 / 3.0 * kPi * r2 * v_radius);
   }
   float k = v_extra.x;

@@ -64,6 +64,42 @@ TEST(AccuracyLadder, LitScenesSplatAShareOfThePhotonsBelowFull) {
   EXPECT_EQ(unlit.size(), make_accuracy_ladder(full).size());
 }
 
+// Issue 15's LOD knob: with a preview LOD a lit scene's ladder gets one
+// level more, the cheapest level thinned by LOD too, at its end; no other
+// level has LOD, and a scene's own gi.lod (every frame has it) gets no
+// second one. apply_accuracy_level writes the level's LOD into the scene.
+TEST(AccuracyLadder, LitScenesThinTheirPhotonsByLodLast) {
+  const RenderSettings full;
+  GiSettings gi;
+  const PhotonLod lod = preview_lod(gi, 12.0);
+  EXPECT_EQ(lod.groups, 16);
+  EXPECT_EQ(lod.near, 12.0);  // near > far: the nearest photons thinned most
+  EXPECT_EQ(lod.far, 0.0);
+  const auto plain = make_accuracy_ladder(full, true);
+  const auto ladder = make_accuracy_ladder(full, true, lod);
+  ASSERT_EQ(ladder.size(), plain.size() + 1);
+  for (std::size_t i = 0; i < plain.size(); ++i) {
+    EXPECT_EQ(ladder[i].label, plain[i].label);
+    EXPECT_EQ(ladder[i].lod.groups, 0) << ladder[i].label;
+  }
+  const AccuracyLevel& last = ladder.back();
+  EXPECT_EQ(last.lod.groups, 16);
+  EXPECT_EQ(last.scale, plain.back().scale);
+  EXPECT_EQ(last.photon_fraction, plain.back().photon_fraction);
+  EXPECT_NE(last.label.find("lod"), std::string::npos) << last.label;
+  Scene scene;
+  apply_accuracy_level(last, &scene);
+  EXPECT_EQ(scene.gi.lod_groups, 16);
+  EXPECT_EQ(scene.gi.lod_near, 12.0);
+  EXPECT_EQ(scene.gi.display_fraction, kPreviewPhotonFraction);
+  apply_accuracy_level(ladder[0], &scene);  // the full level leaves gi.lod as it is
+  EXPECT_EQ(scene.gi.display_fraction, 1.0);
+  gi.lod_groups = 8;
+  EXPECT_EQ(preview_lod(gi, 12.0).groups, 0);
+  // Unlit scenes have no photons to thin.
+  EXPECT_EQ(make_accuracy_ladder(full, false, lod).size(), make_accuracy_ladder(full).size());
+}
+
 TEST(AccuracyController, FirstFrameIsFullAccuracy) {
   AccuracyController c(make_accuracy_ladder({}), {});
   const auto d = c.decide(0.0, pose(0), Motion::kInfer);

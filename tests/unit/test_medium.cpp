@@ -33,16 +33,19 @@ ErrorInfo error_of(const json& j) {
 
 TEST(Medium, ParsesCoefficientsPhaseAndKnobs) {
   const Scene s = parse_scene(fogged({{"sigma_s", 0.2}, {"sigma_a", 0.05}, {"g", 0.5},
-                                      {"beam_rule", "midpoint"}, {"beam_step", 0.5}}),
+                                      {"beam_rule", "midpoint"}, {"beam_step", 0.5},
+                                      {"segments", 8}}),
                               {});
   ASSERT_TRUE(s.medium.has_value());
   EXPECT_DOUBLE_EQ(s.medium->sigma_t(), 0.25);
   EXPECT_NEAR(s.medium->k, 0.70625, 1e-12);  // 1.55 g - 0.55 g^3 at g = 0.5
   EXPECT_EQ(s.medium->beam_rule, BeamMediumRule::kMidpoint);
   EXPECT_DOUBLE_EQ(s.medium->beam_step, 0.5);
+  EXPECT_EQ(s.medium->segments, 8);
   const Scene k = parse_scene(fogged({{"sigma_a", 1.0}, {"k", -0.3}}), {});
   EXPECT_DOUBLE_EQ(k.medium->k, -0.3);
   EXPECT_EQ(k.medium->beam_rule, BeamMediumRule::kGauss2);  // the default
+  EXPECT_EQ(k.medium->segments, 0);                         // exact
 }
 
 // The pass runs only when the medium attenuates: none, or a medium with
@@ -141,6 +144,8 @@ TEST(Medium, BadFieldsAreRefusedWithTheirPath) {
       {{{"beam_step", 0.0}}, "out_of_range", "/medium/beam_step"},
       {{{"estimator", "grid"}}, "invalid_value", "/medium/estimator"},
       {{{"radius", -1.0}}, "out_of_range", "/medium/radius"},
+      {{{"segments", 257}}, "out_of_range", "/medium/segments"},
+      {{{"segments", -1}}, "out_of_range", "/medium/segments"},
       {{{"density", 1.0}}, "unknown_field", "/medium/density"},
       {json::array(), "wrong_type", "/medium"},
   };
