@@ -1,6 +1,7 @@
 // `beamcast bench accuracy`: the accuracy/time benchmark of bench/accuracy.hpp;
 // `bench views`; `bench slim` (bench/slim_bench.hpp); `bench gi` (bench/gi_bench.py, run with this binary);
-// `bench medium` (bench/medium_bench.py, likewise), `bench medium-rule` and `bench fog` (bench/fog_bench.py).
+// `bench medium` (bench/medium_bench.py, likewise), `bench medium-rule`, `bench fog`
+// (bench/fog_bench.py) and `bench povray` (bench/povray_bench.py).
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -37,6 +38,32 @@ void run_python_bench(const std::string& script_name, const std::string& out,
   if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     throw CLI::RuntimeError(status == -1 || !WIFEXITED(status) ? 1 : WEXITSTATUS(status));
   }
+}
+
+// A subcommand NAME that runs bench/SCRIPT with --out and optional --size
+// and --spp (their defaults, stated in the help, are the script's).
+void add_size_spp_bench(CLI::App* bench, const char* name, const std::string& help,
+                        const std::string& script, int default_size, int default_spp) {
+  struct Args {
+    std::string out;
+    int size = 0, spp = 0;
+  };
+  auto opts = std::make_shared<Args>();
+  CLI::App* cmd = bench->add_subcommand(name, help);
+  cmd->add_option("--out,-o", opts->out, "Output directory (created if missing)")->required();
+  cmd->add_option("--size", opts->size,
+                  "Frame width and height (default " + std::to_string(default_size) + ")")
+      ->check(CLI::Range(16, 4096));
+  cmd->add_option("--spp", opts->spp,
+                  "Reference paths per pixel per seed (default " + std::to_string(default_spp) +
+                      ")")
+      ->check(CLI::Range(1, 1 << 20));
+  cmd->callback([opts, script] {
+    std::string extra;
+    if (opts->size > 0) extra += " --size " + std::to_string(opts->size);
+    if (opts->spp > 0) extra += " --spp " + std::to_string(opts->spp);
+    run_python_bench(script, opts->out, extra);
+  });
 }
 
 }  // namespace
@@ -181,29 +208,25 @@ void add_bench_command(CLI::App& app) {
   });
 
   // Light scattered in fog: the seed's volume estimate against the beam
-  // radiance estimate and the path tracer (bench/fog_bench.py).
-  struct FogArgs {
-    std::string out;
-    int size = 0, spp = 0;
-  };
-  auto fopts = std::make_shared<FogArgs>();
-  CLI::App* fog = bench->add_subcommand(
-      "fog",
-      "In-scattered light in a homogeneous medium on examples/fog_stage.json and a denser copy: "
-      "the seed's estimate and the beam radiance estimate against the path tracer, photon count, "
-      "GPU time; writes fog.csv, fog.md and fog.png to --out (runs bench/fog_bench.py with "
-      "/usr/bin/python3 and numpy)");
-  fog->add_option("--out,-o", fopts->out, "Output directory (created if missing)")->required();
-  fog->add_option("--size", fopts->size, "Frame width and height (default 256)")
-      ->check(CLI::Range(16, 4096));
-  fog->add_option("--spp", fopts->spp, "Reference paths per pixel per seed (default 2048)")
-      ->check(CLI::Range(1, 1 << 20));
-  fog->callback([fopts] {
-    std::string extra;
-    if (fopts->size > 0) extra += " --size " + std::to_string(fopts->size);
-    if (fopts->spp > 0) extra += " --spp " + std::to_string(fopts->spp);
-    run_python_bench("fog_bench.py", fopts->out, extra);
-  });
+  // radiance estimate and the path tracer, LOD and the seed's segments
+  // (bench/fog_bench.py).
+  add_size_spp_bench(
+      bench, "fog",
+      "In-scattered light in fog on examples/fog_stage.json, a denser copy and "
+      "examples/ground_fog.json (its layer also as a mesh region): the seed's estimate and the "
+      "beam radiance estimate against the path tracer, photon count, LOD, the seed's S view-ray "
+      "segments, GPU time; writes fog.csv, fog.md, fog.png and fog_segments.png to --out (runs "
+      "bench/fog_bench.py with /usr/bin/python3 and numpy)",
+      "fog_bench.py", 256, 2048);
+  // The Cornell box beside POV-Ray 3.7 (issue 14's peer; installed by the
+  // script, not by the tests): time and error against one reference.
+  add_size_spp_bench(
+      bench, "povray",
+      "The Cornell box beside POV-Ray 3.7 (radiosity presets; installs the povray package if "
+      "missing) and the path tracer: time and error against one path-traced reference, time to "
+      "equal error; writes povray.csv, povray.md, povray.png to --out (runs "
+      "bench/povray_bench.py with /usr/bin/python3 and numpy)",
+      "povray_bench.py", 512, 1024);
 
   // The beam rule's own error in double (render/beam_medium.hpp), as CSV on
   // stdout: what medium_bench.py plots beside the GPU's image error.

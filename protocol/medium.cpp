@@ -54,7 +54,9 @@ std::string format_point(const Vec3& p) {
 std::vector<std::array<Vec3, 3>> closed_surface(std::vector<std::array<Vec3, 3>> tris,
                                                 const std::string& path) {
   std::map<Vec3, int> ids;
-  auto id = [&](const Vec3& p) { return ids.emplace(p, static_cast<int>(ids.size())).first->second; };
+  auto id = [&](const Vec3& p) {
+    return ids.emplace(p, static_cast<int>(ids.size())).first->second;
+  };
   std::map<std::pair<int, int>, int> edges;  // directed edge -> triangles running it
   std::map<std::pair<int, int>, std::pair<Vec3, Vec3>> ends;
   std::vector<std::array<Vec3, 3>> kept;
@@ -101,8 +103,7 @@ std::vector<std::array<Vec3, 3>> closed_surface(std::vector<std::array<Vec3, 3>>
 
 std::vector<std::array<Vec3, 3>> read_mesh_region(const ObjectReader& o,
                                                   const SceneLoadOptions& opts,
-                                                  std::int64_t* mesh_triangles,
-                                                  std::string* path) {
+                                                  std::int64_t* mesh_triangles, std::string* path) {
   const auto file = o.optional("file");
   const auto verts = o.optional("vertices");
   const auto tris = o.optional("triangles");
@@ -110,7 +111,9 @@ std::vector<std::array<Vec3, 3>> read_mesh_region(const ObjectReader& o,
   const std::int64_t room = kMaxMediumMeshTriangles - *mesh_triangles;
   if (file) {
     for (const char* f : {"vertices", "triangles"}) {
-      if (auto v = o.optional(f)) fail("unknown_field", v->path, "give a mesh as file or as vertices and triangles, not both");
+      if (auto v = o.optional(f))
+        fail("unknown_field", v->path,
+             "give a mesh as file or as vertices and triangles, not both");
     }
     *path = file->path;
     const std::string name = read_string(*file);
@@ -124,7 +127,9 @@ std::vector<std::array<Vec3, 3>> read_mesh_region(const ObjectReader& o,
     }
   } else {
     for (const char* f : {"translate", "scale", "rotation"}) {
-      if (auto v = o.optional(f)) fail("unknown_field", v->path, std::string(f) + " is for meshes from a file; give inline vertices in world space");
+      if (auto v = o.optional(f))
+        fail("unknown_field", v->path,
+             std::string(f) + " is for meshes from a file; give inline vertices in world space");
     }
     if (!verts || !tris) {
       fail("missing_field", o.path_of(verts ? "triangles" : "vertices"),
@@ -132,7 +137,8 @@ std::vector<std::array<Vec3, 3>> read_mesh_region(const ObjectReader& o,
     }
     *path = tris->path;
     std::vector<Vec3> vs;
-    for (const Node& v : read_array(*verts, 3 * kMaxMediumMeshTriangles, "max_medium_mesh_triangles")) {
+    for (const Node& v :
+         read_array(*verts, 3 * kMaxMediumMeshTriangles, "max_medium_mesh_triangles")) {
       vs.push_back(check_coordinates(v, read_vec3(v), opts.limits.max_abs_coordinate));
     }
     for (const Node& t : read_array(*tris, room, "max_medium_mesh_triangles")) {
@@ -192,9 +198,11 @@ MediumRegion parse_medium_region(const Node& n, const SceneLoadOptions& opts,
     r.lo = point(o.required("center"));
     const Node rad = o.required("radius");
     r.radius = check_positive(rad, read_number(rad));
-    if (r.radius > max_abs) fail("out_of_range", rad.path, "radius must be <= " + format_number(max_abs));
+    if (r.radius > max_abs)
+      fail("out_of_range", rad.path, "radius must be <= " + format_number(max_abs));
   } else {
-    refuse({"min", "max", "center", "radius"}, " is for boxes and spheres; a mesh region has its triangles");
+    refuse({"min", "max", "center", "radius"},
+           " is for boxes and spheres; a mesh region has its triangles");
     std::string path;
     r.triangles = closed_surface(read_mesh_region(o, opts, mesh_triangles, &path), path);
     Aabb box;
@@ -248,7 +256,7 @@ void mesh_crossings(const std::vector<std::array<Vec3, 3>>& tris, const Vec3& o,
     const Vec3 p0 = tri[0] - o, p1 = tri[1] - o, p2 = tri[2] - o;
     const double e0 = triple(v, p1, p2), e1 = triple(v, p2, p0), e2 = triple(v, p0, p1);
     const double det = e0 + e1 + e2;  // v . n, n = (p1 - p0) x (p2 - p0)
-    if (det == 0.0) continue;          // the line lies in the triangle's plane
+    if (det == 0.0) continue;         // the line lies in the triangle's plane
     const bool back = det > 0.0;
     if (!edge_counts(e0, back, tri[1], tri[2]) || !edge_counts(e1, back, tri[2], tri[0]) ||
         !edge_counts(e2, back, tri[0], tri[1])) {

@@ -3,9 +3,8 @@
 // centres, and the same cube with a dent (concave).
 #pragma once
 
-#include <utility>
-
 #include <nlohmann/json.hpp>
+#include <utility>
 
 namespace beamcast::test {
 

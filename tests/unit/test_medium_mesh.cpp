@@ -64,7 +64,7 @@ TEST(MediumMesh, ACubeMeshHasTheBoxsChords) {
   for (const Vec3& v : {Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}, Vec3{-1, 0, 0}}) {
     const Vec3 o = -3.0 * v;
     EXPECT_DOUBLE_EQ(fm.optical_depth(o, v, 0.0, 6.0), 2.0) << v[0] << v[1] << v[2];
-    EXPECT_DOUBLE_EQ(fm.optical_depth(o, v, 0.0, 2.5), 0.5);  // ends inside
+    EXPECT_DOUBLE_EQ(fm.optical_depth(o, v, 0.0, 2.5), 0.5);              // ends inside
     EXPECT_DOUBLE_EQ(fm.optical_depth(Vec3{0, 0, 0}, v, 0.0, 9.0), 1.0);  // starts inside
   }
   std::mt19937 rng(7);
@@ -118,7 +118,9 @@ TEST(MediumMesh, MeshRegionsFromObjFiles) {
     for (const json& p : cube_vertices()) out << "v " << p[0] << " " << p[1] << " " << p[2] << "\n";
     int i = 0;
     for (const json& t : cube_triangles()) {
-      if (i++ != skip) out << "f " << t[0].get<int>() + 1 << " " << t[1].get<int>() + 1 << " " << t[2].get<int>() + 1 << "\n";
+      if (i++ != skip)
+        out << "f " << t[0].get<int>() + 1 << " " << t[1].get<int>() + 1 << " "
+            << t[2].get<int>() + 1 << "\n";
     }
   };
   write("cube.obj", -1);
@@ -157,13 +159,19 @@ TEST(MediumMesh, BadMeshesAreRefusedWithTheirPath) {
       {mesh_region(cube_vertices(), flat), "bad_mesh", "/media/0/triangles", "no volume"},
       {mesh_region(cube_vertices(), bad_index), "out_of_range", "/media/0/triangles/3/1", ""},
       {mesh_region(cube_vertices(), {{0, 1}}), "invalid_value", "/media/0/triangles/0", ""},
-      {{{"type", "mesh"}, {"vertices", cube_vertices()}}, "missing_field", "/media/0/triangles",
+      {{{"type", "mesh"}, {"vertices", cube_vertices()}},
+       "missing_field",
+       "/media/0/triangles",
        ""},
-      {{{"type", "mesh"}, {"file", "a.obj"}, {"vertices", cube_vertices()}}, "unknown_field",
-       "/media/0/vertices", ""},
+      {{{"type", "mesh"}, {"file", "a.obj"}, {"vertices", cube_vertices()}},
+       "unknown_field",
+       "/media/0/vertices",
+       ""},
       {{{"type", "mesh"}, {"file", "a.obj"}}, "forbidden_path", "/media/0/file", ""},
       {{{"type", "box"}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"triangles", json::array()}},
-       "unknown_field", "/media/0/triangles", ""},
+       "unknown_field",
+       "/media/0/triangles",
+       ""},
       {mesh_region({{0, 0, 1e300}}, {{0, 0, 0}}), "out_of_range", "/media/0/vertices/0/2", ""},
   };
   for (const Case& c : cases) {
