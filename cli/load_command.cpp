@@ -303,6 +303,9 @@ class Verifier {
 
 class Load;
 
+// The id of each connection's scene.put, before its renders (ids from 1).
+constexpr std::int64_t kScenePutId = -1;
+
 class Conn : public std::enable_shared_from_this<Conn> {
  public:
   Conn(Load& load, asio::io_context& io, int index, TrafficClass& cls)
@@ -354,6 +357,7 @@ class Load {
        std::vector<std::unique_ptr<TrafficClass>> cls)
       : args(a),
         scene_id(std::move(scene_id)),
+        scene_json(scene_json),
         classes(std::move(cls)),
         verifier(results, scene_json, a.scene_file, a.tolerance) {}
 
@@ -402,6 +406,7 @@ class Load {
 
   const LoadArgs& args;
   std::string scene_id;
+  json scene_json;  // stored by every connection on its server (Conn::start)
   std::vector<std::unique_ptr<TrafficClass>> classes;
   Results results;
   Verifier verifier;
@@ -516,10 +521,16 @@ void Conn::start(const tcp::resolver::results_type& endpoints) {
                                         {"method", "hello"},
                                         {"params", {{"protocol", 1}, {"token", self->load_.args.token}}}};
                           self->write(encode_frame(hello.dump()));
-                          return;  // ready once hello is answered
                         }
-                        self->ready_ = true;
-                        self->load_.on_ready(*self);
+                        // The scene on this connection's own server (behind a
+                        // load balancer each connection may reach another one;
+                        // the same content again is a no-op): ready once it is
+                        // stored.
+                        json put = {{"id", kScenePutId},
+                                    {"method", "scene.put"},
+                                    {"params",
+                                     {{"scene_id", self->load_.scene_id}, {"scene", self->load_.scene_json}}}};
+                        self->write(encode_frame(put.dump()));
                       });
 }
 
@@ -602,7 +613,8 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
   const json id = msg.value("id", json());
   const bool ok = msg.value("ok", false);
   Results& r = load_.results;
-  if (!ready_) {  // the answer to hello
+  if (!ready_) {  // the answers to hello and to the connection's scene.put
+    if (ok && msg.value("id", json()) != json(kScenePutId)) return;  // hello: wait for the put
     if (!ok) {
       std::lock_guard lock(r.mu);
       const std::string code = msg["error"].value("code", "hello_failed");

@@ -18,6 +18,7 @@ PACKAGES=(
   clang-tidy-14                                       # the clang-tidy stage of scripts/test.sh
   python3 python3-numpy python3-matplotlib            # plots and analysis scripts
   nodejs chromium                                     # the preview page's browser test (ctest -L preview)
+  haproxy                                             # several servers behind it (deploy/, ctest -L scaleout)
 )
 
 missing=()

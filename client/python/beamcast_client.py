@@ -12,9 +12,11 @@ import argparse
 import base64
 import itertools
 import json
+import random
 import socket
 import struct
 import sys
+import threading
 import time
 
 MAGIC = b"BCP1"
@@ -141,6 +143,101 @@ class BeamcastClient:
             frames.append(f)
         return frames, result
 
+
+
+class RetryBudget:
+    """Retries allowed as a share of requests (a token bucket): every request
+    earns `ratio` of a retry, a retry spends one, and at most `burst` are
+    saved up. With ratio 0.1 a failing cluster sees at most ~1.1 requests
+    for every request the callers make, not a storm of retries."""
+
+    def __init__(self, ratio=0.1, burst=10.0):
+        self.ratio, self.burst = ratio, burst
+        self.tokens = burst
+        self.lock = threading.Lock()
+
+    def on_request(self):
+        with self.lock:
+            self.tokens = min(self.burst, self.tokens + self.ratio)
+
+    def try_spend(self):
+        with self.lock:
+            if self.tokens >= 1.0 - 1e-9:  # ten requests' 0.1 sum to 0.999...
+                self.tokens -= 1.0
+                return True
+            return False
+
+
+class ResilientClient:
+    """A client for a server or a load balancer in front of several
+    (docs/deploy.md): idempotent requests (render, ping, scene.put) are sent
+    again on a new connection when the connection drops or cannot be made,
+    after an exponential backoff with full jitter (base_s x 2^attempt,
+    capped at cap_s), while the shared RetryBudget allows; a render by
+    scene_id that lands on a server without the scene (unknown_scene) puts
+    the scene again, from the content this client stored, and renders once
+    more. Counts requests, retries and re-puts. One connection at a time,
+    not thread-safe: one per thread, sharing a budget."""
+
+    RETRIABLE = (ConnectionError, OSError, socket.timeout, struct.error)
+
+    def __init__(self, host, port, timeout=60.0, budget=None, base_s=0.02, cap_s=1.0,
+                 max_attempts=5, rng=None):
+        self.host, self.port, self.timeout = host, port, timeout
+        self.budget = budget if budget is not None else RetryBudget()
+        self.base_s, self.cap_s, self.max_attempts = base_s, cap_s, max_attempts
+        self.rng = rng if rng is not None else random.Random()
+        self.client = None
+        self.scenes = {}  # scene_id -> scene, for re-puts
+        self.requests = self.retries = self.reputs = 0
+
+    def close(self):
+        if self.client:
+            self.client.close()
+            self.client = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _attempt(self, fn):
+        """fn(client) on a connection (opened if need be), with retries."""
+        self.requests += 1
+        self.budget.on_request()
+        attempt = 0
+        while True:
+            try:
+                if self.client is None:
+                    self.client = BeamcastClient(self.host, self.port, self.timeout)
+                return fn(self.client)
+            except self.RETRIABLE:
+                self.close()
+                attempt += 1
+                if attempt >= self.max_attempts or not self.budget.try_spend():
+                    raise
+                self.retries += 1
+                time.sleep(self.rng.uniform(0, min(self.cap_s, self.base_s * 2 ** attempt)))
+
+    def ping(self, payload=None):
+        return self._attempt(lambda c: c.ping(payload))
+
+    def scene_put(self, scene_id, scene):
+        self.scenes[scene_id] = scene
+        return self._attempt(lambda c: c.scene_put(scene_id, scene))
+
+    def render(self, scene=None, scene_id=None, **kw):
+        def go(c):
+            try:
+                return c.render(scene=scene, scene_id=scene_id, **kw)
+            except ServerError as e:
+                if e.code != "unknown_scene" or scene_id not in self.scenes:
+                    raise
+                self.reputs += 1
+                c.scene_put(scene_id, self.scenes[scene_id])
+                return c.render(scene_id=scene_id, **kw)
+        return self._attempt(go)
 
 def parse_server(text):
     host, sep, port = text.rpartition(":")

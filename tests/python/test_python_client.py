@@ -9,6 +9,7 @@ SIGTERM and expects exit status 0 within 15 s. Plain python3, no pytest: prints
 """
 import os
 import signal
+import socket
 import struct
 import subprocess
 import sys
@@ -16,7 +17,7 @@ import traceback
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "client", "python"))
-from beamcast_client import BeamcastClient, ServerError  # noqa: E402
+from beamcast_client import BeamcastClient, ResilientClient, RetryBudget, ServerError  # noqa: E402
 from local_server import start_server  # noqa: E402
 
 # One sphere beam seen from the front by one 64x64 camera.
@@ -90,6 +91,30 @@ def test_pipelined_by_id(c):
     assert len(binary) == msg["result"]["frames"][0]["attachment"]["length"]
 
 
+def test_resilient_client(c):
+    # ResilientClient (docs/deploy.md): a scene gone from the server is put
+    # again from the client's copy; a dropped connection is retried on a new
+    # one; the budget allows ~10% retries and a burst.
+    port = c.sock.getpeername()[1]
+    with ResilientClient("127.0.0.1", port, timeout=120) as rc:
+        rc.scene_put("resilient", TINY_SCENE)
+        c.call("scene.delete", {"scene_id": "resilient"})
+        frames, result = rc.render(scene_id="resilient")
+        check_frames(frames, result)
+        assert (rc.reputs, rc.retries) == (1, 0), (rc.reputs, rc.retries)
+        rc.client.sock.shutdown(socket.SHUT_RDWR)  # the connection drops
+        frames, result = rc.render(scene_id="resilient")
+        check_frames(frames, result)
+        assert (rc.reputs, rc.retries, rc.requests) == (1, 1, 3), (rc.reputs, rc.retries)
+    b = RetryBudget(ratio=0.1, burst=1.0)
+    assert b.try_spend() and not b.try_spend()
+    for _ in range(9):
+        b.on_request()
+    assert not b.try_spend()  # 0.9 of a retry earned
+    b.on_request()
+    assert b.try_spend()
+
+
 def main():
     if len(sys.argv) < 2:
         print(__doc__, file=sys.stderr)
@@ -97,7 +122,7 @@ def main():
     proc, port = start_server(sys.argv[1:2] + sys.argv[2:], echo=True)
     passed = failed = 0
     tests = [test_hello, test_ping, test_render_demo_binary, test_render_inline_base64,
-             test_bad_scene_names_path, test_pipelined_by_id]
+             test_bad_scene_names_path, test_pipelined_by_id, test_resilient_client]
     try:
         with BeamcastClient("127.0.0.1", port, timeout=120) as c:
             for t in tests:

@@ -1,0 +1,301 @@
+#!/usr/bin/env python3
+"""Three beamcast-servers behind HAProxy on loopback (issue 18, ctest -L scaleout).
+
+    python3 tests/python/test_scaleout.py build/bin/beamcast-server
+
+The deployment of deploy/haproxy.cfg.in, end to end: three servers on free
+loopback ports, HAProxy in front (its BCP1 port in TCP mode, health from each
+server's HTTP /health). Checks, each printed with its numbers:
+  1. all three servers come up in HAProxy and renders through it (a new
+     connection each, frames verified) reach every one of them;
+  2. four clients (client/python's ResilientClient: retries on a new
+     connection with backoff and a shared retry budget, the scene put again
+     where a server lacks it) render by scene_id for 2 s; then `kill -9` of
+     one server under that load: HAProxy marks it down within 1 s (the
+     issue's bound; inter 250 ms, fall 3, fastinter 100 ms), no request is
+     lost or fails (each frame byte-equal to the first), retries stay within
+     the budget (<= 10% of requests + its burst of 10), and the p99 latency
+     of the 2 s after the kill is printed beside the steady p99; every
+     render on a new connection after detection is answered by the others;
+  3. the server restarted on its ports: back up within 2 s (rise 2) and
+     given renders again.
+What this does not check yet (issue 18, open): the C++ client's and
+`beamcast load`'s retries, a bound on the failover p99 (measured, printed).
+Plain python3; exits 0 only if every check passed.
+"""
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.join(HERE, "..", "..")
+sys.path.insert(0, os.path.join(ROOT, "client", "python"))
+from beamcast_client import BeamcastClient, ResilientClient, RetryBudget  # noqa: E402
+
+SCENE = {
+    "beams": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "density": "linear"}],
+    "cameras": [{"name": "c", "position": [0, 0, 4], "target": [0, 0, 0],
+                 "width": 48, "height": 40}],
+}
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Cluster:
+    def __init__(self, server_bin, n, run_dir):
+        self.server_bin = server_bin
+        self.run_dir = run_dir
+        self.ports = [(free_port(), free_port()) for _ in range(n)]
+        self.procs = [None] * n
+        self.haproxy = None
+        self.bcp_port = free_port()
+
+    def start_server(self, i):
+        port, http = self.ports[i]
+        proc = subprocess.Popen(
+            [self.server_bin, "--bind", "127.0.0.1", "--port", str(port), "--http-port", str(http),
+             "--no-demo", "--quiet-requests", "--render-workers", "1"],
+            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        line = []
+        reader = threading.Thread(target=lambda: line.append(proc.stdout.readline()), daemon=True)
+        reader.start()
+        reader.join(60)
+        if not line or "listening on" not in line[0]:
+            proc.kill()
+            raise RuntimeError(f"server {i} did not start: {line}")
+        threading.Thread(target=lambda: [None for _ in proc.stdout], daemon=True).start()
+        self.procs[i] = proc
+
+    def start(self):
+        for i in range(len(self.ports)):
+            self.start_server(i)
+        bcp = "\n".join(f"  server s{i + 1} 127.0.0.1:{p} check port {h}"
+                        for i, (p, h) in enumerate(self.ports))
+        http = "\n".join(f"  server s{i + 1} 127.0.0.1:{h} check"
+                         for i, (p, h) in enumerate(self.ports))
+        with open(os.path.join(ROOT, "deploy", "haproxy.cfg.in")) as f:
+            text = f.read()
+        for k, v in {"@RUN_DIR@": self.run_dir, "@BIND@": "127.0.0.1",
+                     "@BCP_PORT@": str(self.bcp_port), "@HTTP_PORT@": str(free_port()),
+                     "@BCP_SERVERS@": bcp, "@HTTP_SERVERS@": http}.items():
+            text = text.replace(k, v)
+        cfg = os.path.join(self.run_dir, "haproxy.cfg")
+        with open(cfg, "w") as f:
+            f.write(text)
+        check = subprocess.run(["haproxy", "-c", "-f", cfg], capture_output=True, text=True)
+        if check.returncode != 0:
+            raise RuntimeError("haproxy -c refused the configuration:\n" + check.stdout +
+                               check.stderr)
+        self.haproxy = subprocess.Popen(["haproxy", "-f", cfg, "-db"],
+                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def stat(self):
+        """{server name: (status, total sessions)} of the BCP1 backend, from `show stat`."""
+        with socket.socket(socket.AF_UNIX) as s:
+            s.settimeout(2)
+            s.connect(os.path.join(self.run_dir, "haproxy.sock"))
+            s.sendall(b"show stat\n")
+            data = b""
+            while True:
+                chunk = s.recv(65536)
+                if not chunk:
+                    break
+                data += chunk
+        lines = data.decode().splitlines()
+        head = lines[0].lstrip("# ").split(",")
+        out = {}
+        for line in lines[1:]:
+            row = dict(zip(head, line.split(",")))
+            if row.get("pxname") == "beamcast_bcp1" and row.get("svname", "").startswith("s"):
+                out[row["svname"]] = (row["status"], int(row["stot"] or 0))
+        return out
+
+    def wait_status(self, name, want, timeout):
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < timeout:
+            try:
+                if self.stat().get(name, ("", 0))[0].startswith(want):
+                    return time.monotonic() - t0
+            except OSError:
+                pass
+            time.sleep(0.01)
+        return None
+
+    def stop(self):
+        for p in self.procs + [self.haproxy]:
+            if p and p.poll() is None:
+                p.terminate()
+        for p in self.procs + [self.haproxy]:
+            if p:
+                try:
+                    p.wait(timeout=30)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+
+
+def render_through(port):
+    with BeamcastClient("127.0.0.1", port, timeout=30) as c:
+        frames, result = c.render(scene=SCENE)
+    png = frames[0]["png"]
+    assert png[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    assert png[16:24] == (48).to_bytes(4, "big") + (40).to_bytes(4, "big"), "wrong size"
+    return result
+
+
+def percentile(values, q):
+    v = sorted(values)
+    return v[min(len(v) - 1, int(q * len(v)))] if v else float("nan")
+
+
+class Load:
+    """`threads` closed-loop clients (ResilientClient, one shared RetryBudget)
+    rendering SCENE by scene_id through the balancer; each frame is compared
+    byte for byte with the first (the same pose renders the same PNG on any
+    server of one build). Latencies are kept with their end time."""
+
+    def __init__(self, port, threads):
+        self.port, self.budget = port, RetryBudget()
+        self.stop = threading.Event()
+        self.lock = threading.Lock()
+        self.samples = []  # (end time, ms)
+        self.failures, self.mismatches = [], 0
+        self.reference = None
+        self.clients = [ResilientClient("127.0.0.1", port, timeout=30, budget=self.budget,
+                                        rng=__import__("random").Random(i))
+                        for i in range(threads)]
+        self.threads = [threading.Thread(target=self.run, args=(c, f"scaleout-{i}"), daemon=True)
+                        for i, c in enumerate(self.clients)]
+
+    def run(self, client, scene_id):
+        # Each client its own scene id: one that reconnects to another server
+        # finds no scene there (unknown_scene) and puts it again.
+        try:
+            client.scene_put(scene_id, SCENE)
+        except Exception as e:  # noqa: BLE001 - counted and reported
+            with self.lock:
+                self.failures.append(repr(e))
+            return
+        while not self.stop.is_set():
+            t0 = time.monotonic()
+            try:
+                frames, _ = client.render(scene_id=scene_id)
+            except Exception as e:  # noqa: BLE001 - counted and reported
+                with self.lock:
+                    self.failures.append(repr(e))
+                continue
+            t1 = time.monotonic()
+            with self.lock:
+                if self.reference is None:
+                    self.reference = frames[0]["png"]
+                elif frames[0]["png"] != self.reference:
+                    self.mismatches += 1
+                self.samples.append((t1, (t1 - t0) * 1000.0))
+
+    def start(self):
+        for t in self.threads:
+            t.start()
+
+    def finish(self):
+        self.stop.set()
+        for t in self.threads:
+            t.join(60)
+        for c in self.clients:
+            c.close()
+
+    def between(self, t0, t1):
+        with self.lock:
+            return [ms for t, ms in self.samples if t0 <= t < t1]
+
+    def totals(self):
+        return (sum(c.requests for c in self.clients), sum(c.retries for c in self.clients),
+                sum(c.reputs for c in self.clients))
+
+
+def main():
+    server_bin = sys.argv[1]
+    failed = []
+
+    def check(name, ok, detail):
+        print(("PASS " if ok else "FAIL ") + name + ": " + detail, flush=True)
+        if not ok:
+            failed.append(name)
+
+    with tempfile.TemporaryDirectory() as run_dir:
+        cluster = Cluster(server_bin, 3, run_dir)
+        try:
+            cluster.start()
+            up = [cluster.wait_status(f"s{i}", "UP", 10) for i in (1, 2, 3)]
+            check("all servers up", all(t is not None for t in up), f"after {up} s")
+            for _ in range(30):
+                render_through(cluster.bcp_port)
+            sessions = {k: v[1] for k, v in cluster.stat().items()}
+            check("renders reach every server", all(v > 0 for v in sessions.values()),
+                  f"sessions per server {sessions} for 30 renders")
+
+            # Steady load for 2 s, then server 2 killed under it for 2 s more.
+            load = Load(cluster.bcp_port, 4)
+            load.start()
+            time.sleep(2.0)
+            t_kill = time.monotonic()
+            cluster.procs[1].kill()  # kill -9
+            detect = cluster.wait_status("s2", "DOWN", 5)
+            time.sleep(max(0.0, t_kill + 2.0 - time.monotonic()))
+            load.finish()
+            steady = load.between(t_kill - 1.5, t_kill)
+            failover = load.between(t_kill, t_kill + 2.0)
+            requests, retries, reputs = load.totals()
+            check("a killed server is marked down within 1 s",
+                  detect is not None and detect <= 1.0, f"{detect} s")
+            check("no request lost or failed under failover",
+                  not load.failures and load.mismatches == 0 and retries > 0 and reputs > 0,
+                  f"{len(load.samples)} renders answered, {len(load.failures)} failed "
+                  f"{load.failures[:3]}, {load.mismatches} frames not the reference's; "
+                  f"{retries} retries and {reputs} scene re-puts for {requests} requests")
+            check("retries within the budget", retries <= 0.1 * requests + 10,
+                  f"{retries} retries / {requests} requests "
+                  f"(amplification {(requests + retries) / max(1, requests):.3f})")
+            p99s, p99f = percentile(steady, 0.99), percentile(failover, 0.99)
+            print(f"  latency: steady p50 {percentile(steady, 0.5):.1f} ms p99 {p99s:.1f} ms "
+                  f"({len(steady)} renders); failover p50 {percentile(failover, 0.5):.1f} ms "
+                  f"p99 {p99f:.1f} ms ({len(failover)} renders): ratio {p99f / p99s:.2f}",
+                  flush=True)
+            before = cluster.stat()["s2"][1]
+            errors = 0
+            for _ in range(30):
+                try:
+                    render_through(cluster.bcp_port)
+                except Exception as e:  # noqa: BLE001 - counted and reported
+                    errors += 1
+                    print("  render failed:", e)
+            check("renders after detection all answered", errors == 0,
+                  f"{30 - errors} / 30 correct frames, none sent to the dead server "
+                  f"({cluster.stat()['s2'][1] - before} sessions to it)")
+
+            t0 = time.monotonic()
+            cluster.start_server(1)
+            back = cluster.wait_status("s2", "UP", 5)
+            check("the restarted server is back up within 2 s",
+                  back is not None and time.monotonic() - t0 <= 2.5 and back <= 2.0,
+                  f"{back} s after its restart")
+            before = cluster.stat()["s2"][1]
+            for _ in range(30):
+                render_through(cluster.bcp_port)
+            after = cluster.stat()["s2"][1]
+            check("the restarted server gets renders again", after > before,
+                  f"{after - before} of 30 sessions")
+        finally:
+            cluster.stop()
+    print(f"{'FAILED: ' + ', '.join(failed) if failed else 'all checks passed'}")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
