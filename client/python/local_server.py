@@ -4,12 +4,12 @@ import sys
 import threading
 
 
-def start_server(argv, echo=False):
-    """Runs `argv` (the server binary and its options) with --port 0; returns
-    (process, port) once it prints its 'listening on HOST:PORT' line. Its
-    further output is drained (echoed with echo=True) so a chatty server never
-    blocks on a full pipe."""
-    proc = subprocess.Popen(list(argv) + ["--port", "0"], stdout=subprocess.PIPE,
+def start_server(argv, echo=False, port=0):
+    """Runs `argv` (the server binary and its options) with --port `port` (0:
+    a free one); returns (process, port) once it prints its 'listening on
+    HOST:PORT' line. Its further output is drained (echoed with echo=True) so
+    a chatty server never blocks on a full pipe."""
+    proc = subprocess.Popen(list(argv) + ["--port", str(port)], stdout=subprocess.PIPE,
                             stderr=None if echo else subprocess.DEVNULL, text=True)
     line = []
     reader = threading.Thread(target=lambda: line.append(proc.stdout.readline()), daemon=True)

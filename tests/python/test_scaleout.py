@@ -35,6 +35,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.join(HERE, "..", "..")
 sys.path.insert(0, os.path.join(ROOT, "client", "python"))
 from beamcast_client import BeamcastClient, ResilientClient, RetryBudget  # noqa: E402
+from local_server import start_server  # noqa: E402
 
 SCENE = {
     "beams": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "density": "linear"}],
@@ -60,19 +61,9 @@ class Cluster:
 
     def start_server(self, i):
         port, http = self.ports[i]
-        proc = subprocess.Popen(
-            [self.server_bin, "--bind", "127.0.0.1", "--port", str(port), "--http-port", str(http),
-             "--no-demo", "--quiet-requests", "--render-workers", "1"],
-            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-        line = []
-        reader = threading.Thread(target=lambda: line.append(proc.stdout.readline()), daemon=True)
-        reader.start()
-        reader.join(60)
-        if not line or "listening on" not in line[0]:
-            proc.kill()
-            raise RuntimeError(f"server {i} did not start: {line}")
-        threading.Thread(target=lambda: [None for _ in proc.stdout], daemon=True).start()
-        self.procs[i] = proc
+        self.procs[i], _ = start_server(
+            [self.server_bin, "--bind", "127.0.0.1", "--http-port", str(http), "--no-demo",
+             "--quiet-requests", "--render-workers", "1"], port=port)
 
     def start(self):
         for i in range(len(self.ports)):
