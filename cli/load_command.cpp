@@ -614,7 +614,7 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
   const bool ok = msg.value("ok", false);
   Results& r = load_.results;
   if (!ready_) {  // the answers to hello and to the connection's scene.put
-    if (ok && msg.value("id", json()) != json(kScenePutId)) return;  // hello: wait for the put
+    if (ok && id != json(kScenePutId)) return;  // hello: wait for the put
     if (!ok) {
       std::lock_guard lock(r.mu);
       const std::string code = msg["error"].value("code", "hello_failed");

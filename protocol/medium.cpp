@@ -43,6 +43,14 @@ void read_coefficients(const ObjectReader& o, M* m) {
 
 namespace {
 
+// Refuses ("unknown_field") any of `fields` present in `o`: "<field><why>".
+void refuse(const ObjectReader& o, std::initializer_list<const char*> fields,
+            const std::string& why) {
+  for (const char* f : fields) {
+    if (auto v = o.optional(f)) fail("unknown_field", v->path, std::string(f) + why);
+  }
+}
+
 std::string format_point(const Vec3& p) {
   return "(" + format_number(p[0]) + ", " + format_number(p[1]) + ", " + format_number(p[2]) + ")";
 }
@@ -57,8 +65,11 @@ std::vector<std::array<Vec3, 3>> closed_surface(std::vector<std::array<Vec3, 3>>
   auto id = [&](const Vec3& p) {
     return ids.emplace(p, static_cast<int>(ids.size())).first->second;
   };
-  std::map<std::pair<int, int>, int> edges;  // directed edge -> triangles running it
-  std::map<std::pair<int, int>, std::pair<Vec3, Vec3>> ends;
+  struct Run {
+    int n = 0;  // triangles running this directed edge
+    Vec3 p, q;  // its ends, for messages
+  };
+  std::map<std::pair<int, int>, Run> edges;
   std::vector<std::array<Vec3, 3>> kept;
   for (const auto& t : tris) {
     const int a = id(t[0]), b = id(t[1]), c = id(t[2]);
@@ -66,15 +77,18 @@ std::vector<std::array<Vec3, 3>> closed_surface(std::vector<std::array<Vec3, 3>>
     kept.push_back(t);
     const std::array<std::pair<int, int>, 3> run{{{a, b}, {b, c}, {c, a}}};
     for (std::size_t i = 0; i < 3; ++i) {
-      ++edges[run[i]];
-      ends[run[i]] = {t[i], t[(i + 1) % 3]};
+      Run& e = edges[run[i]];
+      ++e.n;
+      e.p = t[i];
+      e.q = t[(i + 1) % 3];
     }
   }
   if (kept.empty()) fail("bad_mesh", path, "a medium region's mesh has no triangles");
-  for (const auto& [e, n] : edges) {
+  for (const auto& [e, r] : edges) {
     const auto back = edges.find({e.second, e.first});
-    const int m = back == edges.end() ? 0 : back->second;
-    const auto& [p, q] = ends[e];
+    const int n = r.n, m = back == edges.end() ? 0 : back->second.n;
+    const Vec3& p = r.p;
+    const Vec3& q = r.q;
     if (n + m == 1) {
       fail("bad_mesh", path,
            "the mesh is open: its edge from " + format_point(p) + " to " + format_point(q) +
@@ -110,11 +124,8 @@ std::vector<std::array<Vec3, 3>> read_mesh_region(const ObjectReader& o,
   std::vector<std::array<Vec3, 3>> out;
   const std::int64_t room = kMaxMediumMeshTriangles - *mesh_triangles;
   if (file) {
-    for (const char* f : {"vertices", "triangles"}) {
-      if (auto v = o.optional(f))
-        fail("unknown_field", v->path,
-             "give a mesh as file or as vertices and triangles, not both");
-    }
+    refuse(o, {"vertices", "triangles"},
+           ": give a mesh as file or as vertices and triangles, not both");
     *path = file->path;
     const std::string name = read_string(*file);
     if (name.empty()) fail("invalid_value", file->path, "file must be a non-empty relative path");
@@ -126,11 +137,8 @@ std::vector<std::array<Vec3, 3>> read_mesh_region(const ObjectReader& o,
       out.push_back({mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]});
     }
   } else {
-    for (const char* f : {"translate", "scale", "rotation"}) {
-      if (auto v = o.optional(f))
-        fail("unknown_field", v->path,
-             std::string(f) + " is for meshes from a file; give inline vertices in world space");
-    }
+    refuse(o, {"translate", "scale", "rotation"},
+           " is for meshes from a file; give inline vertices in world space");
     if (!verts || !tris) {
       fail("missing_field", o.path_of(verts ? "triangles" : "vertices"),
            "a mesh region needs file, or vertices and triangles");
@@ -174,17 +182,12 @@ MediumRegion parse_medium_region(const Node& n, const SceneLoadOptions& opts,
                                                   {"sphere", MediumRegion::Shape::kSphere},
                                                   {"mesh", MediumRegion::Shape::kMesh}});
   auto point = [&](const Node& v) { return check_coordinates(v, read_vec3(v), max_abs); };
-  auto refuse = [&](std::initializer_list<const char*> fields, const std::string& why) {
-    for (const char* f : fields) {
-      if (auto v = o.optional(f)) fail("unknown_field", v->path, std::string(f) + why);
-    }
-  };
   if (r.shape != MediumRegion::Shape::kMesh) {
-    refuse({"vertices", "triangles", "file", "translate", "scale", "rotation"},
+    refuse(o, {"vertices", "triangles", "file", "translate", "scale", "rotation"},
            " is for mesh regions");
   }
   if (r.shape == MediumRegion::Shape::kBox) {
-    refuse({"center", "radius"}, " is for spheres; a box has min and max");
+    refuse(o, {"center", "radius"}, " is for spheres; a box has min and max");
     r.lo = point(o.required("min"));
     const Node hi = o.required("max");
     r.hi = point(hi);
@@ -194,14 +197,14 @@ MediumRegion parse_medium_region(const Node& n, const SceneLoadOptions& opts,
       }
     }
   } else if (r.shape == MediumRegion::Shape::kSphere) {
-    refuse({"min", "max"}, " is for boxes; a sphere has center and radius");
+    refuse(o, {"min", "max"}, " is for boxes; a sphere has center and radius");
     r.lo = point(o.required("center"));
     const Node rad = o.required("radius");
     r.radius = check_positive(rad, read_number(rad));
     if (r.radius > max_abs)
       fail("out_of_range", rad.path, "radius must be <= " + format_number(max_abs));
   } else {
-    refuse({"min", "max", "center", "radius"},
+    refuse(o, {"min", "max", "center", "radius"},
            " is for boxes and spheres; a mesh region has its triangles");
     std::string path;
     r.triangles = closed_surface(read_mesh_region(o, opts, mesh_triangles, &path), path);
