@@ -39,6 +39,7 @@
 #include "cli/commands.hpp"
 #include "client/client.hpp"
 #include "client/latency_histogram.hpp"
+#include "client/resilient_client.hpp"
 #include "protocol/bounded_json.hpp"
 #include "protocol/data_dir.hpp"
 #include "protocol/framing.hpp"
@@ -84,6 +85,11 @@ struct LoadArgs {
   double busy_backoff_ms = 20;  // closed loop: pause after a "busy" answer, as a polite client does  // open loop: more than this is a client-side skip
   double timeout_s = 60;
   std::string token;
+  // Retries (docs/deploy.md): a connection that drops or cannot be made is
+  // opened again after a backoff with full jitter, and its unanswered
+  // requests are sent again while the retry budget allows.
+  int max_attempts = 5;  // consecutive tries of a connection; 1: no retries
+  double timeline_ms = 1000;  // width of the report's timeline buckets
   bool json_out = false;
   bool quiet = false;
 };
@@ -150,6 +156,15 @@ struct Results {
   std::uint64_t ref_checked = 0, ref_failed = 0;
   int ref_max_diff = 0;
   std::vector<std::string> failures;  // first few, for the report
+  // Retries: requests sent again, connections opened again, scenes put again
+  // (unknown_scene), retries the budget refused.
+  std::uint64_t retries = 0, reconnects = 0, reputs = 0, budget_refused = 0;
+  // Per timeline bucket (by the time an answer or error arrived).
+  struct Bucket {
+    LatencyHistogram latency;
+    std::uint64_t ok = 0, errors = 0, retries = 0;
+  };
+  std::map<long long, Bucket> timeline;
 };
 
 // One class of traffic: how its requests look and how they are sent, and what
@@ -311,6 +326,8 @@ class Conn : public std::enable_shared_from_this<Conn> {
   Conn(Load& load, asio::io_context& io, int index, TrafficClass& cls)
       : load_(load), socket_(io), index_(index), cls_(cls) {}
   void start(const tcp::resolver::results_type& endpoints);
+  // Opens the connection (again after a failure), says hello, puts the scene.
+  void connect();
   // Sends request `seq`, timed from `intended` (its scheduled time).
   void send_render(std::uint64_t seq, Clock::time_point intended);
   std::size_t inflight() const { return pending_.size(); }
@@ -320,7 +337,10 @@ class Conn : public std::enable_shared_from_this<Conn> {
   std::uint64_t ok_requests() const { return ok_requests_; }
   std::uint64_t ok_frames() const { return ok_frames_; }
   bool ready() const { return ready_ && !dead_; }
+  // Still responsible for requests (answered or to be sent again).
+  bool live() const { return !dead_; }
   void close() {
+    closing_ = true;
     boost::system::error_code ignored;
     socket_.close(ignored);
   }
@@ -330,15 +350,26 @@ class Conn : public std::enable_shared_from_this<Conn> {
     std::uint64_t seq;
     Clock::time_point intended;
     json cameras;
+    json params;  // as sent, to send again after a reconnect
   };
+  void send_pending(Pending p);
   void write(std::vector<std::uint8_t> frame);
   void do_write();
   void read_header();
   void on_message(json msg, std::vector<std::uint8_t> binary);
   void fail(const std::string& why);
+  // A transport failure: reconnect and send the unanswered requests again
+  // (retries), or give up (fail) when the attempts are spent.
+  void on_transport_error(const std::string& why);
 
   Load& load_;
   tcp::socket socket_;
+  tcp::resolver::results_type endpoints_;
+  // Handlers of an earlier socket (completing with an error after a
+  // reconnect) carry an older generation and are ignored.
+  std::uint64_t generation_ = 0;
+  int attempt_ = 0;  // consecutive failed tries; reset by an answer
+  bool closing_ = false;
   int index_;
   TrafficClass& cls_;
   std::uint64_t frame_no_ = 0;  // preview: this connection's frames so far (its orbit position)
@@ -359,7 +390,8 @@ class Load {
         scene_id(std::move(scene_id)),
         scene_json(scene_json),
         classes(std::move(cls)),
-        verifier(results, scene_json, a.scene_file, a.tolerance) {}
+        verifier(results, scene_json, a.scene_file, a.tolerance),
+        rng(static_cast<std::uint64_t>(::getpid())) {}
 
   int run(const client::Endpoint& ep) {
     tcp::resolver resolver(io);
@@ -383,7 +415,10 @@ class Load {
   // when an answer arrived (closed loop: sends the next).
   void on_ready(Conn& c) {
     if (c.traffic_class().rate > 0) return;
-    for (int i = 0; i < c.traffic_class().pipeline; ++i) maybe_send(c, Clock::now());
+    // Requests sent again after a reconnect count towards the pipeline.
+    for (auto i = c.inflight(); i < static_cast<std::size_t>(c.traffic_class().pipeline); ++i) {
+      maybe_send(c, Clock::now());
+    }
   }
   void on_answer(Conn& c, bool busy) {
     const bool closed = c.traffic_class().rate <= 0;
@@ -403,6 +438,11 @@ class Load {
     return stopping || (args.requests > 0 && total_sent >= static_cast<std::uint64_t>(args.requests));
   }
   void on_dead() { maybe_stop(); }
+  // The timeline bucket of `now` (caller holds results.mu).
+  Results::Bucket& bucket(Clock::time_point now) {
+    const double ms = std::chrono::duration<double, std::milli>(now - start).count();
+    return results.timeline[static_cast<long long>(ms / std::max(1.0, args.timeline_ms))];
+  }
 
   const LoadArgs& args;
   std::string scene_id;
@@ -410,6 +450,10 @@ class Load {
   std::vector<std::unique_ptr<TrafficClass>> classes;
   Results results;
   Verifier verifier;
+  // One budget for the whole run: retries stay within ~10% of requests.
+  client::RetryBudget budget;
+  client::RetryPolicy policy;
+  std::mt19937_64 rng;  // backoff jitter
   asio::io_context io;
   std::vector<std::shared_ptr<Conn>> conns;
   Clock::time_point start;
@@ -426,7 +470,7 @@ class Load {
   void maybe_stop() {
     if (!sending_over()) return;
     for (auto& c : conns) {
-      if (c->ready() && c->inflight() > 0) return;
+      if (c->live() && c->inflight() > 0) return;  // answers (or retries) to come
     }
     for (auto& c : conns) c->close();
     io.stop();
@@ -442,7 +486,7 @@ class Load {
       // Answers that never came count as errors.
       std::lock_guard lock(results.mu);
       for (auto& c : conns) {
-        const std::size_t n = c->ready() ? c->inflight() : 0;
+        const std::size_t n = c->live() ? c->inflight() : 0;
         results.errors["no_answer"] += n;
         if (n > 0) c->traffic_class().errors["no_answer"] += n;
       }
@@ -511,9 +555,21 @@ class Load {
 };
 
 void Conn::start(const tcp::resolver::results_type& endpoints) {
-  asio::async_connect(socket_, endpoints,
-                      [self = shared_from_this()](const boost::system::error_code& ec, const tcp::endpoint&) {
-                        if (ec) return self->fail("connect_failed");
+  endpoints_ = endpoints;
+  connect();
+}
+
+void Conn::connect() {
+  const std::uint64_t gen = ++generation_;
+  socket_ = tcp::socket(socket_.get_executor());
+  ready_ = false;
+  writing_ = false;
+  writes_.clear();
+  asio::async_connect(socket_, endpoints_,
+                      [self = shared_from_this(), gen](const boost::system::error_code& ec,
+                                                       const tcp::endpoint&) {
+                        if (gen != self->generation_ || self->closing_) return;
+                        if (ec) return self->on_transport_error("connect_failed");
                         self->socket_.set_option(tcp::no_delay(true));
                         self->read_header();
                         if (!self->load_.args.token.empty()) {
@@ -535,7 +591,6 @@ void Conn::start(const tcp::resolver::results_type& endpoints) {
 }
 
 void Conn::send_render(std::uint64_t seq, Clock::time_point intended) {
-  const std::int64_t id = next_id_++;
   const PoseSource& poses = *cls_.pose_source;
   json params = {{"scene_id", load_.scene_id}};
   json cams;
@@ -550,13 +605,18 @@ void Conn::send_render(std::uint64_t seq, Clock::time_point intended) {
     cams = poses.cameras_for(seq, cls_.poses, cls_.cameras);
   }
   params["cameras"] = cams;
-  json req = {{"id", id}, {"method", "render"}, {"params", std::move(params)}};
-  pending_[id] = Pending{seq, intended, std::move(cams)};
   {
     std::lock_guard lock(load_.results.mu);
     ++load_.results.sent;
     ++cls_.sent;
   }
+  send_pending(Pending{seq, intended, std::move(cams), std::move(params)});
+}
+
+void Conn::send_pending(Pending p) {
+  const std::int64_t id = next_id_++;
+  const json req = {{"id", id}, {"method", "render"}, {"params", p.params}};
+  pending_[id] = std::move(p);
   write(encode_frame(req.dump()));
 }
 
@@ -568,8 +628,10 @@ void Conn::write(std::vector<std::uint8_t> frame) {
 void Conn::do_write() {
   writing_ = true;
   asio::async_write(socket_, asio::buffer(writes_.front()),
-                    [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
-                      if (ec) return self->fail("write_failed");
+                    [self = shared_from_this(), gen = generation_](const boost::system::error_code& ec,
+                                                                   std::size_t) {
+                      if (gen != self->generation_ || self->closing_) return;
+                      if (ec) return self->on_transport_error("write_failed");
                       self->writes_.pop_front();
                       if (self->writes_.empty()) {
                         self->writing_ = false;
@@ -581,8 +643,10 @@ void Conn::do_write() {
 
 void Conn::read_header() {
   asio::async_read(socket_, asio::buffer(header_),
-                   [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
-                     if (ec) return self->fail("connection_lost");
+                   [self = shared_from_this(), gen = generation_](const boost::system::error_code& ec,
+                                                                  std::size_t) {
+                     if (gen != self->generation_ || self->closing_) return;
+                     if (ec) return self->on_transport_error("connection_lost");
                      FrameHeader h;
                      if (parse_frame_header(self->header_, 1ull << 31, &h) != HeaderStatus::kOk) {
                        return self->fail("bad_frame");
@@ -590,8 +654,9 @@ void Conn::read_header() {
                      self->body_.resize(h.body_length());
                      asio::async_read(
                          self->socket_, asio::buffer(self->body_),
-                         [self, h](const boost::system::error_code& ec2, std::size_t) {
-                           if (ec2) return self->fail("connection_lost");
+                         [self, h, gen](const boost::system::error_code& ec2, std::size_t) {
+                           if (gen != self->generation_ || self->closing_) return;
+                           if (ec2) return self->on_transport_error("connection_lost");
                            BoundedParse parsed = parse_json_bounded(
                                std::string_view(reinterpret_cast<const char*>(self->body_.data()),
                                                 h.json_length),
@@ -603,7 +668,7 @@ void Conn::read_header() {
                            std::vector<std::uint8_t> bin(self->body_.begin() + h.json_length,
                                                          self->body_.end());
                            self->on_message(std::move(msg), std::move(bin));
-                           if (!self->dead_) self->read_header();
+                           if (!self->dead_ && gen == self->generation_) self->read_header();
                          });
                    });
 }
@@ -615,18 +680,42 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
   Results& r = load_.results;
   if (!ready_) {  // the answers to hello and to the connection's scene.put
     if (ok && id != json(kScenePutId)) return;  // hello: wait for the put
+    if (!ok) return fail(msg["error"].value("code", "hello_failed"));
+    ready_ = true;
+    attempt_ = 0;
+    // After a reconnect: the requests the lost connection never answered go
+    // out again, each a retry the budget must allow (latency still counts
+    // from each one's first scheduled time, so failover shows in it).
+    std::map<std::int64_t, Pending> unanswered;
+    unanswered.swap(pending_);
+    std::uint64_t resent = 0, refused = 0;
+    for (auto& [old_id, p] : unanswered) {
+      if (load_.budget.try_spend()) {
+        send_pending(std::move(p));
+        ++resent;
+      } else {
+        ++refused;
+      }
+    }
+    {
+      std::lock_guard lock(r.mu);
+      r.retries += resent;
+      load_.bucket(now).retries += resent;
+      r.budget_refused += refused;
+      if (refused > 0) {
+        r.errors["retry_budget_spent"] += refused;
+        cls_.errors["retry_budget_spent"] += refused;
+        load_.bucket(now).errors += refused;
+      }
+    }
+    load_.on_ready(*this);
+    return;
+  }
+  if (id == json(kScenePutId)) {  // a re-put after unknown_scene
     if (!ok) {
       std::lock_guard lock(r.mu);
-      const std::string code = msg["error"].value("code", "hello_failed");
-      ++r.errors[code];
-      ++cls_.errors[code];
-      dead_ = true;
-      close();
-      load_.on_dead();
-      return;
+      ++r.errors["reput_" + msg["error"].value("code", "failed")];
     }
-    ready_ = true;
-    load_.on_ready(*this);
     return;
   }
   if (!id.is_number_integer() || !pending_.count(id.get<std::int64_t>())) {
@@ -642,9 +731,24 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
   if (!ok) {
     const std::string code = msg["error"].value("code", "unknown");
     busy = code == "busy";
+    if (code == "unknown_scene" && load_.budget.try_spend()) {
+      // This connection reached a server without the scene (a balancer moved
+      // it, or the server restarted): put it again, render again.
+      json put = {{"id", kScenePutId},
+                  {"method", "scene.put"},
+                  {"params", {{"scene_id", load_.scene_id}, {"scene", load_.scene_json}}}};
+      write(encode_frame(put.dump()));
+      send_pending(p);
+      std::lock_guard lock(r.mu);
+      ++r.reputs;
+      ++r.retries;
+      ++load_.bucket(now).retries;
+      return;
+    }
     std::lock_guard lock(r.mu);
     ++r.errors[code];
     ++cls_.errors[code];
+    ++load_.bucket(now).errors;
     if (busy) r.busy_latency.record_ms(ms);
   } else {
     std::optional<RenderResponse> res;
@@ -687,6 +791,9 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
         r.frames += res->frames.size();
         r.bytes += kFrameHeaderSize + body_.size();
         r.latency.record_ms(ms);
+        Results::Bucket& b = load_.bucket(now);
+        b.latency.record_ms(ms);
+        ++b.ok;
         ++cls_.ok;
         cls_.frames += res->frames.size();
         cls_.bytes += kFrameHeaderSize + body_.size();
@@ -721,10 +828,31 @@ void Conn::fail(const std::string& why) {
     }
     load_.results.errors["no_answer"] += pending_.size();
     if (!pending_.empty()) cls_.errors["no_answer"] += pending_.size();
+    load_.bucket(Clock::now()).errors += pending_.size();
   }
   pending_.clear();
   close();
   load_.on_dead();
+}
+
+void Conn::on_transport_error(const std::string& why) {
+  if (dead_) return;
+  // Nothing more to send or await: the run is over for this connection.
+  if (load_.sending_over() && pending_.empty()) return fail(why);
+  if (++attempt_ >= load_.args.max_attempts) return fail(why);
+  boost::system::error_code ignored;
+  socket_.close(ignored);
+  ready_ = false;
+  ++generation_;  // the old socket's handlers are stale from here on
+  {
+    std::lock_guard lock(load_.results.mu);
+    ++load_.results.reconnects;
+  }
+  auto timer = std::make_shared<asio::steady_timer>(socket_.get_executor());
+  timer->expires_after(client::backoff_delay(load_.policy, attempt_, load_.rng));
+  timer->async_wait([self = shared_from_this(), timer](const boost::system::error_code&) {
+    if (!self->dead_ && !self->closing_) self->connect();
+  });
 }
 
 // The classes of a run: the mix's preview and batch classes, or one class
@@ -797,28 +925,27 @@ int run_load(const LoadArgs& args) {
   }
   // Store the scene once under a per-run id; every request renders it by id.
   const std::string scene_id = "load-" + std::to_string(::getpid());
-  {
-    client::Client c;
-    c.set_receive_timeout(std::chrono::milliseconds(static_cast<long long>(args.timeout_s * 1000)));
-    c.connect(ep.host, ep.port);
-    if (!args.token.empty()) {
-      const auto h = c.call("hello", {{"protocol", 1}, {"token", args.token}});
-      if (!h.ok) throw std::runtime_error("hello refused: [" + h.error.code + "] " + h.error.message);
-    }
-    const auto put = c.scene_put(scene_id, scene_json);
-    if (!put.ok) throw std::runtime_error("scene.put refused: [" + put.error.code + "] " + put.error.message);
-  }
+  // (With retries: the server, or the balancer's first pick, may be down.)
+  client::ResilientOptions ropts;
+  ropts.policy.max_attempts = args.max_attempts;
+  ropts.receive_timeout = std::chrono::milliseconds(static_cast<long long>(args.timeout_s * 1000));
+  ropts.token = args.token;
+  client::ResilientClient(ep, nullptr, ropts).scene_put(scene_id, scene_json);
 
   Load load(args, scene_json, scene_id, make_classes(args, scene_json));
   load.run(ep);
   const double wall = std::chrono::duration<double>(Clock::now() - load.start).count();
   load.progress(Clock::now(), true);
 
-  {
+  try {
+    // Best effort: behind a balancer this reaches one server; the copies the
+    // other connections stored age out of their servers' scene stores.
     client::Client c;
     c.connect(ep.host, ep.port);
     if (!args.token.empty()) c.call("hello", {{"protocol", 1}, {"token", args.token}});
     c.scene_delete(scene_id);
+  } catch (const std::runtime_error& e) {
+    std::fprintf(stderr, "beamcast load: could not delete the run's scene: %s\n", e.what());
   }
 
   Results& r = load.results;
@@ -876,6 +1003,26 @@ int run_load(const LoadArgs& args) {
     }
     classes.push_back(std::move(c));
   }
+  // Retries and the timeline (answers, errors and retries per bucket of
+  // --timeline-ms, with the bucket's latency percentiles): a failover shows
+  // where it happened.
+  const json retries = {
+      {"requests_sent_again", r.retries},
+      {"reconnects", r.reconnects},
+      {"scene_reputs", r.reputs},
+      {"refused_by_budget", r.budget_refused},
+      {"max_attempts", args.max_attempts},
+      {"amplification", r.sent > 0 ? static_cast<double>(r.sent + r.retries) / r.sent : 1.0}};
+  json timeline = json::array();
+  for (const auto& [k, b] : r.timeline) {
+    timeline.push_back({{"t_s", k * args.timeline_ms / 1000.0},
+                        {"ok", b.ok},
+                        {"errors", b.errors},
+                        {"retries", b.retries},
+                        {"p50_ms", b.latency.percentile_ms(0.5)},
+                        {"p99_ms", b.latency.percentile_ms(0.99)},
+                        {"max_ms", b.latency.max_ms()}});
+  }
   const bool mix = args.preview_connections > 0 || args.batch_connections > 0;
   json out = {
       {"server", args.server},
@@ -888,6 +1035,9 @@ int run_load(const LoadArgs& args) {
       {"duration_s", wall},
       {"requests", {{"sent", r.sent}, {"ok", r.ok}, {"errors", errors}, {"not_sent", r.skipped}}},
       {"errors_by_code", r.errors},
+      {"retries", retries},
+      {"timeline_ms", args.timeline_ms},
+      {"timeline", timeline},
       {"frames", r.frames},
       {"frames_per_s", r.frames / wall},
       {"requests_per_s", r.ok / wall},
@@ -924,6 +1074,11 @@ int run_load(const LoadArgs& args) {
                 (unsigned long long)r.sent, (unsigned long long)r.ok,
                 (unsigned long long)errors, (unsigned long long)r.skipped);
     for (auto& [k, v] : r.errors) std::printf("    error %-20s %llu\n", k.c_str(), (unsigned long long)v);
+    std::printf("  retries  %llu requests sent again (amplification %.3f), %llu reconnects, "
+                "%llu scenes put again, %llu refused by the budget\n",
+                (unsigned long long)r.retries, retries["amplification"].get<double>(),
+                (unsigned long long)r.reconnects, (unsigned long long)r.reputs,
+                (unsigned long long)r.budget_refused);
     std::printf("  throughput  %.1f frames/s  %.1f requests/s  %.2f MB/s\n", r.frames / wall,
                 r.ok / wall, r.bytes / wall / 1e6);
     std::printf("  latency ms  p50 %.1f  p90 %.1f  p99 %.1f  p99.9 %.1f  max %.1f\n",
@@ -1042,6 +1197,12 @@ void add_load_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--token", args->token, "Token for hello (servers on non-loopback addresses)")
       ->envname("BEAMCAST_TOKEN");
+  cmd->add_option("--attempts", args->max_attempts,
+                  "Tries of a connection that drops or is refused before its requests fail "
+                  "(reconnects with backoff and jitter; 1: no retries)")
+      ->check(CLI::Range(1, 100));
+  cmd->add_option("--timeline-ms", args->timeline_ms, "Width of the timeline's buckets in the report")
+      ->check(CLI::Range(10.0, 3.6e6));
   cmd->add_flag("--json", args->json_out, "Print the results as JSON");
   cmd->add_flag("--quiet,-q", args->quiet, "No live progress line");
   cmd->callback([args] {

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Three beamcast-servers behind HAProxy on loopback (issue 18, ctest -L scaleout).
 
-    python3 tests/python/test_scaleout.py build/bin/beamcast-server
+    python3 tests/python/test_scaleout.py build/bin/beamcast-server build/bin/beamcast
 
 The deployment of deploy/haproxy.cfg.in, end to end: three servers on free
 loopback ports, HAProxy in front (its BCP1 port in TCP mode, health from each
@@ -18,12 +18,20 @@ server's HTTP /health). Checks, each printed with its numbers:
      of the 2 s after the kill is printed beside the steady p99; every
      render on a new connection after detection is answered by the others;
   3. the server restarted on its ports: back up within 2 s (rise 2) and
-     given renders again.
-What this does not check yet (issue 18, open): the C++ client's and
-`beamcast load`'s retries, a bound on the failover p99 (measured, printed).
+     given renders again;
+  4. `beamcast load` (4 connections, closed loop, frames decoded and 5%
+     compared with a local render) through HAProxy for 6 s, another server
+     killed with SIGKILL 2.5 s in and restarted 2 s later: every request
+     answered correctly, the connections cut reconnected and their requests
+     sent again within the budget (amplification <= 1.1, the issue's
+     bound), and the p99 of the timeline's 250 ms buckets around the kill
+     printed beside the steady ones (measured, not asserted: a timing bound
+     on a shared 2-core machine belongs to docs/deploy.md's record).
 Plain python3; exits 0 only if every check passed.
 """
+import json
 import os
+import subprocess
 import sys
 import tempfile
 import threading
@@ -120,8 +128,61 @@ class Load:
                 sum(c.reputs for c in self.clients))
 
 
+def load_failover(cluster, cli_bin, run_dir, check):
+    """Check 4: `beamcast load` through the balancer while server 3 is killed
+    and restarted."""
+    scene_file = os.path.join(run_dir, "scene.json")
+    with open(scene_file, "w") as f:
+        json.dump(SCENE, f)
+    t0 = time.monotonic()
+    proc = subprocess.Popen(
+        [cli_bin, "load", "--server", f"127.0.0.1:{cluster.bcp_port}", "-c", "4",
+         "--duration", "6", "--size", "48", "--poses", "orbit", "--cameras", "1",
+         "--verify-fraction", "0.05", "--timeline-ms", "250", "--scene", scene_file,
+         "--json", "-q"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(2.5)
+    kill_at = time.monotonic() - t0
+    cluster.procs[2].kill()
+    detect = cluster.wait_status("s3", "DOWN", 5)
+    time.sleep(max(0.0, t0 + 4.5 - time.monotonic()))
+    cluster.start_server(2)
+    out, err = proc.communicate(timeout=120)
+    if proc.returncode != 0 and not out.strip():
+        check("beamcast load through a failover", False, f"exit {proc.returncode}: {err[-2000:]}")
+        return
+    r = json.loads(out)
+    req, retries, verify = r["requests"], r["retries"], r["verify"]
+    check("beamcast load: the kill detected within 1 s",
+          detect is not None and detect <= 1.0, f"{detect} s")
+    check("beamcast load: no request lost or failed, frames verified",
+          proc.returncode == 0 and req["errors"] == 0 and req["ok"] == req["sent"] and
+          verify["all_frames_correct"] and verify["reference_checked"] > 0,
+          f"{req['ok']} / {req['sent']} answered, errors {r['errors_by_code']}; "
+          f"{verify['decoded']} frames decoded, {verify['reference_checked']} compared with "
+          f"a local render (max diff {verify['reference_max_diff']})")
+    check("beamcast load: cut connections reconnected, retries within 1.1x",
+          retries["reconnects"] > 0 and retries["amplification"] <= 1.1 and
+          retries["refused_by_budget"] == 0,
+          f"{retries['reconnects']} reconnects, {retries['requests_sent_again']} requests "
+          f"sent again, {retries['scene_reputs']} scene re-puts; amplification "
+          f"{retries['amplification']:.4f}")
+    # Buckets (250 ms) by the time answers arrived; the load started ~t0.
+    steady = [b["p99_ms"] for b in r["timeline"] if 0.5 <= b["t_s"] < kill_at - 0.25 and b["ok"]]
+    around = [b for b in r["timeline"] if kill_at - 0.25 <= b["t_s"] < kill_at + 2.0]
+    steady_p99 = sorted(steady)[len(steady) // 2] if steady else float("nan")
+    worst = max((b["p99_ms"] for b in around), default=float("nan"))
+    print(f"  load latency: steady p99 (median of {len(steady)} buckets) {steady_p99:.1f} ms; "
+          f"worst bucket p99 in the 2 s after the kill {worst:.1f} ms "
+          f"(ratio {worst / steady_p99:.2f}); {r['frames_per_s']:.0f} frames/s overall",
+          flush=True)
+    print("  timeline (t_s ok errors retries p99_ms): " + ", ".join(
+        f"{b['t_s']:.2f} {b['ok']} {b['errors']} {b['retries']} {b['p99_ms']:.1f}"
+        for b in r["timeline"]), flush=True)
+
+
 def main():
     server_bin = sys.argv[1]
+    cli_bin = sys.argv[2]
     failed = []
 
     def check(name, ok, detail):
@@ -192,6 +253,8 @@ def main():
             after = cluster.stat()["s2"][1]
             check("the restarted server gets renders again", after > before,
                   f"{after - before} of 30 sessions")
+
+            load_failover(cluster, cli_bin, run_dir, check)
         finally:
             cluster.stop()
     print(f"{'FAILED: ' + ', '.join(failed) if failed else 'all checks passed'}")

@@ -1,20 +1,26 @@
 // beamcast_client against a scripted peer on a loopback socket (no real
 // server): id matching with out-of-order responses, frame decoding from
 // attachments and base64, server errors as values, and transport failures
-// (timeout, close, bad magic, refused) as std::runtime_error.
+// (timeout, close, bad magic, refused) as std::runtime_error; ResilientClient's
+// retries on a new connection, re-puts, budget and refusals.
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
+#include <memory>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "client/client.hpp"
+#include "client/resilient_client.hpp"
 #include "protocol/framing.hpp"
 
 namespace beamcast::client {
@@ -22,10 +28,13 @@ namespace {
 
 using nlohmann::json;
 
-// Listens on 127.0.0.1:<ephemeral>, accepts one connection and runs `script` on it.
+// Listens on 127.0.0.1:<ephemeral>, accepts one connection per script, one
+// after the other, and runs each script on its connection.
 class FakePeer {
  public:
-  explicit FakePeer(std::function<void(int fd)> script) {
+  explicit FakePeer(std::function<void(int fd)> script)
+      : FakePeer(std::vector<std::function<void(int fd)>>{std::move(script)}) {}
+  explicit FakePeer(std::vector<std::function<void(int fd)>> scripts) {
     listen_fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
     sockaddr_in addr{};
     addr.sin_family = AF_INET;
@@ -37,11 +46,13 @@ class FakePeer {
       throw std::runtime_error("FakePeer: cannot listen");
     }
     port_ = ntohs(addr.sin_port);
-    thread_ = std::thread([this, script = std::move(script)] {
-      const int fd = ::accept(listen_fd_, nullptr, nullptr);
-      if (fd < 0) return;
-      script(fd);
-      ::close(fd);
+    thread_ = std::thread([this, scripts = std::move(scripts)] {
+      for (const auto& script : scripts) {
+        const int fd = ::accept(listen_fd_, nullptr, nullptr);
+        if (fd < 0) return;
+        script(fd);
+        ::close(fd);
+      }
     });
   }
   ~FakePeer() {
@@ -297,6 +308,160 @@ TEST(ClientLoopback, RefusedConnectThrows) {
   expect_transport_error([&] { c.connect("127.0.0.1", port); }, "127.0.0.1:");
   expect_transport_error([&] { c.ping(); }, "not connected");
 }
+
+// --- ResilientClient ---
+
+// A render result with one base64 frame, enough for Client::render.
+json one_frame_result(const json& id) {
+  const std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G'};
+  return {{"id", id},
+          {"ok", true},
+          {"result",
+           {{"passes", {"beams"}},
+            {"frames", json::array({{{"camera", "c"},
+                                     {"index", 0},
+                                     {"width", 1},
+                                     {"height", 1},
+                                     {"data_base64", base64_encode(png)}}})},
+            {"batched", false},
+            {"batch", {{"requests", 1}, {"views", 1}}},
+            {"timings",
+             {{"queue_ms", 0.0},
+              {"render_ms", 1.0},
+              {"readback_ms", 0.0},
+              {"encode_ms", 0.0},
+              {"server_ms", 1.0}}}}}};
+}
+
+ResilientOptions fast_retries(int attempts = 5) {
+  ResilientOptions o;
+  o.policy.max_attempts = attempts;
+  o.policy.base = std::chrono::milliseconds(1);  // tests wait milliseconds, not seconds
+  o.policy.cap = std::chrono::milliseconds(5);
+  o.receive_timeout = std::chrono::milliseconds(2000);
+  return o;
+}
+
+TEST(ResilientClient, DroppedConnectionIsRetriedOnANewOne) {
+  FakePeer peer({[](int fd) { read_request(fd); },  // takes the ping, closes unanswered
+                 [](int fd) {
+                   const json req = read_request(fd);
+                   EXPECT_EQ(req["method"], "ping");
+                   reply(fd, {{"id", req["id"]}, {"ok", true}, {"result", json::object()}});
+                 }});
+  ResilientClient c({"127.0.0.1", peer.port()}, std::make_shared<RetryBudget>(), fast_retries());
+  EXPECT_TRUE(c.ping().ok);
+  EXPECT_EQ(c.stats().requests, 1u);
+  EXPECT_EQ(c.stats().retries, 1u);
+  EXPECT_EQ(c.stats().connections, 2u);
+}
+
+TEST(ResilientClient, UnknownScenePutsTheSceneAgain) {
+  const json scene = {{"beams", json::array()}};
+  FakePeer peer({[](int fd) {
+                   const json put = read_request(fd);
+                   reply(fd, {{"id", put["id"]}, {"ok", true}, {"result", json::object()}});
+                   read_request(fd);  // the render: the connection drops (its server died)
+                 },
+                 [&](int fd) {  // another server, without the scene
+                   const json render = read_request(fd);
+                   reply(fd, {{"id", render["id"]},
+                              {"ok", false},
+                              {"error", {{"code", "unknown_scene"}, {"message", "no scene s"}}}});
+                   const json put = read_request(fd);
+                   EXPECT_EQ(put["method"], "scene.put");
+                   EXPECT_EQ(put["params"]["scene"], scene);
+                   reply(fd, {{"id", put["id"]}, {"ok", true}, {"result", json::object()}});
+                   const json again = read_request(fd);
+                   EXPECT_EQ(again["params"]["scene_id"], "s");
+                   reply(fd, one_frame_result(again["id"]));
+                 }});
+  ResilientClient c({"127.0.0.1", peer.port()}, std::make_shared<RetryBudget>(), fast_retries());
+  c.scene_put("s", scene);
+  const RenderResult r = c.render(stored("s"));
+  ASSERT_TRUE(r.ok) << r.error.message;
+  EXPECT_EQ(r.frames.size(), 1u);
+  EXPECT_EQ(c.stats().retries, 1u);
+  EXPECT_EQ(c.stats().reputs, 1u);
+}
+
+TEST(ResilientClient, AnEmptyBudgetStopsRetries) {
+  FakePeer peer([](int fd) { read_request(fd); });
+  // No burst: one request earns 0.1 of a retry, not enough for one.
+  auto budget = std::make_shared<RetryBudget>(0.1, 0.0);
+  ResilientClient c({"127.0.0.1", peer.port()}, budget, fast_retries());
+  expect_transport_error([&] { c.ping(); }, "the retry budget is spent");
+  EXPECT_EQ(c.stats().retries, 0u);
+  EXPECT_EQ(budget->refused(), 1u);
+}
+
+TEST(ResilientClient, GivesUpAfterItsAttemptsNamingTheEndpoint) {
+  std::uint16_t port = 0;
+  {
+    FakePeer peer([](int) {});
+    port = peer.port();
+    Client probe;
+    probe.connect("127.0.0.1", port);
+  }  // nothing listens there now: every connect is refused
+  ResilientClient c({"127.0.0.1", port}, std::make_shared<RetryBudget>(), fast_retries(3));
+  expect_transport_error([&] { c.ping(); }, "gave up after 3 tries");
+  expect_transport_error([&] { c.ping(); }, "127.0.0.1:" + std::to_string(port));
+  EXPECT_EQ(c.stats().retries, 4u);  // two per request
+}
+
+TEST(ResilientClient, AWrongTokenIsRefusedNotRetried) {
+  FakePeer peer([](int fd) {
+    const json hello = read_request(fd);
+    EXPECT_EQ(hello["params"]["token"], "wrong");
+    reply(fd, {{"id", hello["id"]},
+               {"ok", false},
+               {"error", {{"code", "unauthorized"}, {"message", "bad token"}, {"path", "/params/token"}}}});
+  });
+  ResilientOptions o = fast_retries();
+  o.token = "wrong";
+  ResilientClient c({"127.0.0.1", peer.port()}, std::make_shared<RetryBudget>(), o);
+  try {
+    c.ping();
+    ADD_FAILURE() << "a refused hello must throw";
+  } catch (const RequestRefused& e) {
+    EXPECT_EQ(e.error().code, "unauthorized");
+    EXPECT_NE(std::string(e.what()).find("refused hello"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(c.stats().connections, 1u);
+  EXPECT_EQ(c.stats().retries, 0u);
+}
+
+TEST(RetryBudget, RetriesAreATenthOfRequestsPlusTheBurst) {
+  RetryBudget b(0.1, 10.0);
+  int granted = 0;
+  for (int i = 0; i < 1000; ++i) {
+    b.on_request();
+    if (b.try_spend()) ++granted;
+  }
+  // Every request asks for a retry: the burst of 10, then one per ten requests.
+  EXPECT_GE(granted, 109);
+  EXPECT_LE(granted, 110);
+}
+
+TEST(RetryBudget, BackoffIsFullJitterUnderTheCap) {
+  RetryPolicy p;
+  p.base = std::chrono::milliseconds(20);
+  p.cap = std::chrono::milliseconds(1000);
+  std::mt19937_64 rng(7);
+  for (int attempt = 0; attempt < 12; ++attempt) {
+    const double top_us = std::min(1e6, 20e3 * std::ldexp(1.0, attempt));
+    double hi = 0;
+    for (int i = 0; i < 200; ++i) {
+      const auto d = backoff_delay(p, attempt, rng).count();
+      EXPECT_GE(d, 0);
+      EXPECT_LE(d, top_us);
+      hi = std::max(hi, static_cast<double>(d));
+    }
+    // Uniform over [0, top]: 200 draws all below half the top has odds 2^-200.
+    EXPECT_GT(hi, 0.5 * top_us) << "attempt " << attempt;
+  }
+}
+
 
 }  // namespace
 }  // namespace beamcast::client
