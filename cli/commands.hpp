@@ -25,6 +25,7 @@ struct RemoteRenderArgs {
   std::string scene_id;  // a scene stored on the server
   std::string out = ".";
   std::string encoding = "binary";
+  std::string token;  // presented in hello when set
   double timeout_s = 120;
   bool json = false;
 };
@@ -43,7 +44,9 @@ struct SequenceArgs {
   bool json = false;
   int device = -1;
   std::string platform = "auto";
-  std::string server;
+  std::string server;      // HOST:PORT, or several separated by commas
+  int connections = 2;     // workers per server (each its own connection)
+  std::string token;       // presented in hello when set
   std::string encoding = "binary";
   double timeout_s = 120;
 };

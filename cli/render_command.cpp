@@ -223,7 +223,9 @@ void add_render_command(CLI::App& app) {
 
   // Rendering on a server: the scene file is sent inline, or a stored scene named.
   CLI::Option* server = cmd->add_option(
-      "--server", remote->server, "Render on the beamcast-server at HOST:PORT instead of locally");
+      "--server", remote->server,
+      "Render on the beamcast-server at HOST:PORT instead of locally; with --rig or --path, "
+      "on several (A,B,C): the batches are shared out and the frames written in order");
   cmd->add_option("--scene-id", remote->scene_id, "With --server: render this stored scene")
       ->needs(server)
       ->excludes(scene);
@@ -233,6 +235,9 @@ void add_render_command(CLI::App& app) {
       ->needs(server);
   cmd->add_option("--timeout", remote->timeout_s, "With --server: seconds to wait for the frames")
       ->check(CLI::PositiveNumber)
+      ->needs(server);
+  cmd->add_option("--token", remote->token,
+                  "With --server: the token for hello (servers on non-loopback addresses)")
       ->needs(server);
   // Frame sequences: numbered PNGs of a rig or a camera path.
   CLI::Option* rig = cmd->add_option(
@@ -252,6 +257,12 @@ void add_render_command(CLI::App& app) {
       cmd->add_option("--batch", seq->batch,
                       "With --rig or --path: views per render call or request (default 12)")
           ->check(CLI::Range(1, 256));
+  CLI::Option* connections =
+      cmd->add_option("--connections", seq->connections,
+                      "With --server and --rig or --path: connections (workers) per server; "
+                      "through a balancer, its servers share them")
+          ->check(CLI::Range(1, 64))
+          ->needs(server);
   for (CLI::Option* o : {rig, path}) {
     o->excludes(reference);
     o->excludes(gather);
@@ -260,7 +271,7 @@ void add_render_command(CLI::App& app) {
   for (CLI::Option* local : {assets, reference, hdr, device, platform, threads, spp, seed, gather})
     server->excludes(local);
 
-  cmd->callback([args, remote, seq, batch] {
+  cmd->callback([args, remote, seq, batch, connections] {
     int rc = 0;
     if (!seq->rig.empty() || !seq->path.empty()) {
       if (args->scene.empty()) {
@@ -275,9 +286,10 @@ void add_render_command(CLI::App& app) {
       seq->server = remote->server;
       seq->encoding = remote->encoding;
       seq->timeout_s = remote->timeout_s;
+      seq->token = remote->token;
       rc = run_sequence(*seq);
-    } else if (batch->count() > 0) {
-      throw CLI::ValidationError("--batch applies to --rig and --path only");
+    } else if (batch->count() > 0 || connections->count() > 0) {
+      throw CLI::ValidationError("--batch and --connections apply to --rig and --path only");
     } else if (!remote->server.empty()) {
       if (args->scene.empty() && remote->scene_id.empty()) {
         throw CLI::ValidationError("render --server needs a scene file or --scene-id");

@@ -2,7 +2,15 @@
 // pair or keyframed animation rendered to numbered PNGs (frame_0000.png ...),
 // locally or on a server, in batches of views, with progress on stderr and a
 // per-frame time summary.
+#include <unistd.h>
+
 #include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +23,7 @@
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
 #include "client/client.hpp"
+#include "client/resilient_client.hpp"
 #include "protocol/camera_path.hpp"
 #include "protocol/rigs.hpp"
 #include "protocol/scene_json.hpp"
@@ -65,6 +74,150 @@ std::vector<Camera> sequence_cameras(const SequenceArgs& args, const Scene& scen
   return expand_camera_path(path, args.frames);
 }
 
+// The frames of a sequence rendered on one or more servers (--server A,B,C,
+// each with --connections workers; a balancer's address counts as one): the
+// job is cut into batches of views, and each worker takes the next batch,
+// renders it by a scene id it stored on its connection, and hands the
+// frames over by their position, so the numbered files come out in order
+// whichever server rendered them. A worker whose server fails after its
+// retries (client::ResilientClient) puts its batch back for the others and
+// stops; the job fails only when every worker has, or when a server refuses
+// a request (a bad scene fails the same way everywhere).
+struct RemoteResult {
+  std::string error;        // empty: every frame was delivered
+  std::string description;  // "beamcast-server at A, B"
+  nlohmann::json servers;   // per worker: endpoint, batches, frames, retries, error
+};
+
+using DeliverFn = std::function<void(std::size_t first, const std::vector<client::RenderedFrame>& frames,
+                                     double request_ms)>;
+
+RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& scene_json,
+                               const std::vector<Camera>& cams, std::size_t batch,
+                               const DeliverFn& deliver) {
+  std::vector<client::Endpoint> endpoints;
+  std::string list = args.server;
+  for (std::size_t at = 0; at <= list.size();) {
+    const std::size_t comma = std::min(list.find(',', at), list.size());
+    try {
+      endpoints.push_back(client::parse_endpoint(list.substr(at, comma - at)));
+    } catch (const std::invalid_argument& e) {
+      throw CLI::ValidationError("--server", e.what());
+    }
+    at = comma + 1;
+  }
+  RemoteResult out;
+  out.description = "beamcast-server at " + args.server;
+
+  std::mutex mu;
+  std::deque<std::size_t> todo;  // first view of each batch not yet delivered
+  for (std::size_t at = 0; at < cams.size(); at += batch) todo.push_back(at);
+  std::size_t delivered = 0, in_flight = 0, batches = todo.size();
+  std::condition_variable changed;
+  std::string refusal;  // a server's error answer: the job's end
+
+  auto budget = std::make_shared<client::RetryBudget>();
+  const std::string scene_id = "render-" + std::to_string(::getpid());
+  const auto timeout = std::chrono::milliseconds(static_cast<long long>(args.timeout_s * 1000));
+  struct Worker {
+    std::string endpoint;
+    std::size_t batches = 0, frames = 0;
+    client::RetryStats stats;
+    std::string error;
+  };
+  std::vector<Worker> report;
+  std::vector<std::thread> threads;
+  const int per_endpoint = std::max(1, args.connections);
+  report.resize(endpoints.size() * static_cast<std::size_t>(per_endpoint));
+  for (std::size_t w = 0; w < report.size(); ++w) {
+    const client::Endpoint& ep = endpoints[w / static_cast<std::size_t>(per_endpoint)];
+    threads.emplace_back([&, w, ep] {
+      Worker& me = report[w];
+      client::ResilientOptions opts;
+      opts.connect_timeout = std::min(timeout, std::chrono::milliseconds(10000));
+      opts.receive_timeout = timeout;
+      opts.token = args.token;
+      opts.seed = w + 1;
+      client::ResilientClient c(ep, budget, opts);
+      me.endpoint = c.endpoint();
+      std::optional<std::size_t> mine;
+      try {
+        c.scene_put(scene_id, scene_json);
+        for (;;) {
+          {
+            // Idle workers wait while batches are out: one may come back.
+            std::unique_lock lock(mu);
+            changed.wait(lock, [&] { return !todo.empty() || in_flight == 0 || !refusal.empty(); });
+            if (todo.empty() || !refusal.empty()) break;
+            mine = todo.front();
+            todo.pop_front();
+            ++in_flight;
+          }
+          const std::size_t at = *mine;
+          const std::size_t count = std::min(batch, cams.size() - at);
+          client::RenderRequest req;
+          req.scene_id = scene_id;
+          req.encoding = args.encoding;
+          req.cameras = nlohmann::json::array();
+          for (std::size_t k = at; k < at + count; ++k) req.cameras.push_back(camera_to_json(cams[k]));
+          const auto t0 = Clock::now();
+          const client::RenderResult r = c.render(req);
+          if (!r.ok) {
+            std::lock_guard lock(mu);
+            refusal = me.endpoint + ": [" + r.error.code + "] " + r.error.path +
+                      (r.error.path.empty() ? "" : ": ") + r.error.message;
+            mine.reset();
+            --in_flight;
+            changed.notify_all();
+            break;
+          }
+          if (r.frames.size() != count) throw std::runtime_error("server sent a wrong number of frames");
+          deliver(at, r.frames, ms_since(t0));
+          mine.reset();
+          std::lock_guard lock(mu);
+          --in_flight;
+          delivered += 1;
+          me.batches += 1;
+          me.frames += count;
+          changed.notify_all();
+        }
+      } catch (const std::exception& e) {
+        // Its server is gone (after retries) or refused the scene: the batch
+        // goes back for the other workers.
+        std::lock_guard lock(mu);
+        me.error = e.what();
+        if (mine) {
+          todo.push_front(*mine);
+          --in_flight;
+        }
+        changed.notify_all();
+      }
+      me.stats = c.stats();
+    });
+  }
+  for (auto& t : threads) t.join();
+  // A worker that stopped before the queue drained leaves work: the others
+  // took it, unless every one failed.
+  std::string failures;
+  for (const Worker& w : report) {
+    out.servers.push_back({{"server", w.endpoint},
+                           {"batches", w.batches},
+                           {"frames", w.frames},
+                           {"retries", w.stats.retries},
+                           {"scene_reputs", w.stats.reputs},
+                           {"connections", w.stats.connections},
+                           {"error", w.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(w.error)}});
+    if (!w.error.empty()) failures += "\n  " + w.endpoint + ": " + w.error;
+  }
+  if (!refusal.empty()) {
+    out.error = "server refused the render: " + refusal;
+  } else if (delivered < batches) {
+    out.error = std::to_string(batches - delivered) + " of " + std::to_string(batches) +
+                " batches not rendered: every server failed" + failures;
+  }
+  return out;
+}
+
 }  // namespace
 
 int run_sequence(const SequenceArgs& args) {
@@ -95,6 +248,7 @@ int run_sequence(const SequenceArgs& args) {
   auto last = t0;
   std::size_t done = 0;
   std::string renderer_name;
+  nlohmann::json servers_json;  // with --server: frames, retries and errors per server
 
   // Per frame: the wall time since the previous batch completed, shared by the
   // batch's frames, plus the frame's own encode-and-write time.
@@ -128,51 +282,35 @@ int run_sequence(const SequenceArgs& args) {
       complete(at, count, write_ms);
     }
   } else {
-    client::Endpoint ep;
-    try {
-      ep = client::parse_endpoint(args.server);
-    } catch (const std::invalid_argument& e) {
-      throw CLI::ValidationError("--server", e.what());
+    nlohmann::json scene_json;
+    {
+      std::ifstream in(args.scene);
+      scene_json = nlohmann::json::parse(in);
     }
-    client::Client c;
-    const auto timeout = std::chrono::milliseconds(static_cast<long long>(args.timeout_s * 1000));
-    c.set_receive_timeout(timeout);
-    c.connect(ep.host, ep.port, std::min(timeout, std::chrono::milliseconds(10000)));
-    renderer_name = "beamcast-server at " + args.server;
-    std::ifstream in(args.scene);
-    const nlohmann::json scene_json = nlohmann::json::parse(in);
-    // Requests of `batch` cameras, one kept in flight ahead of the one awaited.
-    auto send_part = [&](std::size_t at) {
-      nlohmann::json cameras = nlohmann::json::array();
-      for (std::size_t k = at; k < std::min(n, at + batch); ++k) {
-        cameras.push_back(camera_to_json(cams[k]));
-      }
-      return c.send({{"method", "render"},
-                     {"params", {{"scene", scene_json}, {"cameras", cameras},
-                                 {"encoding", args.encoding}}}});
-    };
-    std::vector<nlohmann::json> ids;
-    for (std::size_t at = 0; at < n && ids.size() < 2; at += batch) ids.push_back(send_part(at));
-    for (std::size_t at = 0, next = 2 * batch; at < n; at += batch, next += batch) {
-      const client::Response r = c.receive_for(ids.front());
-      ids.erase(ids.begin());
-      if (next < n) ids.push_back(send_part(next));
-      if (!r.ok) {
-        progress.finish();
-        print_error("server", r.error);
-        return 2;
-      }
-      const auto frames = client::decode_frames(r);
-      const std::size_t count = std::min(batch, n - at);
-      if (frames.size() != count) throw std::runtime_error("server sent a wrong number of frames");
-      std::vector<double> write_ms(count);
-      for (std::size_t k = 0; k < count; ++k) {
-        const auto w0 = Clock::now();
-        write_bytes(frame_file(args.out, at + k), frames[k].png);
-        write_ms[k] = ms_since(w0);
-      }
-      complete(at, count, write_ms);
+    std::mutex mu;  // guards `complete` and the progress bar
+    const RemoteResult remote = render_on_servers(
+        args, scene_json, cams, batch,
+        [&](std::size_t at, const std::vector<client::RenderedFrame>& frames, double request_ms) {
+          std::vector<double> write_ms(frames.size());
+          for (std::size_t k = 0; k < frames.size(); ++k) {
+            const auto w0 = Clock::now();
+            write_bytes(frame_file(args.out, at + k), frames[k].png);
+            write_ms[k] = ms_since(w0);
+          }
+          std::lock_guard lock(mu);
+          for (std::size_t k = 0; k < frames.size(); ++k) {
+            frame_ms[at + k] = request_ms / static_cast<double>(frames.size()) + write_ms[k];
+          }
+          done += frames.size();
+          progress.update(static_cast<int>(done));
+        });
+    if (!remote.error.empty()) {
+      progress.finish();
+      std::fprintf(stderr, "beamcast: %s\n", remote.error.c_str());
+      return 2;
     }
+    renderer_name = remote.description;
+    servers_json = remote.servers;
   }
   progress.finish();
   const double total_s = ms_since(t0) / 1000.0;
@@ -185,6 +323,7 @@ int run_sequence(const SequenceArgs& args) {
                               {"files", files},
                               {"total_s", total_s},
                               {"frame_ms", {{"mean", t.mean}, {"p50", t.p50}, {"max", t.max}}}};
+    if (!servers_json.is_null()) summary["servers"] = servers_json;
     std::printf("%s\n", summary.dump(2).c_str());
   } else {
     std::printf("%zu frames (%dx%d) -> %s/frame_0000.png .. frame_%04zu.png in %.2f s\n", n,

@@ -15,6 +15,7 @@
 
 #include "cli/commands.hpp"
 #include "client/client.hpp"
+#include "client/resilient_client.hpp"
 
 namespace beamcast::cli {
 namespace {
@@ -82,8 +83,19 @@ int run_remote_render(const RemoteRenderArgs& args) {
     }
   }
 
-  Client c;
-  connect(c, args.server, args.timeout_s);
+  // Retried on a new connection if one drops (a server behind a balancer
+  // may die mid-render); a server's error answer is not retried.
+  client::Endpoint ep;
+  try {
+    ep = client::parse_endpoint(args.server);
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--server", e.what());
+  }
+  client::ResilientOptions opts;
+  opts.receive_timeout = std::chrono::milliseconds(static_cast<long long>(args.timeout_s * 1000));
+  opts.connect_timeout = std::min(opts.receive_timeout, std::chrono::milliseconds(10000));
+  opts.token = args.token;
+  client::ResilientClient c(ep, nullptr, opts);
   const client::RenderResult r = c.render(req);
   if (!r.ok) {
     print_error(r.error);

@@ -26,7 +26,12 @@ server's HTTP /health). Checks, each printed with its numbers:
      sent again within the budget (amplification <= 1.1, the issue's
      bound), and the p99 of the timeline's 250 ms buckets around the kill
      printed beside the steady ones (measured, not asserted: a timing bound
-     on a shared 2-core machine belongs to docs/deploy.md's record).
+     on a shared 2-core machine belongs to docs/deploy.md's record);
+  5. `beamcast render --rig orbit:36` split over the three servers
+     (--server A,B,C), with one of them killed mid-job, and through HAProxy
+     (--connections 3): each of the 36 frames byte-identical to the same
+     job on one server, every server given a share, the killed server's
+     unfinished batches rendered by the others.
 Plain python3; exits 0 only if every check passed.
 """
 import json
@@ -180,6 +185,67 @@ def load_failover(cluster, cli_bin, run_dir, check):
         for b in r["timeline"]), flush=True)
 
 
+def batch_render(cluster, cli_bin, run_dir, check):
+    """Check 5: one orbit job on one server, on three (one killed mid-job)
+    and through the balancer; the frames compared byte for byte."""
+    scene = os.path.join(ROOT, "examples", "paper_10sets.json")
+
+    def render(name, servers, extra=(), kill=None):
+        out = os.path.join(run_dir, name)
+        proc = subprocess.Popen([cli_bin, "render", scene, "--rig", "orbit:36", "--batch", "2",
+                                 "--server", servers, "--out", out, "--json", *extra],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        if kill is not None:
+            time.sleep(0.5)  # every worker holds a batch by then (the job takes ~2 s)
+            cluster.procs[kill].kill()
+        stdout, stderr = proc.communicate(timeout=120)
+        if proc.returncode != 0:
+            return None, f"exit {proc.returncode}: {stderr[-1500:]}", out
+        return json.loads(stdout), None, out
+
+    def frames(out):
+        result = []
+        for i in range(36):
+            with open(os.path.join(out, f"frame_{i:04d}.png"), "rb") as f:
+                result.append(f.read())
+        return result
+
+    one, err, out_one = render("one", f"127.0.0.1:{cluster.ports[0][0]}")
+    if err:
+        check("batch render on one server", False, err)
+        return
+    want = frames(out_one)
+    direct = ",".join(f"127.0.0.1:{p}" for p, _ in cluster.ports)
+    for name, servers, extra, kill in (("three", direct, (), 1),
+                                       ("balancer", f"127.0.0.1:{cluster.bcp_port}",
+                                        ("--connections", "3"), None)):
+        before = {k: v[1] for k, v in cluster.stat().items()}
+        res, err, out = render(name, servers, extra, kill)
+        spread = {k: v[1] - before.get(k, 0) for k, v in cluster.stat().items()}
+        if err:
+            check(f"batch render ({name})", False, err)
+            continue
+        got = frames(out)
+        same = sum(a == b for a, b in zip(want, got))
+        shares = [(w["server"], w["frames"], w["error"] is not None) for w in res["servers"]]
+        by_server = {}
+        for srv, n, _ in shares:
+            by_server[srv] = by_server.get(srv, 0) + n
+        detail = (f"{same}/36 frames byte-identical to one server's; frames per worker "
+                  f"(server, frames, failed) {shares}")
+        if kill is None:
+            # The server killed just before is down: the other two share it.
+            check("batch render through HAProxy equals one server's",
+                  same == 36 and sum(n > 0 for n in spread.values()) >= 2,
+                  detail + f"; HAProxy sessions per server {spread}")
+        else:
+            killed = f"127.0.0.1:{cluster.ports[kill][0]}"
+            others = [n for srv, n in by_server.items() if srv != killed]
+            failed = [f for srv, _, f in shares if srv == killed]
+            check("batch render over three servers, one killed mid-job, equals one server's",
+                  same == 36 and all(failed) and all(n > 0 for n in others), detail)
+
+
 def main():
     server_bin = sys.argv[1]
     cli_bin = sys.argv[2]
@@ -255,6 +321,7 @@ def main():
                   f"{after - before} of 30 sessions")
 
             load_failover(cluster, cli_bin, run_dir, check)
+            batch_render(cluster, cli_bin, run_dir, check)
         finally:
             cluster.stop()
     print(f"{'FAILED: ' + ', '.join(failed) if failed else 'all checks passed'}")
