@@ -181,9 +181,16 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
           me.frames += count;
           changed.notify_all();
         }
+      } catch (const client::RequestRefused& e) {
+        // A wrong token or a scene the server refuses: the same everywhere.
+        std::lock_guard lock(mu);
+        me.error = e.what();
+        refusal = e.what();
+        if (mine) --in_flight;
+        changed.notify_all();
       } catch (const std::exception& e) {
-        // Its server is gone (after retries) or refused the scene: the batch
-        // goes back for the other workers.
+        // Its server is gone (after retries): the batch goes back for the
+        // other workers.
         std::lock_guard lock(mu);
         me.error = e.what();
         if (mine) {
@@ -210,7 +217,7 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
     if (!w.error.empty()) failures += "\n  " + w.endpoint + ": " + w.error;
   }
   if (!refusal.empty()) {
-    out.error = "server refused the render: " + refusal;
+    out.error = "refused: " + refusal;
   } else if (delivered < batches) {
     out.error = std::to_string(batches - delivered) + " of " + std::to_string(batches) +
                 " batches not rendered: every server failed" + failures;

@@ -37,7 +37,7 @@ struct Client::Io {
       socket.close(ignored);
       ctx.restart();
       ctx.run();
-      throw std::runtime_error(what + ": timed out");
+      throw TransportTimeout(what + ": timed out");
     }
   }
 };

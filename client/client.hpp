@@ -16,6 +16,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -93,6 +94,15 @@ struct RenderResult {
 };
 
 // --- the client ---
+
+// A network wait that ran past its deadline (connect or receive): thrown by
+// Client as this subclass of std::runtime_error, so callers that retry can
+// tell "no answer" (retrying waits as long again) from a refused or dropped
+// connection.
+class TransportTimeout : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 class Client {
  public:

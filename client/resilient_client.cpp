@@ -78,6 +78,13 @@ auto ResilientClient::attempt(F&& fn) -> decltype(fn(std::declval<Client&>())) {
       return fn(connection());
     } catch (const RequestRefused&) {
       throw;
+    } catch (const TransportTimeout& e) {
+      // No answer within the deadline: a retry would wait as long again (and
+      // a slow render would run twice). A server that hangs is taken out by
+      // the balancer's health checks, which cuts this connection: that drop
+      // is retried.
+      client_.reset();
+      throw TransportTimeout(std::string(e.what()) + " (not retried)");
     } catch (const std::runtime_error& e) {
       // The connection dropped, could not be made, timed out or spoke
       // nonsense: this one is done with; another may land elsewhere.

@@ -82,7 +82,8 @@ struct RetryStats {
 // One connection at a time to one endpoint (a server or a balancer), opened on
 // first use and again after a transport failure. Idempotent requests (ping,
 // scene.put of the same content, render) are sent again on a new connection
-// when the connection drops, cannot be made or times out, after backoff_delay,
+// when the connection drops or cannot be made (not when a wait times out:
+// TransportTimeout is thrown at once), after backoff_delay,
 // while the attempts last and the shared budget allows; then the last
 // transport error is thrown (std::runtime_error naming the endpoint and the
 // attempts). A render by scene_id answered unknown_scene puts the scene this

@@ -431,6 +431,24 @@ TEST(ResilientClient, AWrongTokenIsRefusedNotRetried) {
   EXPECT_EQ(c.stats().retries, 0u);
 }
 
+TEST(ResilientClient, ATimeoutIsReportedNotRetried) {
+  FakePeer peer([](int fd) {
+    read_request(fd);
+    read_request(fd);  // never answers; returns when the client closes
+  });
+  ResilientOptions o = fast_retries();
+  o.receive_timeout = std::chrono::milliseconds(200);
+  ResilientClient c({"127.0.0.1", peer.port()}, std::make_shared<RetryBudget>(), o);
+  try {
+    c.ping();
+    ADD_FAILURE() << "a silent server must time out";
+  } catch (const TransportTimeout& e) {
+    EXPECT_NE(std::string(e.what()).find("timed out (not retried)"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(c.stats().connections, 1u);
+  EXPECT_EQ(c.stats().retries, 0u);
+}
+
 TEST(RetryBudget, RetriesAreATenthOfRequestsPlusTheBurst) {
   RetryBudget b(0.1, 10.0);
   int granted = 0;
