@@ -171,7 +171,8 @@ class RetryBudget:
 class ResilientClient:
     """A client for a server or a load balancer in front of several
     (docs/deploy.md): idempotent requests (render, ping, scene.put) are sent
-    again on a new connection when the connection drops or cannot be made,
+    again on a new connection when the connection drops or cannot be made
+    (not when an answer times out: that is raised at once),
     after an exponential backoff with full jitter (base_s x 2^attempt,
     capped at cap_s), while the shared RetryBudget allows; a render by
     scene_id that lands on a server without the scene (unknown_scene) puts
@@ -179,7 +180,7 @@ class ResilientClient:
     more. Counts requests, retries and re-puts. One connection at a time,
     not thread-safe: one per thread, sharing a budget."""
 
-    RETRIABLE = (ConnectionError, OSError, socket.timeout, struct.error)
+    RETRIABLE = (ConnectionError, OSError, struct.error)
 
     def __init__(self, host, port, timeout=60.0, budget=None, base_s=0.02, cap_s=1.0,
                  max_attempts=5, rng=None):
@@ -212,6 +213,13 @@ class ResilientClient:
                 if self.client is None:
                     self.client = BeamcastClient(self.host, self.port, self.timeout)
                 return fn(self.client)
+            except socket.timeout:
+                # No answer within the deadline: a retry would wait as long
+                # again (and run a slow render twice); a hung server is taken
+                # out by the balancer, which cuts the connection: that drop
+                # is retried.
+                self.close()
+                raise
             except self.RETRIABLE:
                 self.close()
                 attempt += 1
