@@ -6,6 +6,12 @@
 // pixels, default 512), budget (frame-time budget in ms, default 33), still
 // (ms of rest before the full-accuracy frame, default 300), inflight (requests
 // kept in flight, default 2).
+//
+// Behind HAProxy (deploy/haproxy.cfg.in, `balance url_param scene`) a session
+// sticks to one server by the `scene` query parameter, so the WebSocket and the
+// /api requests carry the selected scene's. A lost WebSocket (its server died
+// or drained) is reopened with backoff; the new one may reach another server,
+// so the page stores its scene again and asks for the current view.
 'use strict';
 
 const params = new URLSearchParams(location.search);
@@ -22,14 +28,22 @@ const picker = document.getElementById('scene');
 canvas.width = size;
 canvas.height = size;
 
-// State the browser test reads (tests/preview/preview_test.mjs).
+// State the browser tests read (tests/preview/preview_test.mjs, haproxy_test.mjs).
 const preview = {
-  frames: [],          // one entry per frame drawn: {t, latency_ms, level, still, format, ...}
+  frames: [],          // one entry per frame drawn: {t, latency_ms, level, still, format, socket, ...}
   lastStill: null,     // {camera, bytes (Uint8Array PNG)} of the latest full-accuracy frame
   sceneId: null,
   ready: false,
   errors: [],
   camera: null,        // the camera of the latest request
+  state: 'connecting', // 'connected' while a WebSocket is open, else 'connecting' or 'reconnecting'
+  sockets: 0,          // WebSockets opened; a frame's `socket` is the one it came on (1, 2, ...)
+  connectedAt: null,   // performance.now() of the latest open
+  closedAt: null,      // performance.now() of the latest loss of an open WebSocket
+  disconnects: 0,      // open WebSockets lost
+  reconnects: 0,       // WebSockets opened again after a loss
+  failedAttempts: 0,   // connection attempts that closed before opening
+  abandoned: 0,        // requests whose WebSocket closed before their answer
 };
 window.beamcastPreview = preview;
 
@@ -42,16 +56,42 @@ let lastSentKey = null;
 let lastSentAt = 0;
 let lastChangeAt = 0;       // when the pose last changed
 let stillKey = null;        // pose of the latest still frame
+let resumed = false;        // the view was kept across a reconnection and is not requested yet
 let inflight = 0;
 let drawing = Promise.resolve();
+let started = false;        // the picker is filled and the animation loop runs
+let viewOf = null;          // the picker value whose view `orbit` holds
+let selectSeq = 0;          // the latest selectScene call; earlier ones give way
+let attempt = 0;            // connection attempts since a scene was last established
 
-function setStatus(text, error) {
-  statusEl.textContent = text;
-  statusEl.className = error ? 'error' : '';
-  if (error) preview.errors.push(text);
+// Backoff before connection attempt n (0, 1, ...): 100 ms doubling to a 2 s
+// cap, uniform in [half, whole] so pages that lost the same server do not all
+// come back in step; while no server answers, a page tries every 1-2 s.
+function backoffMs(n) {
+  const d = Math.min(2000, 100 * 2 ** n);
+  return d / 2 + Math.random() * d / 2;
 }
 
+// kind: '' (information), 'warn' (a passing state, such as reconnecting) or
+// 'error' (kept in preview.errors for the tests).
+function setStatus(text, kind = '') {
+  statusEl.textContent = text;
+  statusEl.className = kind;
+  if (kind === 'error') preview.errors.push(text);
+}
+
+const disconnected = () => ({code: 'disconnected', message: 'the WebSocket closed'});
+
+// The selected scene's name as the page URL spells it (a stored id or an
+// example's file name): the key HAProxy's url_param balancing hashes.
+function sceneKey() {
+  if (picker.value) return picker.value.slice(picker.value.indexOf(':') + 1);
+  return params.get('scene');
+}
+const withScene = (path) => (sceneKey() ? `${path}?scene=${encodeURIComponent(sceneKey())}` : path);
+
 function request(method, params) {
+  if (!ws || ws.readyState !== WebSocket.OPEN) return Promise.reject(disconnected());
   const id = nextId++;
   return new Promise((resolve, reject) => {
     pending.set(id, {resolve, reject, sent: performance.now()});
@@ -59,14 +99,37 @@ function request(method, params) {
   });
 }
 
+// Rejects the requests of a WebSocket that closed: their answers will never
+// come, and the renders among them hold `inflight` until they settle.
+function failPending() {
+  const a = awaitingBinary;
+  const all = [...pending.values()];
+  awaitingBinary = null;
+  pending.clear();
+  preview.abandoned += all.length + (a ? 1 : 0);
+  if (a) a.fail(disconnected());
+  for (const p of all) p.reject(disconnected());
+}
+
 function connect() {
-  const url = (location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + '/ws';
-  ws = new WebSocket(url);
-  ws.binaryType = 'arraybuffer';
-  ws.onopen = () => { setStatus('connected'); start(); };
-  ws.onclose = () => setStatus('disconnected (reload to reconnect)', true);
-  ws.onerror = () => setStatus('WebSocket error', true);
-  ws.onmessage = (ev) => {
+  const url = (location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + withScene('/ws');
+  const sock = new WebSocket(url);
+  ws = sock;
+  sock.binaryType = 'arraybuffer';
+  sock.onopen = () => {
+    if (sock !== ws) return;
+    if (preview.disconnects > 0) ++preview.reconnects;
+    ++preview.sockets;
+    preview.state = 'connected';
+    preview.connectedAt = performance.now();
+    setStatus('connected');
+    establish(sock);
+  };
+  sock.onclose = () => { if (sock === ws) lost(); };
+  // An error is always followed by a close, which reconnects.
+  sock.onerror = () => {};
+  sock.onmessage = (ev) => {
+    if (sock !== ws) return;
     if (typeof ev.data !== 'string') {
       // Attachments of the previous response.
       if (awaitingBinary) { const a = awaitingBinary; awaitingBinary = null; a.finish(new Uint8Array(ev.data)); }
@@ -74,19 +137,37 @@ function connect() {
     }
     const msg = JSON.parse(ev.data);
     const p = pending.get(msg.id);
-    if (!p) { if (!msg.ok) setStatus(msg.error.code + ': ' + msg.error.message, true); return; }
+    if (!p) { if (!msg.ok) setStatus(msg.error.code + ': ' + msg.error.message, 'error'); return; }
     pending.delete(msg.id);
     const hasAttachments = msg.ok && msg.result && Array.isArray(msg.result.frames) &&
         msg.result.frames.some((f) => f.attachment && f.attachment.length > 0);
     const received = performance.now();
     if (hasAttachments) {
-      awaitingBinary = {finish: (bytes) => p.resolve({msg, bytes, sent: p.sent, received})};
+      awaitingBinary = {finish: (bytes) => p.resolve({msg, bytes, sent: p.sent, received}),
+                        fail: p.reject};
     } else if (msg.ok) {
       p.resolve({msg, bytes: null, sent: p.sent, received});
     } else {
       p.reject(msg.error);
     }
   };
+}
+
+// A WebSocket closed, or an attempt failed: the next attempt after the backoff.
+function lost() {
+  if (preview.state === 'connected') {
+    ++preview.disconnects;
+    preview.closedAt = performance.now();
+  } else {
+    ++preview.failedAttempts;
+  }
+  preview.state = preview.disconnects > 0 ? 'reconnecting' : 'connecting';
+  // Nothing is rendered until the scene is established on the next WebSocket.
+  preview.ready = false;
+  preview.sceneId = null;
+  failPending();
+  setStatus(preview.disconnects > 0 ? 'reconnecting…' : 'connecting…', 'warn');
+  setTimeout(connect, backoffMs(attempt++));
 }
 
 // --- camera -----------------------------------------------------------------
@@ -183,12 +264,14 @@ canvas.addEventListener('wheel', (e) => {
 
 // --- frames -----------------------------------------------------------------
 
-function renderRequest(camera) {
-  return {scene_id: preview.sceneId, cameras: [camera], quality: 'auto', budget_ms: budgetMs,
-          still_ms: stillMs};
+function renderRequest(camera, motion) {
+  const r = {scene_id: preview.sceneId, cameras: [camera], quality: 'auto', budget_ms: budgetMs,
+             still_ms: stillMs};
+  if (motion) r.motion = motion;
+  return r;
 }
 
-async function show(res, camera) {
+async function show(res, camera, socket) {
   const {msg, bytes, sent, received} = res;
   const r = msg.result;
   const f = r.frames[0];
@@ -202,7 +285,7 @@ async function show(res, camera) {
   preview.frames.push({
     t: now, latency_ms: received - sent, level: q.level, levels: q.levels, still: !!q.still,
     reason: q.reason, label: q.label, scale: q.scale, format: f.format, bytes: data.length,
-    server_ms: r.timings.server_ms, passes: r.passes,
+    server_ms: r.timings.server_ms, passes: r.passes, socket,
   });
   if (q.still) {
     preview.lastStill = {camera, bytes: data.slice()};
@@ -244,65 +327,118 @@ function maybeSend() {
   const camera = cameraFromOrbit(orbit);
   const key = JSON.stringify(camera);
   const now = performance.now();
-  if (key === lastSentKey) {
+  if (key === lastSentKey && !resumed) {
     // Camera at rest: once it has been still for still_ms, ask for the frame
     // again; the server (which times the motion itself) answers with the
     // full-accuracy frame, or with "settling" if it is early, and then we
     // retry shortly. Nothing is sent while a button is held on a resting camera.
     if (drag || key === stillKey || inflight > 0) return;
     if (now - lastChangeAt < stillMs || now - lastSentAt < 40) return;
-  } else {
+  } else if (key !== lastSentKey) {
     lastChangeAt = now;
   }
+  // The server behind a new WebSocket has seen no motion, and would answer
+  // its first request with a full-accuracy frame: in the middle of a drag
+  // that holds the picture for a full frame's time, so say it is moving.
+  const motion = resumed && (drag || now - lastChangeAt < stillMs) ? 'moving' : undefined;
+  resumed = false;
   lastSentKey = key;
   lastSentAt = now;
   preview.camera = camera;
   ++inflight;
-  const req = request('render', renderRequest(camera));
+  const socket = preview.sockets;
+  const req = request('render', renderRequest(camera, motion));
+  // Handled here, although the chain below reaches it only after the earlier
+  // frames: a lost WebSocket rejects it at once.
+  req.catch(() => {});
   // Draw in arrival order, one at a time.
-  drawing = drawing.then(() => req).then((res) => show(res, camera))
-      .catch((e) => setStatus(`render: ${e.code || ''} ${e.message || e}`, true))
+  drawing = drawing.then(() => req).then((res) => show(res, camera, socket))
+      .catch((e) => {
+        // A lost WebSocket is the reconnection's to mend, not an error of the frame.
+        if (e.code !== 'disconnected') setStatus(`render: ${e.code || ''} ${e.message || e}`, 'error');
+      })
       .finally(() => { --inflight; maybeSend(); });
 }
 
+// GET of the page's JSON API, from the server the scene's key leads to. A 404
+// is an answer (no such scene there); other failures (a balancer with no
+// server up answers 502 or 503) are worth another attempt.
+async function getJson(path) {
+  const res = await fetch(withScene(path));
+  if (res.status === 404) throw {code: 'not_found', message: `${path} is not on this server`};
+  if (!res.ok) throw new Error(`${path}: HTTP ${res.status}`);
+  return res.json();
+}
+
+// Makes `value` (a picker value) the scene rendered on this WebSocket: an
+// example is stored on the server first. The view is the scene's first camera,
+// except when the same scene is established again after a reconnection, where
+// the user's view is kept and requested anew.
 async function selectScene(value) {
+  const seq = ++selectSeq;
   preview.ready = false;
   preview.sceneId = null;
-  stillKey = lastSentKey = null;
-  let json;
+  stillKey = null;
+  let json, id;
   if (value.startsWith('example:')) {
     const name = value.slice(8);
-    json = await (await fetch('/api/examples/' + encodeURIComponent(name))).json();
-    const id = 'example.' + name.replace(/\.json$/, '').replace(/[^A-Za-z0-9_.-]/g, '_');
+    json = await getJson('/api/examples/' + encodeURIComponent(name));
+    id = 'example.' + name.replace(/\.json$/, '').replace(/[^A-Za-z0-9_.-]/g, '_');
     await request('scene.put', {scene_id: id, scene: json});
-    preview.sceneId = id;
   } else {
-    const id = value.slice(7);
-    json = await (await fetch('/api/scenes/' + encodeURIComponent(id))).json();
-    preview.sceneId = id;
+    id = value.slice(7);
+    json = await getJson('/api/scenes/' + encodeURIComponent(id));
   }
-  const cams = json.cameras || [];
-  orbit = orbitFromCamera(cams[0] || {});
-  setStatus(`scene ${preview.sceneId}`);
+  if (seq !== selectSeq) return;  // a later pick or reconnection took over
+  preview.sceneId = id;
+  if (viewOf !== value) {
+    const cams = json.cameras || [];
+    orbit = orbitFromCamera(cams[0] || {});
+    viewOf = value;
+    lastSentKey = null;
+  } else {
+    resumed = true;
+  }
+  setStatus(`connected · scene ${preview.sceneId}`);
   preview.ready = true;
 }
 
-async function start() {
+// On every open WebSocket: the first time fills the picker and starts the
+// animation loop; every time establishes the selected scene.
+async function establish(sock) {
   try {
-    const list = await (await fetch('/api/scenes')).json();
-    picker.innerHTML = '';
-    for (const id of list.stored) picker.add(new Option('stored: ' + id, 'stored:' + id));
-    for (const name of list.examples) picker.add(new Option('example: ' + name, 'example:' + name));
-    const want = params.get('scene');
-    if (want) {
-      const v = list.stored.includes(want) ? 'stored:' + want : 'example:' + want;
-      picker.value = v;
+    if (!started) {
+      const list = await getJson('/api/scenes');
+      picker.innerHTML = '';
+      for (const id of list.stored) picker.add(new Option('stored: ' + id, 'stored:' + id));
+      for (const name of list.examples) picker.add(new Option('example: ' + name, 'example:' + name));
+      const want = params.get('scene');
+      if (want) {
+        const v = list.stored.includes(want) ? 'stored:' + want : 'example:' + want;
+        picker.value = v;
+      }
+      picker.onchange = () => selectScene(picker.value).catch((e) => {
+        // Without a WebSocket the reconnection establishes the picked scene.
+        if (e.code !== 'disconnected') setStatus(String(e.message || e), 'error');
+      });
+      started = true;
+      requestAnimationFrame(tick);
     }
-    picker.onchange = () => selectScene(picker.value).catch((e) => setStatus(String(e.message || e), true));
     if (picker.value) await selectScene(picker.value);
-    requestAnimationFrame(tick);
+    attempt = 0;
   } catch (e) {
-    setStatus('start: ' + (e.message || e), true);
+    if (e.code === 'disconnected') return;  // the close already scheduled the next attempt
+    if (e.code) {
+      // The server refused the scene or has none by that name: another
+      // attempt would get the same answer.
+      setStatus(`scene: ${e.code}: ${e.message}`, 'error');
+      return;
+    }
+    // A fetch failed: start over on a new WebSocket, after the backoff.
+    if (sock === ws && sock.readyState === WebSocket.OPEN) {
+      console.warn('preview: ' + (e.message || e) + '; reconnecting');
+      sock.close();
+    }
   }
 }
 

@@ -9,12 +9,12 @@
 //
 // node preview_test.mjs --server BIN --cli BIN --artifacts DIR
 //     [--scene demo] [--size 512] [--drag-ms 2000] [--budget 33]
-import {chromium} from 'playwright-core';
 import {spawn, execFileSync} from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import readline from 'node:readline';
+import {launchBrowser, pointerMoves, requireChromium} from './browser.mjs';
 import {decodePng} from './png.mjs';
 
 const argv = process.argv.slice(2);
@@ -47,11 +47,7 @@ if (!serverBin || !cliBin) {
   console.error('usage: preview_test.mjs --server BIN --cli BIN --artifacts DIR');
   process.exit(2);
 }
-if (!fs.existsSync('/usr/bin/chromium')) {
-  // Not a skip: CI installs it (scripts/install-deps.sh).
-  console.error('FAIL /usr/bin/chromium is missing (apt package chromium; scripts/install-deps.sh)');
-  process.exit(1);
-}
+requireChromium();
 fs.mkdirSync(artifacts, {recursive: true});
 
 function startServer() {
@@ -83,13 +79,7 @@ const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'beamcast-preview-'));
 try {
   server = await startServer();
   console.log(`server: ${server.url}`);
-  context = await chromium.launchPersistentContext(userDataDir, {
-    executablePath: '/usr/bin/chromium',
-    headless: true,
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-           '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-    viewport: {width: size + 100, height: size + 120},
-  });
+  context = await launchBrowser(userDataDir, size);
   const page = context.pages()[0] || await context.newPage();
   page.on('console', (m) => { if (m.type() === 'error') console.log(`page error: ${m.text()}`); });
   page.on('pageerror', (e) => console.log(`page exception: ${e.message}`));
@@ -103,25 +93,7 @@ try {
   // Drag: a smooth orbit, one pointer move per ~16 ms (a 60 Hz mouse).
   const box = await page.locator('#canvas').boundingBox();
   const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
-  // The button goes down and up through Playwright (trusted input); the
-  // moves in between are pointer events dispatched in the page every 16 ms,
-  // as a 60 Hz mouse delivers them: one CDP round trip per move would be
-  // slower than that on a loaded machine and would cap the frame rate.
-  const dragFor = (ms, radius) => page.evaluate(({ms, radius, cx, cy}) => new Promise((done) => {
-    const canvas = document.getElementById('canvas');
-    const start = performance.now();
-    const timer = setInterval(() => {
-      const t = performance.now() - start;
-      const a = (1.5 * Math.PI * t) / ms;  // ends away from the start pose
-      canvas.dispatchEvent(new PointerEvent('pointermove', {
-        clientX: cx + radius * Math.sin(a), clientY: cy + 0.4 * radius * Math.sin(2 * a),
-        pointerId: 1, bubbles: true, buttons: 1}));
-      if (t >= ms) {
-        clearInterval(timer);
-        done();
-      }
-    }, 16);
-  }), {ms, radius, cx, cy});
+  const dragFor = (ms, radius) => pointerMoves(page, ms, radius, cx, cy);
   // Warm-up: a short drag builds the cheap levels' tables (a one-time cost
   // per scene and render worker), then rest until the still frame is back.
   await page.mouse.move(cx, cy);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Runs the preview page's browser test: installs playwright-core (pinned by
-# package-lock.json, into tests/preview/node_modules, never a browser) if it
-# is not there yet, then drives Debian's /usr/bin/chromium.
+# Runs a browser test of the preview page (preview_test.mjs, or the script
+# named first: run.sh haproxy_test.mjs ...): installs playwright-core (pinned
+# by package-lock.json, into tests/preview/node_modules, never a browser) if
+# it is not there yet, then drives Debian's /usr/bin/chromium.
 # Missing node, npm or chromium is a failure, not a skip.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -12,4 +13,6 @@ if [ ! -f "$here/node_modules/playwright-core/package.json" ]; then
   # PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD: playwright-core downloads nothing, but be explicit.
   (cd "$here" && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error)
 fi
-exec node "$here/preview_test.mjs" "$@"
+script=preview_test.mjs
+if [[ "${1:-}" == *.mjs ]]; then script="$1"; shift; fi
+exec node "$here/$script" "$@"

@@ -1,0 +1,47 @@
+// Shared by the preview page's browser tests: Debian's headless chromium
+// through playwright-core (no browser is downloaded), and the page's errors.
+import {chromium} from 'playwright-core';
+import fs from 'node:fs';
+
+export function requireChromium() {
+  if (!fs.existsSync('/usr/bin/chromium')) {
+    // Not a skip: CI installs it (scripts/install-deps.sh).
+    console.error('FAIL /usr/bin/chromium is missing (apt package chromium; scripts/install-deps.sh)');
+    process.exit(1);
+  }
+}
+
+// A persistent context (a fresh profile in userDataDir) with a viewport that
+// holds a size x size canvas and the page's header and footer.
+export function launchBrowser(userDataDir, size) {
+  return chromium.launchPersistentContext(userDataDir, {
+    executablePath: '/usr/bin/chromium',
+    headless: true,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+           '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+    viewport: {width: size + 100, height: size + 120},
+  });
+}
+
+// Pointer moves over the canvas for `ms`, centred on (cx, cy): the button goes
+// down and up through Playwright (trusted input) around this; the moves in
+// between are pointer events dispatched in the page every 16 ms, as a 60 Hz
+// mouse delivers them: one CDP round trip per move would be slower than that
+// on a loaded machine and would cap the frame rate.
+export function pointerMoves(page, ms, radius, cx, cy) {
+  return page.evaluate(({ms, radius, cx, cy}) => new Promise((done) => {
+    const canvas = document.getElementById('canvas');
+    const start = performance.now();
+    const timer = setInterval(() => {
+      const t = performance.now() - start;
+      const a = (1.5 * Math.PI * t) / ms;  // ends away from the start pose
+      canvas.dispatchEvent(new PointerEvent('pointermove', {
+        clientX: cx + radius * Math.sin(a), clientY: cy + 0.4 * radius * Math.sin(2 * a),
+        pointerId: 1, bubbles: true, buttons: 1}));
+      if (t >= ms) {
+        clearInterval(timer);
+        done();
+      }
+    }, 16);
+  }), {ms, radius, cx, cy});
+}
