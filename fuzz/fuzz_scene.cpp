@@ -28,6 +28,24 @@ void check_scene(const beamcast::Scene& s, const beamcast::SceneLimits& l) {
   for (const beamcast::Beam& b : s.beams) {
     FUZZ_CHECK(std::isfinite(b.radius) && b.radius > 0.0);
   }
+  // Volumes: what the ray caster and the GPU packing index and divide by.
+  FUZZ_CHECK(static_cast<int>(s.volumes.size()) <= beamcast::kMaxVolumes);
+  std::int64_t voxels = 0;
+  for (const beamcast::Volume& v : s.volumes) {
+    FUZZ_CHECK(v.grid != nullptr);
+    for (int n : v.grid->dims) FUZZ_CHECK(n >= 2 && n <= beamcast::kMaxVolumeDimension);
+    FUZZ_CHECK(static_cast<std::int64_t>(v.grid->values.size()) == v.grid->voxels());
+    voxels += v.grid->voxels();
+    for (int a = 0; a < 3; ++a) FUZZ_CHECK(std::isfinite(v.spacing[a]) && v.spacing[a] > 0.0);
+    FUZZ_CHECK(v.range[0] < v.range[1] && std::isfinite(v.range[1] - v.range[0]));
+    FUZZ_CHECK(v.transfer.points.size() >= 2 && v.transfer.opacity_unit > 0.0);
+    for (std::size_t i = 1; i < v.transfer.points.size(); ++i) {
+      FUZZ_CHECK(v.transfer.points[i].value > v.transfer.points[i - 1].value);
+    }
+  }
+  FUZZ_CHECK(voxels <= beamcast::kMaxVolumeVoxels);
+  FUZZ_CHECK(s.volume.level >= 0 && s.volume.level <= beamcast::kMaxVolumeLevel);
+  FUZZ_CHECK(s.volume.samples_per_voxel > 0.0 && s.volume.samples_per_voxel <= 64.0);
 }
 
 }  // namespace

@@ -83,6 +83,15 @@ write("fuzz_scene", "occluders", compact(dict(small, occluders=[
     {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1]},
     {"type": "sphere", "center": [0, 0, 0], "radius": 0.5},
     {"type": "mesh", "file": "meshes/torus.obj", "scale": [1, 2, 1]}])))
+write("fuzz_scene", "procedural_volumes", compact({
+    "volumes": [
+        {"source": {"type": "marschner_lobb", "resolution": 9}, "transfer": {"preset": "ml"}},
+        {"source": {"type": "heat", "resolution": 5}, "spacing": 0.25, "rotation": [1, 0, 0, 1],
+         "range": [0.1, 0.9], "transfer": {"points": [[0, 0, 0, 0, 0], [0.5, 1, 0.5, 0.2, 0.3],
+                                                      [1, 1, 1, 1, 0.9]], "opacity_unit": 0.05},
+         "intensity": 2}],
+    "volume": {"samples_per_voxel": 1, "level": 1, "pyramid": "max"},
+    "cameras": [dict(scenes["volume_ml"]["cameras"][0], width=16, height=16)]}))
 
 # fuzz_obj: byte 0 picks transform and limits.
 torus = (ROOT / "examples" / "meshes" / "torus.obj").read_bytes()

@@ -65,38 +65,40 @@ Vec3 MeshTransform::apply(const Vec3& v) const {
 }
 
 fs::path resolve_asset_path(const fs::path& assets_dir, const std::string& file,
-                            const std::string& json_path) {
+                            const std::string& json_path, std::string_view what) {
+  const std::string kind(what);
   if (assets_dir.empty()) {
     fail("forbidden_path", json_path,
-         "mesh files are disabled here (no assets directory configured), cannot load \"" + file +
-             "\"");
+         kind + " files are disabled here (no assets directory configured), cannot load \"" +
+             file + "\"");
   }
   if (file.find('\0') != std::string::npos) {
-    fail("forbidden_path", json_path, "mesh path must not contain NUL characters");
+    fail("forbidden_path", json_path, kind + " path must not contain NUL characters");
   }
   const fs::path rel(file);
   if (rel.is_absolute() || rel.has_root_name() || rel.has_root_directory()) {
     fail("forbidden_path", json_path,
-         "mesh path must be relative to the assets directory, got absolute path \"" + file + "\"");
+         kind + " path must be relative to the assets directory, got absolute path \"" + file +
+             "\"");
   }
   for (const auto& part : rel) {
     if (part == "..") {
       fail("forbidden_path", json_path,
-           "mesh path must not contain \"..\" components, got \"" + file + "\"");
+           kind + " path must not contain \"..\" components, got \"" + file + "\"");
     }
   }
   const fs::path full = assets_dir / rel;
   std::error_code ec;
   if (!fs::is_regular_file(full, ec)) {
     fail("file_not_found", json_path,
-         "mesh file \"" + file + "\" was not found in the assets directory");
+         kind + " file \"" + file + "\" was not found in the assets directory");
   }
   // Symlinks inside the assets directory must not lead out of it.
   const fs::path root = fs::canonical(assets_dir, ec);
   const fs::path target = ec ? fs::path() : fs::canonical(full, ec);
   if (ec || !is_within(root, target)) {
     fail("forbidden_path", json_path,
-         "mesh path \"" + file + "\" resolves to a file outside the assets directory");
+         kind + " path \"" + file + "\" resolves to a file outside the assets directory");
   }
   return full;
 }

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 #include "protocol/scene.hpp"
 
@@ -30,9 +31,11 @@ struct MeshLoadLimits {
 // The file named `file` (as written in the scene) below `assets_dir`. Refuses
 // (code "forbidden_path") an empty assets_dir, absolute paths, ".." components
 // and paths that leave assets_dir through a symlink; "file_not_found" if it is
-// not a readable regular file. `json_path` is the pointer reported in errors.
+// not a readable regular file. `json_path` is the pointer reported in errors;
+// `what` names the kind of file in messages ("mesh", "volume").
 std::filesystem::path resolve_asset_path(const std::filesystem::path& assets_dir,
-                                         const std::string& file, const std::string& json_path);
+                                         const std::string& file, const std::string& json_path,
+                                         std::string_view what = "mesh");
 
 // Parses OBJ text (materials and "mtllib" are ignored), triangulates polygons,
 // transforms vertices to world space. Throws "bad_mesh" (parse error, index

@@ -18,6 +18,7 @@
 #include "protocol/medium.hpp"
 #include "protocol/occluders/occluders.hpp"
 #include "protocol/vec.hpp"
+#include "protocol/volume.hpp"
 
 namespace beamcast {
 
@@ -241,6 +242,10 @@ struct Scene {
   // regions of heterogeneous medium ("media") added to it.
   std::optional<Medium> medium;
   std::vector<MediumRegion> media;
+  // Scalar volumes ray cast with transfer functions ("volumes"; issue 17)
+  // and the ray caster's accuracy knobs ("volume").
+  std::vector<Volume> volumes;
+  VolumeSettings volume;
 
   // Global illumination runs when a light of "lights" lights the scene;
   // otherwise the directional light shades it.

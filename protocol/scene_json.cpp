@@ -833,7 +833,7 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   ObjectReader o(root, "a scene");
   o.allow_only(
       {"version", "background", "light", "lights", "gi", "beams", "occluders", "cameras", "output",
-       "render", "slim", "medium", "media"});
+       "render", "slim", "medium", "media", "volumes", "volume"});
   Scene scene;
   if (auto v = o.optional("version")) {
     const std::int64_t version = read_integer(*v);
@@ -848,6 +848,7 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   if (auto v = o.optional("render")) scene.render = parse_render(*v, limits);
   if (auto v = o.optional("slim")) scene.slim = parse_slim_settings(*v);
   if (auto v = o.optional("medium")) scene.medium = parse_medium(*v);
+  if (auto v = o.optional("volume")) scene.volume = parse_volume_settings(*v);
   if (auto v = o.optional("media")) {
     std::int64_t mesh_triangles = 0;
     for (const Node& r : read_array(*v, kMaxMediumRegions, "max_medium_regions")) {
@@ -885,6 +886,14 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   const Node cameras = o.required("cameras");
   scene.cameras = parse_camera_list(cameras.json(), cameras.path, limits);
   check_method_fits_densities(scene);
+  // Last: reading volume files is the costliest step, so a scene with a
+  // cheaper mistake is refused without it.
+  if (auto v = o.optional("volumes")) {
+    std::int64_t voxels = 0;
+    for (const Node& e : read_array(*v, kMaxVolumes, "max_volumes")) {
+      scene.volumes.push_back(parse_volume(e, opts, &voxels));
+    }
+  }
   return scene;
 }
 
@@ -920,6 +929,15 @@ Scene load_scene_file(const std::filesystem::path& file, const SceneLoadOptions&
   return parse_scene(j, opts);
 }
 
+namespace {
+
+template <std::size_t N>
+std::vector<std::string_view> names(const std::string_view (&list)[N]) {
+  return {std::begin(list), std::end(list)};
+}
+
+}  // namespace
+
 nlohmann::json scene_capabilities() {
   json densities = density_names();
   densities.push_back("table");
@@ -942,7 +960,26 @@ nlohmann::json scene_capabilities() {
           {"medium_region_fields", std::vector<std::string_view>(std::begin(kMediumRegionFields),
                                                                  std::end(kMediumRegionFields))},
           {"medium_region_types", std::vector<std::string_view>(std::begin(kMediumRegionTypes),
-                                                                std::end(kMediumRegionTypes))}};
+                                                                std::end(kMediumRegionTypes))},
+          {"volume_fields", names(kVolumeFields)},
+          {"volume_source_types", names(kVolumeSourceTypes)},
+          {"volume_sources",
+           {{"raw", names(kVolumeRawFields)},
+            {"nrrd", names(kVolumeFileFields)},
+            {"inr", names(kVolumeFileFields)},
+            {"marschner_lobb", names(kVolumeProceduralFields)},
+            {"heat", names(kVolumeProceduralFields)}}},
+          {"volume_raw_formats", names(kVolumeRawFormats)},
+          {"volume_transfer_fields", names(kVolumeTransferFields)},
+          {"volume_transfer_presets", names(kVolumeTransferPresets)},
+          {"volume_settings", names(kVolumeSettingFields)},
+          {"volume_pyramids", names(kVolumePyramids)},
+          {"volume_limits",
+           {{"max_volumes", kMaxVolumes},
+            {"max_volume_voxels", kMaxVolumeVoxels},
+            {"max_volume_dimension", kMaxVolumeDimension},
+            {"max_transfer_points", kMaxTransferPoints},
+            {"max_volume_level", kMaxVolumeLevel}}}};
 }
 
 }  // namespace beamcast

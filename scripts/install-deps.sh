@@ -8,6 +8,7 @@ PACKAGES=(
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri   # EGL + OpenGL (llvmpipe without a GPU)
   libglm-dev nlohmann-json3-dev libpng-dev libtinyobjloader-dev libcli11-dev
   libturbojpeg0-dev                                   # JPEG frames of the interactive preview
+  zlib1g-dev                                          # gzip-compressed volume files (NRRD, .inr.gz)
   libembree-dev                                       # photon tracing and the path-traced reference (gi/)
   libnanoflann-dev                                    # k-nearest photons of the CPU gather (gi/)
   glslang-tools                                       # shader compile check in the tests

@@ -1,0 +1,77 @@
+// Volume files (issue 17; docs/scene-format.md, "Volumes"): headerless raw
+// files, NRRD (attached header, raw or gzip encoding) and INRIA .inr (also
+// gzip-compressed, .inr.gz), read into their stored sample type, and the
+// normalization of those samples to a VolumeGrid. Internal to protocol/:
+// volume_json.cpp calls these. Every failure is a ProtocolError at the JSON
+// pointer of the scene's "file" field (or the field named), code
+// "bad_volume" for what is wrong inside a file; sizes are checked against
+// the voxel limits before anything is allocated.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "protocol/volume.hpp"
+
+namespace beamcast {
+
+enum class VolumeSampleType : std::uint8_t { kU8, kI8, kU16, kI16, kU32, kI32, kF32, kF64 };
+std::size_t sample_size(VolumeSampleType t);
+std::string_view sample_type_name(VolumeSampleType t);  // "uint8", ..., "float32", "float64"
+bool is_float(VolumeSampleType t);
+
+// A file's voxels as stored, before normalization: x fastest, then y, z.
+struct VolumeFileData {
+  std::array<int, 3> dims{0, 0, 0};
+  VolumeSampleType type = VolumeSampleType::kU8;
+  bool big_endian = false;
+  std::vector<unsigned char> bytes;  // dims' product x sample_size(type)
+  std::optional<Vec3> spacing;       // from the header: NRRD spacings, INR VX VY VZ
+};
+
+// A volume file named by a scene: where it is, its name as the scene gives
+// it (for messages) and the JSON pointer of the "file" field (for errors).
+struct VolumeFileRef {
+  std::filesystem::path full;
+  std::string name;
+  std::string json_path;
+};
+
+// Dimensions read from a scene or a header, checked in this order: each at
+// least 2 ("out_of_range" at axis_paths[a]); their product, computed with an
+// overflow guard, at most `budget` voxels ("limit_exceeded" at `path`,
+// max_volume_voxels, the room the scene's other volumes leave); each at most
+// kMaxVolumeDimension ("out_of_range"). `what` names them in messages
+// ("dimensions", "\"ct.nrrd\"'s sizes").
+std::array<int, 3> check_volume_dims(const std::array<std::int64_t, 3>& dims, std::int64_t budget,
+                                     const std::string& what,
+                                     const std::array<std::string, 3>& axis_paths,
+                                     const std::string& path);
+
+// A headerless file of exactly the voxels `dims` and `type` give (shorter or
+// longer: "bad_volume", with the byte counts expected and found).
+VolumeFileData read_raw_volume(const VolumeFileRef& f, const std::array<int, 3>& dims,
+                               VolumeSampleType type, bool big_endian);
+// An NRRD file with an attached header: dimension 3; types uint8, int8,
+// uint16, int16, float, double (and their NRRD aliases); encoding raw or
+// gzip; "spacings" (or the lengths of "space directions") as its spacing.
+VolumeFileData read_nrrd_volume(const VolumeFileRef& f, std::int64_t budget);
+// An INRIA image: the "#INRIMAGE-4#{" header of 256-byte blocks ending
+// "##}", VDIM=1, TYPE unsigned fixed, signed fixed or float, PIXSIZE 8 to
+// 64 bits, CPU decm/alpha/pc (little-endian) or sun/sgi (big-endian),
+// VX/VY/VZ as its spacing. Gzip-compressed when the name ends ".gz".
+VolumeFileData read_inr_volume(const VolumeFileRef& f, std::int64_t budget);
+
+// The smallest and largest sample; "bad_volume" naming the voxel (index and
+// x, y, z) if a float sample is NaN or infinite.
+std::array<double, 2> volume_data_range(const VolumeFileData& d, const VolumeFileRef& f);
+// Each sample v as round(clamp((v - lo) / (hi - lo), 0, 1) x 65535).
+std::shared_ptr<const VolumeGrid> normalize_volume(const VolumeFileData& d,
+                                                   const std::array<double, 2>& range);
+
+}  // namespace beamcast
