@@ -47,6 +47,14 @@ const std::vector<TargetDecl>& target_catalog() {
       {"slim_sum_field2", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       {"slim_sum_weight2", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       {"slim_surface", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
+      // The volumes' transmittance along each pixel's ray, for the beams
+      // behind and inside them (shaders/volume_knots.glsl): the ray's
+      // interval in the box around all volumes cut into 7 equal segments,
+      // the transmittance at each one's middle (volume_t0: segments 0-3,
+      // volume_t1: 4-6) and at the interval's end (volume_t1.w); products
+      // over the volumes, so cleared to one.
+      {"volume_t0", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kOne},
+      {"volume_t1", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kOne},
       // What mirror and glass pixels show, found on the CPU (render/specular_pass.hpp).
       {"specular", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
   };
@@ -136,10 +144,15 @@ const std::vector<PassDecl>& pass_catalog() {
          return in.scene.has_gi() && in.scene.medium_scatters();
        },
        {"hdr"}, {"view_depth"}, {"hdr"}, {"volume_photons"}},
+      // Scalar volumes (seed 004; render/volume_pass.hpp): each ray cast up
+      // to the nearest surface and composited over hdr, farther volumes
+      // first; the transmittance knots for the beams.
+      {PassId::kVolumes, "volumes", [](const PlanInput& in) { return !in.scene.volumes.empty(); },
+       {"hdr"}, {"view_depth"}, {"hdr", "volume_t0", "volume_t1"}, {"volumes"}},
       // Beams: energy added to hdr; a ray ends at the nearest surface if
       // anything wrote view_depth.
       {PassId::kBeams, "beams", [](const PlanInput& in) { return !in.scene.beams.empty(); },
-       {"hdr"}, {"view_depth"}, {"hdr"}, {"beams"}},
+       {"hdr"}, {"view_depth", "volume_t0", "volume_t1"}, {"hdr"}, {"beams"}},
       // Every frame is tone-mapped into its output format.
       {PassId::kTonemap, "tonemap", [](const PlanInput&) { return true; }, {"hdr"}, {}, {"output"},
        {}},

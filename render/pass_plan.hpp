@@ -33,11 +33,12 @@ enum class PassId {
   kSpecular,
   kMedium,
   kVolumePhotons,
+  kVolumes,
   kBeams,
   kTonemap,
   kUpscale
 };
-inline constexpr std::size_t kPassCount = 15;
+inline constexpr std::size_t kPassCount = 16;
 
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {
@@ -53,6 +54,7 @@ enum class TargetClear {
   kNoSurface,   // FrameTargets' kNoSurface view depth ("no surface on this ray")
   kFarDepth,    // reversed-Z far plane (0)
   kZero,        // zero (accumulation targets)
+  kOne,         // one (products: transmittance)
 };
 enum class TargetSize {
   kRender,  // the render size (camera size times the resolution scale)

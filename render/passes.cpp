@@ -12,6 +12,7 @@
 #include "render/medium_pass.hpp"
 #include "render/slim_pass.hpp"
 #include "render/specular_pass.hpp"
+#include "render/volume_pass.hpp"
 #include "shaders/shader_sources.hpp"
 
 namespace beamcast {
@@ -107,6 +108,11 @@ void FrameTargets::clear(const FramePlan& plan, const Color& background) {
       case TargetClear::kZero: {
         const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
         glClearTexImage(tex, 0, GL_RGBA, GL_FLOAT, zero);
+        break;
+      }
+      case TargetClear::kOne: {
+        const float one[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+        glClearTexImage(tex, 0, GL_RGBA, GL_FLOAT, one);
         break;
       }
       case TargetClear::kFarDepth: {
@@ -536,6 +542,11 @@ class BeamPass final : public Pass {
     glBindTextureUnit(2, surfaces ? ctx.targets.texture("view_depth") : 0);
     glBindTextureUnit(3, ctx.resources.warp_texture());
     if (medium) glBindTextureUnit(4, ctx.resources.moment_texture());
+    // Behind and inside volumes: their transmittance knots (volume_knots.glsl).
+    const bool volumes = ctx.plan.written("volume_t0");
+    glUniform1i(program.uniform(multi, "u_has_volumes"), volumes ? 1 : 0);
+    glBindTextureUnit(5, volumes ? ctx.targets.texture("volume_t0") : 0);
+    glBindTextureUnit(6, volumes ? ctx.targets.texture("volume_t1") : 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx.resources.beam_buffer());
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
@@ -548,7 +559,9 @@ class BeamPass final : public Pass {
     glBindVertexArray(ctx.empty_vao);
     int view = 0;
     for_each_view(ctx, self, program, [&] {
-      if (medium) set_region_eye(ctx, region_eye, view++);
+      const int v = view++;
+      if (medium) set_region_eye(ctx, region_eye, v);
+      if (volumes) set_volume_box(program, multi, ctx, v);
       glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count());
     });
     glDisable(GL_BLEND);
@@ -677,6 +690,8 @@ std::unique_ptr<Pass> make_pass(PassId id) {
       return make_medium_pass();
     case PassId::kVolumePhotons:
       return make_volume_photon_pass();
+    case PassId::kVolumes:
+      return make_volume_pass();
     case PassId::kBeams:
       return std::make_unique<BeamPass>();
     case PassId::kTonemap:

@@ -256,6 +256,74 @@ struct Hit {
 
 // The nearest occluder hit of a ray with t in [t_min, t_max], if any; each
 // kind intersects itself (protocol/occluders/).
+// ---------------------------------------------------------------------------
+// Scalar volumes
+
+// A volume's default reference step: a sixteenth of its smallest spacing.
+double default_volume_step(const Volume& v) {
+  return std::min({v.spacing[0], v.spacing[1], v.spacing[2]}) / 16.0;
+}
+
+// The normalized value at a world point inside the volume's box.
+double volume_value(const Volume& v, const Vec3& p, bool exact) {
+  const Vec3 g = v.to_grid(p);
+  return exact ? v.exact(g) : v.sample(g);
+}
+
+// The opacity of a segment of length `len` whose value is `value`.
+double segment_alpha(const Volume& v, double value, double len) {
+  const double op = v.transfer.opacity(value);
+  if (op >= 1.0) return 1.0;
+  return 1.0 - std::pow(1.0 - op, len / v.transfer.opacity_unit);
+}
+
+struct VolumeOnRay {
+  const Volume* volume;
+  double t0, t1, step;
+};
+
+}  // namespace
+
+bool volume_interval(const Volume& volume, const Vec3& origin, const Vec3& dir, double t_min,
+                     double t_max, double* t0, double* t1) {
+  // In grid coordinates the box is [0, n - 1]^3 and the ray's parameter is
+  // still the world distance (the map is affine).
+  const Vec3 og = volume.to_grid(origin);
+  const Vec3 dg = volume.to_grid(origin + dir) - og;
+  double lo = t_min, hi = t_max;
+  for (int a = 0; a < 3; ++a) {
+    const double top = volume.grid->dims[a] - 1;
+    if (std::abs(dg[a]) < 1e-300) {
+      if (og[a] < 0.0 || og[a] > top) return false;
+      continue;
+    }
+    const double ta = -og[a] / dg[a], tb = (top - og[a]) / dg[a];
+    lo = std::max(lo, std::min(ta, tb));
+    hi = std::min(hi, std::max(ta, tb));
+  }
+  *t0 = lo;
+  *t1 = hi;
+  return hi > lo;
+}
+
+VolumeComposite volume_composite_reference(const Volume& volume, const Vec3& origin, const Vec3& dir,
+                                           double t0, double t1, double step, bool exact) {
+  VolumeComposite out;
+  double a = 0.0, b = 0.0;
+  if (!(step > 0.0) || !volume_interval(volume, origin, dir, t0, t1, &a, &b)) return out;
+  for (double s = a; s < b && out.transmittance > 0.0; s += step) {
+    const double len = std::min(step, b - s);
+    const double value = volume_value(volume, origin + (s + 0.5 * len) * dir, exact);
+    const double alpha = segment_alpha(volume, value, len);
+    const Color c = volume.transfer.color(value);
+    for (int k = 0; k < 3; ++k) out.color[k] += out.transmittance * alpha * c[k] * volume.intensity;
+    out.transmittance *= 1.0 - alpha;
+  }
+  return out;
+}
+
+namespace {
+
 Hit nearest_hit(const Scene& scene, const Vec3& o, const Vec3& v, double t_min, double t_max) {
   Hit best;
   for (const Occluder& occ : scene.occluders) {
@@ -284,6 +352,44 @@ double beam_energy_reference(const Beam& beam, const Vec3& origin, const Vec3& d
                               sigma_t > 0.0 ? &field : nullptr) /
          len;
 }
+
+namespace {
+
+// A beam's energy along [t_min, t_end] with each point's light attenuated by
+// the volumes in front of it: the ray is cut into the volumes' steps (the
+// finest of them over their union), each piece's beam energy weighted by the
+// transmittance at its middle (the volumes' opacity up to the piece's start,
+// then half its own step's, exact for a piece of constant extinction).
+double beam_energy_through_volumes(const PreparedBeam& pb, const Vec3& o, const Vec3& v,
+                                   double t_min, double t_end, const std::vector<VolumeOnRay>& vols,
+                                   const ReferenceOptions& opts, const MediumField* field) {
+  double a = kInf, b = -kInf, step = kInf;
+  for (const VolumeOnRay& vr : vols) {
+    a = std::min(a, vr.t0);
+    b = std::max(b, vr.t1);
+    step = std::min(step, vr.step);
+  }
+  double energy = beam_energy_prepared(pb, o, v, t_min, a, opts.rel_tol, field);
+  double transmittance = 1.0;
+  for (double s = a; s < b && transmittance > 0.0; s += step) {
+    const double len = std::min(step, b - s);
+    const Vec3 mid = o + (s + 0.5 * len) * v;
+    double pass = 1.0;  // what this piece lets through
+    for (const VolumeOnRay& vr : vols) {
+      if (s + 0.5 * len < vr.t0 || s + 0.5 * len > vr.t1) continue;
+      pass *= 1.0 - segment_alpha(*vr.volume, volume_value(*vr.volume, mid, opts.volume_exact), len);
+    }
+    energy += transmittance * std::sqrt(pass) *
+              beam_energy_prepared(pb, o, v, s, s + len, opts.rel_tol, field);
+    transmittance *= pass;
+  }
+  if (transmittance > 0.0) {
+    energy += transmittance * beam_energy_prepared(pb, o, v, b, t_end, opts.rel_tol, field);
+  }
+  return energy;
+}
+
+}  // namespace
 
 HdrImage render_reference(const Scene& scene, const Camera& cam, const ReferenceOptions& opts) {
   HdrImage img;
@@ -350,11 +456,31 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
         const double tr = std::exp(-tau);
         for (int k = 0; k < 3; ++k) c[k] *= tr;
       }
+      // The volumes this ray meets before its end.
+      std::vector<VolumeOnRay> on_ray;
+      for (const Volume& v : scene.volumes) {
+        double a = 0.0, b = 0.0;
+        if (volume_interval(v, ray.origin, ray.dir, ray.t_min, t_end, &a, &b)) {
+          on_ray.push_back({&v, a, b, opts.volume_step > 0.0 ? opts.volume_step : default_volume_step(v)});
+        }
+      }
+      // What lies behind the volumes, then each volume over it, farthest first.
+      std::sort(on_ray.begin(), on_ray.end(),
+                [](const VolumeOnRay& p, const VolumeOnRay& q) { return p.t1 > q.t1; });
+      for (const VolumeOnRay& v : on_ray) {
+        const VolumeComposite vc =
+            volume_composite_reference(*v.volume, ray.origin, ray.dir, v.t0, v.t1, v.step,
+                                       opts.volume_exact);
+        for (int k = 0; k < 3; ++k) c[k] = vc.color[k] + vc.transmittance * c[k];
+      }
       for (std::size_t b = 0; b < beams.size(); ++b) {
-        const double e = beam_energy_prepared(beams[b], ray.origin, ray.dir, ray.t_min, t_end,
-                                              opts.rel_tol, field);
-        if (e == 0.0) continue;
         const Beam& src = *beam_src[b];
+        const double e = on_ray.empty()
+                             ? beam_energy_prepared(beams[b], ray.origin, ray.dir, ray.t_min, t_end,
+                                                    opts.rel_tol, field)
+                             : beam_energy_through_volumes(beams[b], ray.origin, ray.dir, ray.t_min,
+                                                           t_end, on_ray, opts, field);
+        if (e == 0.0) continue;
         for (int k = 0; k < 3; ++k) c[k] += src.color[k] * src.intensity * e;
       }
       float* px = img.at(x, y);

@@ -18,7 +18,28 @@ struct ReferenceOptions {
   // of the surfaces' radiance (gi/path_tracer.hpp).
   int gi_spp = 64;
   std::uint64_t gi_seed = 1;
+  // Scalar volumes (Scene::volumes): the march's step in world units (0: a
+  // sixteenth of the volume's smallest voxel spacing, each step sampled at
+  // its middle), and whether to sample the exact field of procedural
+  // volumes (Volume::exact) instead of the trilinear grid.
+  double volume_step = 0.0;
+  bool volume_exact = false;
 };
+
+// One volume's front-to-back composite along a ray (unit `dir`) over
+// t in [t0, t1]: its colour and what it lets through. Steps of `step`
+// (world units; the last one shorter), each sampled at its middle, opacity
+// corrected for the step's length: alpha = 1 - (1 - opacity)^(ds / unit).
+struct VolumeComposite {
+  Color color{0.0, 0.0, 0.0};
+  double transmittance = 1.0;
+};
+VolumeComposite volume_composite_reference(const Volume& volume, const Vec3& origin, const Vec3& dir,
+                                           double t0, double t1, double step, bool exact = false);
+// The ray distances [t0, t1] where the ray meets the volume's box, clipped to
+// [t_min, t_max]; false if it misses.
+bool volume_interval(const Volume& volume, const Vec3& origin, const Vec3& dir, double t_min,
+                     double t_max, double* t0, double* t1);
 
 // Linear HDR image of `cam` (rows top-down): background or Lambert-shaded
 // occluder, plus the beams' energy along the visible part of each ray. With
@@ -28,7 +49,9 @@ struct ReferenceOptions {
 // A medium (Scene::has_medium) attenuates the surface by e^(-sigma_t t) (the
 // background, at infinity, entirely) and each beam within itself; in lit
 // scenes the path tracer follows paths through it (free flights, single and
-// multiple scattering, transmittance to the lights).
+// multiple scattering, transmittance to the lights). Scalar volumes are
+// composited over what lies behind them (farther volumes first), and the
+// beams' light is attenuated by the volumes in front of each point of it.
 HdrImage render_reference(const Scene& scene, const Camera& cam, const ReferenceOptions& opts = {});
 
 // The energy one beam adds along a ray for t in [t0, t1] (world units), i.e.

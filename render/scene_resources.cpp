@@ -159,6 +159,7 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
   }
   if (plan.uploads_group("shadows")) upload_direct();
   if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene);
+  if (plan.uploads_group("volumes")) volumes_ = std::make_unique<VolumeResources>(scene);
   upload_medium_meshes();
   if (plan.uploads_group("specular")) {
     if (!photons)

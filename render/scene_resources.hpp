@@ -19,6 +19,7 @@
 #include "render/lut.hpp"
 #include "render/pass_plan.hpp"
 #include "render/slim_pass.hpp"
+#include "render/volume_pass.hpp"
 
 namespace beamcast {
 
@@ -107,6 +108,8 @@ class SceneResources {
   GLuint medium_triangle_buffer() const { return medium_tri_ssbo_.get(); }
   // SLIM surfaces (group "slim"); null without them.
   SlimResources* slim() const { return slim_.get(); }
+  // Scalar volumes (group "volumes"); null without them.
+  const VolumeResources* volumes() const { return volumes_.get(); }
   // Time spent tracing the maps for this render (0 when they came from the
   // cache) and uploading them.
   double photon_trace_ms() const { return photon_trace_ms_; }
@@ -153,6 +156,7 @@ class SceneResources {
   Vec3 volume_anchor_{};
   double volume_radius_ = 1.0;
   std::unique_ptr<SlimResources> slim_;
+  std::unique_ptr<VolumeResources> volumes_;
   std::unique_ptr<GiScene> gi_scene_;
   std::shared_ptr<const PhotonGather> photon_gather_;
   // The per-camera data of bind_camera, written to `out` (for bind_views).

@@ -26,6 +26,10 @@ layout(std430, binding = 1) readonly buffer Beams { BeamData beams[]; };
 
 layout(binding = 2) uniform VIEW_SAMPLER u_view_depth;  // surfaces' view depth (huge: none)
 uniform int u_has_surfaces;
+// Scenes with volumes: their transmittance knots (volume_knots.glsl).
+layout(binding = 5) uniform VIEW_SAMPLER u_volume_t0;
+layout(binding = 6) uniform VIEW_SAMPLER u_volume_t1;
+uniform int u_has_volumes;
 
 flat in int v_beam;
 layout(location = 0) out vec4 out_energy;
@@ -163,19 +167,9 @@ void clip_plane(float u0, float du, float bound, bool above, inout float t0, ino
   }
 }
 
-void main() {
-  select_view(view_index());
-  BeamData b = beams[v_beam];
-  g_layer = b.color_layer.w;
-  g_kind = int(b.density.x);
-  g_sigma = b.density.y;
-  ViewRay ray = view_ray(gl_FragCoord.xy);
-  float t0 = ray.t_min;
-  float t1 = ray.t_max;
-  if (u_has_surfaces != 0) {
-    float z = VIEW_TEXEL(u_view_depth, ivec2(gl_FragCoord.xy)).r;
-    t1 = min(t1, z / ray.cos_axis);
-  }
+// The beam's energy along the ray for t in [t0, t1].
+float beam_energy(BeamData b, ViewRay ray, float t0, float t1) {
+  if (!(t1 > t0)) return 0.0;
   float r = b.p0_radius.w;
   vec3 p0 = b.p0_radius.xyz;
   float e;
@@ -202,10 +196,51 @@ void main() {
       e += sphere_energy(ray.origin, ray.dir, p0 + len * w, r, sa, sb);
     }
   }
+  return e;
+}
+
+void main() {
+  select_view(view_index());
+  BeamData b = beams[v_beam];
+  g_layer = b.color_layer.w;
+  g_kind = int(b.density.x);
+  g_sigma = b.density.y;
+  ViewRay ray = view_ray(gl_FragCoord.xy);
+  float t0 = ray.t_min;
+  float t1 = ray.t_max;
+  if (u_has_surfaces != 0) {
+    float z = VIEW_TEXEL(u_view_depth, ivec2(gl_FragCoord.xy)).r;
+    t1 = min(t1, z / ray.cos_axis);
+  }
+  // Behind and inside volumes: the light of each knot segment weighted by
+  // the transmittance at its middle, beyond them by the whole volumes'
+  // (piece 0: before the volumes, 1-7: the segments, 8: beyond). One call
+  // site, so the energy's code is compiled once.
+  float a = 0.0, c = 0.0;
+  bool volumes = u_has_volumes != 0 && volume_knot_interval(ray, t1, a, c);
+  vec4 k0 = vec4(1.0), k1 = vec4(1.0);
+  if (volumes) {
+    k0 = VIEW_TEXEL(u_volume_t0, ivec2(gl_FragCoord.xy));
+    k1 = VIEW_TEXEL(u_volume_t1, ivec2(gl_FragCoord.xy));
+  }
+  float knot[8] = float[8](k0.x, k0.y, k0.z, k0.w, k1.x, k1.y, k1.z, k1.w);
+  float h = (c - a) / kVolumeSegments;
+  int pieces = volumes ? kVolumeKnots + 1 : 1;
+  float e = 0.0;
+  for (int k = 0; k < pieces; ++k) {
+    float sa = t0, sb = t1, weight = 1.0;
+    if (volumes) {
+      sa = k == 0 ? t0 : k == kVolumeKnots ? c : a + float(k - 1) * h;
+      sb = k == 0 ? a : k >= kVolumeKnots - 1 ? (k == kVolumeKnots ? t1 : c) : a + float(k) * h;
+      weight = k == 0 ? 1.0 : knot[k - 1];
+    }
+    e += weight * beam_energy(b, ray, sa, sb);
+  }
 #ifdef BEAMCAST_MEDIUM_REGIONS
   // Regions of medium (medium_regions.glsl): their optical depth to the
   // ray's point nearest the beam's centre (the scene-wide medium is exact,
   // in medium_piece; the regions' variation across the beam is not).
+  vec3 p0 = b.p0_radius.xyz;
   vec3 centre = b.caps_kind.z < 0.5 ? p0 : p0 + 0.5 * b.axis_length.w * b.axis_length.xyz;
   float tm = clamp(dot(centre - ray.origin, ray.dir), t0, t1);
   e *= exp(-region_depth(ray.origin, ray.dir, 0.0, tm));

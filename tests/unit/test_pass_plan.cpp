@@ -12,8 +12,9 @@ namespace beamcast {
 namespace {
 
 Scene scene_with(bool beams, bool occluders, bool lit = false, bool slim = false,
-                 bool mirror = false, bool fog = false) {
+                 bool mirror = false, bool fog = false, bool volume = false) {
   Scene s;
+  if (volume) s.volumes.push_back(procedural_volume(VolumeSourceType::kHeat, 4));
   if (fog) s.medium = Medium{.sigma_s = 0.1};
   if (beams) s.beams.emplace_back();
   if (occluders) s.occluders.push_back(Occluder{SphereOccluder{}, {0.5, 0.5, 0.5}, {}});
@@ -41,6 +42,16 @@ TEST(PassPlan, BeamOnlySceneAllocatesNoSurfaceTargets) {
   EXPECT_EQ(target_names(plan), (std::vector<std::string>{"hdr", "output"}));
   EXPECT_EQ(plan.uploads, (std::vector<std::string>{"beams"}));
   EXPECT_EQ(plan.final_target, "output");
+}
+
+TEST(PassPlan, VolumesWriteTransmittanceKnotsThatBeamsRead) {
+  const FramePlan plan =
+      make_plan(PlanInput{scene_with(true, false, false, false, false, false, true)});
+  EXPECT_EQ(plan.names(), (std::vector<std::string>{"volumes", "beams", "tonemap"}));
+  EXPECT_TRUE(plan.written("volume_t0"));
+  EXPECT_EQ(target_names(plan),
+            (std::vector<std::string>{"hdr", "output", "volume_t0", "volume_t1"}));
+  EXPECT_EQ(plan.uploads, (std::vector<std::string>{"volumes", "beams"}));
 }
 
 TEST(PassPlan, OccludersWriteViewDepthThatBeamsRead) {
@@ -77,11 +88,13 @@ TEST(PassPlan, EveryCatalogPassIsReachable) {
         for (bool slim : {false, true}) {
           for (bool mirror : {false, true}) {
             for (bool fog : {false, true}) {
-              for (double scale : {1.0, 0.5}) {
-                for (const auto& n :
-                     make_plan(PlanInput{scene_with(b, o, lit, slim, mirror, fog), scale})
-                         .names()) {
-                  seen.push_back(n);
+              for (bool vol : {false, true}) {
+                for (double scale : {1.0, 0.5}) {
+                  for (const auto& n :
+                       make_plan(PlanInput{scene_with(b, o, lit, slim, mirror, fog, vol), scale})
+                           .names()) {
+                    seen.push_back(n);
+                  }
                 }
               }
             }

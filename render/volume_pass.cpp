@@ -1,0 +1,175 @@
+#include "render/volume_pass.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "render/passes.hpp"
+#include "render/scene_resources.hpp"
+
+namespace beamcast {
+
+std::vector<float> transfer_texels(const Volume& volume) {
+  std::vector<float> texels(4 * kTransferTexels);
+  for (int i = 0; i < kTransferTexels; ++i) {
+    const double v = static_cast<double>(i) / (kTransferTexels - 1);
+    const Color c = volume.transfer.color(v);
+    for (int k = 0; k < 3; ++k) texels[4 * i + k] = static_cast<float>(c[k] * volume.intensity);
+    texels[4 * i + 3] = static_cast<float>(volume.transfer.opacity(v));
+  }
+  return texels;
+}
+
+VolumeResources::VolumeResources(const Scene& scene) {
+  for (const Volume& vol : scene.volumes) {
+    Uploaded u;
+    u.volume = &vol;
+    std::shared_ptr<const VolumeGrid> grid = vol.grid;
+    if (scene.volume.level > 0) grid = volume_level(*vol.grid, scene.volume.level, scene.volume.pyramid);
+    u.dims = grid->dims;
+    // The level spans the same box, voxel centre to voxel centre.
+    for (int a = 0; a < 3; ++a) {
+      u.spacing[a] = vol.spacing[a] * (vol.grid->dims[a] - 1) / static_cast<double>(u.dims[a] - 1);
+    }
+    GLuint tex = 0;
+    glCreateTextures(GL_TEXTURE_3D, 1, &tex);
+    u.values = GlTexture(tex);
+    glTextureStorage3D(tex, 1, GL_R16, u.dims[0], u.dims[1], u.dims[2]);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
+    glTextureSubImage3D(tex, 0, 0, 0, 0, u.dims[0], u.dims[1], u.dims[2], GL_RED, GL_UNSIGNED_SHORT,
+                        grid->values.data());
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) {
+      glTextureParameteri(tex, wrap, GL_CLAMP_TO_EDGE);
+    }
+    const std::vector<float> tf = transfer_texels(vol);
+    glCreateTextures(GL_TEXTURE_1D, 1, &tex);
+    u.transfer = GlTexture(tex);
+    glTextureStorage1D(tex, 1, GL_RGBA32F, kTransferTexels);
+    glTextureSubImage1D(tex, 0, 0, kTransferTexels, GL_RGBA, GL_FLOAT, tf.data());
+    glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    volumes_.push_back(std::move(u));
+  }
+  gl_check("volume upload");
+}
+
+void set_volume_box(ProgramPair& program, bool multiview, const FrameContext& ctx, int view) {
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const Volume& v : ctx.scene.volumes) {
+    Vec3 a, b;
+    v.world_bounds(&a, &b);
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], a[k]);
+      hi[k] = std::max(hi[k], b[k]);
+    }
+  }
+  const Vec3& eye = ctx.views > 0 && view >= 0 ? ctx.view_eyes[static_cast<std::size_t>(view)]
+                                               : ctx.basis.eye;
+  const Vec3 l = lo - eye, h = hi - eye;
+  glUniform3f(program.uniform(multiview, "u_volume_lo"), static_cast<float>(l[0]),
+              static_cast<float>(l[1]), static_cast<float>(l[2]));
+  glUniform3f(program.uniform(multiview, "u_volume_hi"), static_cast<float>(h[0]),
+              static_cast<float>(h[1]), static_cast<float>(h[2]));
+}
+
+namespace {
+
+// Rotation matrix (row-major) of a unit quaternion (w, x, y, z).
+std::array<double, 9> rotation_matrix(const std::array<double, 4>& q) {
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+}
+
+// The world step of a volume's ray march: the smallest spacing of the
+// uploaded level over the samples per voxel.
+double march_step(const VolumeResources::Uploaded& u, const VolumeSettings& s) {
+  return std::min({u.spacing[0], u.spacing[1], u.spacing[2]}) / s.samples_per_voxel;
+}
+
+class VolumePass final : public Pass {
+ public:
+  VolumePass() : program_("volume_cast") {}
+  void execute(FrameContext& ctx, const PassDecl& self) override {
+    const VolumeResources* res = ctx.resources.volumes();
+    if (!res) throw GlError("volume pass: the scene's volumes were not uploaded");
+    const bool multi = ctx.views > 0;
+    glUseProgram(program_.get(multi));
+    const bool surfaces = ctx.plan.written("view_depth");
+    const VolumeSettings& s = ctx.scene.volume;
+    glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
+    glUniform1f(program_.uniform(multi, "u_ert"), static_cast<float>(s.ert_threshold));
+    glUniform1i(program_.uniform(multi, "u_jitter"), s.jitter ? 1 : 0);
+    glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
+    // hdr = volume colour + (1 - volume opacity) hdr, hdr's alpha kept; the
+    // transmittance knots multiplied over the volumes.
+    glEnable(GL_BLEND);
+    glBlendFuncSeparatei(0, GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    glBlendFuncSeparatei(1, GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_SRC_ALPHA);
+    glBlendFuncSeparatei(2, GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_SRC_ALPHA);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_DEPTH_TEST);
+    glBindVertexArray(ctx.empty_vao);
+
+    // Back to front by the distance of each box's centre from the (first)
+    // eye, so a nearer volume is composited over a farther one.
+    std::vector<std::size_t> order(res->volumes().size());
+    std::iota(order.begin(), order.end(), 0);
+    std::vector<double> dist(order.size());
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      Vec3 lo, hi;
+      res->volumes()[i].volume->world_bounds(&lo, &hi);
+      dist[i] = length(0.5 * (lo + hi) - ctx.basis.eye);
+    }
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return dist[a] > dist[b]; });
+
+    for (std::size_t i : order) {
+      const VolumeResources::Uploaded& u = res->volumes()[i];
+      const Volume& vol = *u.volume;
+      const std::array<double, 9> r = rotation_matrix(vol.rotation);
+      float rot[9];
+      for (int k = 0; k < 9; ++k) rot[k] = static_cast<float>(r[k]);
+      // mat3 from row-major: transpose on upload.
+      glUniformMatrix3fv(program_.uniform(multi, "u_rotation"), 1, GL_TRUE, rot);
+      glUniform3f(program_.uniform(multi, "u_spacing"), static_cast<float>(u.spacing[0]),
+                  static_cast<float>(u.spacing[1]), static_cast<float>(u.spacing[2]));
+      glUniform3f(program_.uniform(multi, "u_dims"), static_cast<float>(u.dims[0]),
+                  static_cast<float>(u.dims[1]), static_cast<float>(u.dims[2]));
+      const double step = march_step(u, s);
+      glUniform1f(program_.uniform(multi, "u_step"), static_cast<float>(step));
+      // Opacity of a sample: corrected for its segment's length, or the
+      // seed's fixed per-sample opacity (the one the default step, level 0,
+      // gets): too transparent when the step grows.
+      const double base_step =
+          std::min({vol.spacing[0], vol.spacing[1], vol.spacing[2]}) / VolumeSettings{}.samples_per_voxel;
+      glUniform1f(program_.uniform(multi, "u_opacity_unit"),
+                  static_cast<float>(vol.transfer.opacity_unit));
+      glUniform1f(program_.uniform(multi, "u_fixed_exponent"),
+                  s.opacity_correction ? -1.0f : static_cast<float>(base_step / vol.transfer.opacity_unit));
+      glBindTextureUnit(1, u.values.get());
+      glBindTextureUnit(2, u.transfer.get());
+      int view = 0;
+      for_each_view_offset(ctx, self, program_, "u_origin", vol.origin, [&] {
+        set_volume_box(program_, multi, ctx, view++);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+      });
+    }
+    glBlendFunc(GL_ONE, GL_ONE);  // every attachment's state back to one value
+    glDisable(GL_BLEND);
+    gl_check("volume pass");
+  }
+
+ private:
+  ProgramPair program_;
+};
+
+}  // namespace
+
+std::unique_ptr<Pass> make_volume_pass() { return std::make_unique<VolumePass>(); }
+
+}  // namespace beamcast

@@ -1,0 +1,53 @@
+// Scalar volumes (issue 17, seed 004; docs/volumes.md): the GPU side. The
+// scene's volumes as 3D textures (16-bit normalized, trilinear, at the
+// settings' pyramid level) with their transfer functions as 1D textures
+// (group "volumes"), and the pass "volumes", which ray casts each volume in
+// the fragment shader (shaders/volume_cast.frag) and composites it over hdr,
+// the rays ending at the nearest surface (view_depth).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "protocol/scene.hpp"
+#include "render/gl_util.hpp"
+
+namespace beamcast {
+
+class Pass;
+
+// Texels of each transfer function's 1D texture: the piecewise linear
+// function sampled at i / (kTransferTexels - 1), so GL_LINEAR between texel
+// centres reproduces it exactly between those samples (only a knot that
+// falls between two samples is rounded off, by at most one sample's width).
+inline constexpr int kTransferTexels = 1024;
+
+class VolumeResources {
+ public:
+  explicit VolumeResources(const Scene& scene);
+  struct Uploaded {
+    const Volume* volume = nullptr;
+    std::array<int, 3> dims{0, 0, 0};  // of the uploaded level
+    Vec3 spacing{};                    // world spacing at that level (grid convention kept)
+    GlTexture values;                  // GL_R16, 3D
+    GlTexture transfer;                // GL_RGBA32F, 1D: (colour x intensity, opacity)
+  };
+  const std::vector<Uploaded>& volumes() const { return volumes_; }
+
+ private:
+  std::vector<Uploaded> volumes_;
+};
+
+// u_volume_lo / u_volume_hi of shaders/volume_knots.glsl: the box around the
+// scene's volumes relative to view `view`'s eye (-1: the only camera).
+class ProgramPair;
+struct FrameContext;
+void set_volume_box(ProgramPair& program, bool multiview, const FrameContext& ctx, int view);
+
+// The RGBA texels of a transfer function (colour x intensity, opacity),
+// exposed for tests.
+std::vector<float> transfer_texels(const Volume& volume);
+
+std::unique_ptr<Pass> make_volume_pass();
+
+}  // namespace beamcast
