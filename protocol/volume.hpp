@@ -113,6 +113,10 @@ struct VolumeSettings {
   double ert_threshold = 0.99;
   // Ray starts offset by a per-pixel fraction of a step (no wood-grain rings).
   bool jitter = true;
+  // Empty-space skipping: the march leaps over bricks of 8^3 voxel cells
+  // whose values all map to zero opacity (a min/max grid; exact: it skips
+  // only samples that would add nothing).
+  bool skip_empty = true;
   // R_v: pyramid level of the volume (0: full resolution; each level halves
   // every axis) and how a level's voxel is made from the 8 below.
   int level = 0;
@@ -180,7 +184,7 @@ inline constexpr std::string_view kVolumeRawFormats[] = {"uint8", "uint16", "flo
 inline constexpr std::string_view kVolumeTransferFields[] = {"preset", "points", "opacity_unit"};
 inline constexpr std::string_view kVolumeTransferPresets[] = {"grey", "bone", "ml"};
 inline constexpr std::string_view kVolumeSettingFields[] = {
-    "samples_per_voxel", "opacity_correction", "ert", "jitter", "level", "pyramid"};
+    "samples_per_voxel", "opacity_correction", "ert", "jitter", "skip_empty", "level", "pyramid"};
 inline constexpr std::string_view kVolumePyramids[] = {"average", "max", "nonzero"};
 
 // One entry of "volumes" (docs/scene-format.md, "Volumes"): its source (a

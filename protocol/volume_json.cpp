@@ -255,6 +255,7 @@ VolumeSettings parse_volume_settings(const Node& n) {
   if (auto v = o.optional("opacity_correction")) s.opacity_correction = read_bool(*v);
   if (auto v = o.optional("ert")) s.ert_threshold = check_half_open(*v, read_number(*v), 1.0);
   if (auto v = o.optional("jitter")) s.jitter = read_bool(*v);
+  if (auto v = o.optional("skip_empty")) s.skip_empty = read_bool(*v);
   if (auto v = o.optional("level")) {
     s.level = static_cast<int>(
         check_closed(*v, static_cast<double>(read_integer(*v)), 0.0, kMaxVolumeLevel));

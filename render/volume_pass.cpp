@@ -20,6 +20,49 @@ std::vector<float> transfer_texels(const Volume& volume) {
   return texels;
 }
 
+std::vector<std::uint8_t> brick_occupancy(const VolumeGrid& grid, const std::vector<float>& texels,
+                                          std::array<int, 3>* brick_dims) {
+  std::array<int, 3>& bd = *brick_dims;
+  for (int a = 0; a < 3; ++a) bd[a] = (grid.dims[a] - 1 + kBrickCells - 1) / kBrickCells;
+  // Any non-zero opacity among the table texels a value range can reach
+  // (a direct scan: the table is small).
+  auto any_opacity = [&](double lo, double hi) {
+    // The shader reads texel coordinate v (K - 1) + 0.5: values in [lo, hi]
+    // blend texels floor(lo (K - 1)) .. ceil(hi (K - 1)).
+    const int a = std::clamp(static_cast<int>(std::floor(lo * (kTransferTexels - 1))), 0,
+                             kTransferTexels - 1);
+    const int b = std::clamp(static_cast<int>(std::ceil(hi * (kTransferTexels - 1))), 0,
+                             kTransferTexels - 1);
+    for (int i = a; i <= b; ++i) {
+      if (texels[4 * static_cast<std::size_t>(i) + 3] > 0.0f) return true;
+    }
+    return false;
+  };
+  std::vector<std::uint8_t> occupied(static_cast<std::size_t>(bd[0]) * bd[1] * bd[2], 0);
+  for (int bz = 0; bz < bd[2]; ++bz) {
+    for (int by = 0; by < bd[1]; ++by) {
+      for (int bx = 0; bx < bd[0]; ++bx) {
+        std::uint16_t lo = 65535, hi = 0;
+        const int x1 = std::min(kBrickCells * (bx + 1), grid.dims[0] - 1);
+        const int y1 = std::min(kBrickCells * (by + 1), grid.dims[1] - 1);
+        const int z1 = std::min(kBrickCells * (bz + 1), grid.dims[2] - 1);
+        for (int z = kBrickCells * bz; z <= z1; ++z) {
+          for (int y = kBrickCells * by; y <= y1; ++y) {
+            const std::size_t row = (static_cast<std::size_t>(z) * grid.dims[1] + y) * grid.dims[0];
+            for (int x = kBrickCells * bx; x <= x1; ++x) {
+              lo = std::min(lo, grid.values[row + x]);
+              hi = std::max(hi, grid.values[row + x]);
+            }
+          }
+        }
+        occupied[(static_cast<std::size_t>(bz) * bd[1] + by) * bd[0] + bx] =
+            any_opacity(lo / 65535.0, hi / 65535.0) ? 1 : 0;
+      }
+    }
+  }
+  return occupied;
+}
+
 VolumeResources::VolumeResources(const Scene& scene) {
   for (const Volume& vol : scene.volumes) {
     Uploaded u;
@@ -52,6 +95,18 @@ VolumeResources::VolumeResources(const Scene& scene) {
     glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    const std::vector<std::uint8_t> bricks = brick_occupancy(*grid, tf, &u.brick_dims);
+    glCreateTextures(GL_TEXTURE_3D, 1, &tex);
+    u.bricks = GlTexture(tex);
+    glTextureStorage3D(tex, 1, GL_R8UI, u.brick_dims[0], u.brick_dims[1], u.brick_dims[2]);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTextureSubImage3D(tex, 0, 0, 0, 0, u.brick_dims[0], u.brick_dims[1], u.brick_dims[2],
+                        GL_RED_INTEGER, GL_UNSIGNED_BYTE, bricks.data());
+    // An integer texture with a linear filter (the default magnification
+    // filter) is incomplete and reads as 0 everywhere: nearest.
+    glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     volumes_.push_back(std::move(u));
   }
   gl_check("volume upload");
@@ -105,6 +160,7 @@ class VolumePass final : public Pass {
     glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
     glUniform1f(program_.uniform(multi, "u_ert"), static_cast<float>(s.ert_threshold));
     glUniform1i(program_.uniform(multi, "u_jitter"), s.jitter ? 1 : 0);
+    glUniform1i(program_.uniform(multi, "u_skip_empty"), s.skip_empty ? 1 : 0);
     glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
     // hdr = volume colour + (1 - volume opacity) hdr, hdr's alpha kept; the
     // transmittance knots multiplied over the volumes.
@@ -153,6 +209,7 @@ class VolumePass final : public Pass {
                   s.opacity_correction ? -1.0f : static_cast<float>(base_step / vol.transfer.opacity_unit));
       glBindTextureUnit(1, u.values.get());
       glBindTextureUnit(2, u.transfer.get());
+      glBindTextureUnit(3, u.bricks.get());
       int view = 0;
       for_each_view_offset(ctx, self, program_, "u_origin", vol.origin, [&] {
         set_volume_box(program_, multi, ctx, view++);

@@ -21,6 +21,15 @@ class Pass;
 // centres reproduces it exactly between those samples (only a knot that
 // falls between two samples is rounded off, by at most one sample's width).
 inline constexpr int kTransferTexels = 1024;
+// Cells per brick edge of the empty-space grid.
+inline constexpr int kBrickCells = 8;
+
+// The occupancy of each brick (x fastest): 1 where the transfer table's
+// opacity is non-zero anywhere between the brick's smallest and largest
+// value (over the table texels the GPU's linear filter can blend there),
+// exposed for tests.
+std::vector<std::uint8_t> brick_occupancy(const VolumeGrid& grid, const std::vector<float>& texels,
+                                          std::array<int, 3>* brick_dims);
 
 class VolumeResources {
  public:
@@ -31,6 +40,11 @@ class VolumeResources {
     Vec3 spacing{};                    // world spacing at that level (grid convention kept)
     GlTexture values;                  // GL_R16, 3D
     GlTexture transfer;                // GL_RGBA32F, 1D: (colour x intensity, opacity)
+    // Empty-space skipping: per brick of kBrickCells^3 cells, 1 if any value
+    // in it (its corner voxels included) has a non-zero opacity in the
+    // transfer table, else 0 (GL_R8, 3D, nearest).
+    GlTexture bricks;
+    std::array<int, 3> brick_dims{0, 0, 0};
   };
   const std::vector<Uploaded>& volumes() const { return volumes_; }
 

@@ -12,6 +12,7 @@
 layout(binding = 0) uniform VIEW_SAMPLER u_view_depth;  // surfaces' view depth
 layout(binding = 1) uniform sampler3D u_values;         // normalized values, GL_R16
 layout(binding = 2) uniform sampler1D u_transfer;       // (colour x intensity, opacity)
+layout(binding = 3) uniform usampler3D u_bricks;        // 1: the brick can show something
 uniform int u_has_surfaces;
 uniform mat3 u_rotation;  // world from (grid x spacing)
 uniform vec3 u_origin;    // voxel (0, 0, 0)'s centre, relative to the eye
@@ -22,12 +23,14 @@ uniform float u_opacity_unit;
 uniform float u_fixed_exponent;  // < 0: opacity correction; else every sample's exponent
 uniform float u_ert;
 uniform int u_jitter;
+uniform int u_skip_empty;
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out vec4 out_knots0;  // knots 0-3
 layout(location = 2) out vec4 out_knots1;  // knots 4-7
 
 const float kTransferTexels = 1024.0;  // render/volume_pass.hpp kTransferTexels
+const float kBrickCells = 8.0;         // render/volume_pass.hpp kBrickCells
 
 // Interleaved gradient noise: a per-pixel offset in [0, 1), the same every
 // frame (frames stay reproducible, bit for bit, on any server).
@@ -67,10 +70,30 @@ void main() {
   int next_knot = knots ? 0 : kVolumeKnots;
   for (int i = 0; i < kVolumeKnots; ++i) knot[i] = 1.0;
   int steps = int(ceil((t1 - t0) / u_step));
-  for (int k = 0; k < steps; ++k) {
+  int k = 0;
+  while (k < steps) {
     float s0 = t0 + float(k) * u_step;
     float len = min(u_step, t1 - s0);
     vec3 g = og + (s0 + offset * len) * dg;
+    int following = k + 1;
+    if (u_skip_empty != 0) {
+      // A brick whose values all have zero opacity: on to the first step
+      // of the same grid that starts past the brick's far side (the
+      // samples skipped would have added nothing).
+      vec3 cell = clamp(floor(g / kBrickCells), vec3(0.0), vec3(textureSize(u_bricks, 0)) - 1.0);
+      if (texelFetch(u_bricks, ivec3(cell), 0).r == 0u) {
+        vec3 lo = cell * kBrickCells, hi = lo + kBrickCells;
+        float exit_t = 1e30;
+        for (int a = 0; a < 3; ++a) {
+          if (abs(dg[a]) > 1e-30) exit_t = min(exit_t, ((dg[a] > 0.0 ? hi[a] : lo[a]) - og[a]) / dg[a]);
+        }
+        // The step containing the exit (its sample may still be inside).
+        following = max(k + 1, int(floor((exit_t - t0) / u_step)));
+        k = following;
+        continue;
+      }
+    }
+    k = following;
     float v = texture(u_values, (g + 0.5) / u_dims).r;
     vec4 tf = texture(u_transfer, (v * (kTransferTexels - 1.0) + 0.5) / kTransferTexels);
     float e = u_fixed_exponent >= 0.0 ? u_fixed_exponent : len / u_opacity_unit;

@@ -167,5 +167,28 @@ TEST(Volumes, ABeamInsideAVolumeIsAttenuatedByWhatLiesInFrontOfIt) {
   EXPECT_GT(naive.rel_l1, 0.2);
 }
 
+TEST(Volumes, EmptySpaceSkippingChangesNoPixel) {
+  // A sparse transfer function (nothing below 0.55: most bricks of the
+  // Marschner-Lobb signal are empty): the march leaps over them, and the
+  // samples it skips would have added exactly nothing, so the image is the
+  // same to the bit, jittered or not.
+  for (bool jitter : {false, true}) {
+    json j = ml_scene(64, {{"jitter", jitter}, {"skip_empty", false}});
+    j["volumes"][0]["transfer"] = {
+        {"points", {{0, 0.0, 0.0, 0.0, 0.0}, {0.55, 0.9, 0.6, 0.2, 0.0}, {1, 1.0, 0.9, 0.6, 0.8}}},
+        {"opacity_unit", 0.1}};
+    const HdrImage full = gpu_hdr(parse_scene(j, {}));
+    j["volume"]["skip_empty"] = true;
+    const HdrImage skipped = gpu_hdr(parse_scene(j, {}));
+    ASSERT_EQ(full.rgb.size(), skipped.rgb.size());
+    double seen = 0.0;
+    for (std::size_t i = 0; i < full.rgb.size(); ++i) {
+      EXPECT_EQ(full.rgb[i], skipped.rgb[i]) << "value " << i << (jitter ? " (jitter)" : "");
+      seen += full.rgb[i];
+    }
+    EXPECT_GT(seen, 0.0);  // something is drawn
+  }
+}
+
 }  // namespace
 }  // namespace beamcast
