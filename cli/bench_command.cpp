@@ -1,7 +1,8 @@
 // `beamcast bench accuracy`: the accuracy/time benchmark of bench/accuracy.hpp;
 // `bench views`; `bench slim` (bench/slim_bench.hpp); `bench gi` (bench/gi_bench.py, run with this binary);
 // `bench medium` (bench/medium_bench.py, likewise), `bench medium-rule`, `bench fog`
-// (bench/fog_bench.py) and `bench povray` (bench/povray_bench.py).
+// (bench/fog_bench.py), `bench povray` (bench/povray_bench.py) and `bench volumes`
+// (bench/volume_bench.hpp).
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -16,6 +17,7 @@
 
 #include "bench/accuracy.hpp"
 #include "bench/slim_bench.hpp"
+#include "bench/volume_bench.hpp"
 #include "bench/views.hpp"
 #include "protocol/density.hpp"
 #include "render/beam_medium.hpp"
@@ -92,6 +94,31 @@ void add_bench_command(CLI::App& app) {
     const int rc = bench::run_accuracy(*opts);
     if (rc != 0) throw CLI::RuntimeError(rc);
   });
+
+  auto volopts = std::make_shared<bench::VolumeBenchOptions>();
+  CLI::App* volumes = bench->add_subcommand(
+      "volumes",
+      "Volume ray casting against the CPU reference: the seed's tables (S_z, S_xy, R_v) with "
+      "error columns, ERT and empty-space skipping on a sparse and a dense volume; writes "
+      "volumes.csv and volumes.md to --out");
+  volumes->add_option("--out,-o", volopts->out, "Output directory (created if missing)")->required();
+  volumes->add_flag("--quick", volopts->quick, "96x96, small volumes, fewer settings");
+  volumes->add_option("--size", volopts->size, "Frame width and height (default 512, 96 with --quick)")
+      ->check(CLI::Range(16, 4096));
+  volumes->add_option("--repeats", volopts->repeats, "GPU frames per row, median reported (default 3)")
+      ->check(CLI::Range(1, 100));
+  volumes->add_option("--reference-spv", volopts->reference_spv,
+                      "The reference's samples per voxel spacing (default 8)")
+      ->check(CLI::Range(1.0, 256.0));
+  volumes->add_option("--skull", volopts->skull,
+                      "skull_2.9.inr (scripts/fetch_cgal_volumes.sh): the sparse volume of the ERT "
+                      "and skipping rows")
+      ->check(CLI::ExistingFile);
+  volumes->add_flag("--images", volopts->images, "Each row's frame as a PNG");
+  volumes->add_option("--device", volopts->egl.device_index, "EGL device index");
+  volumes->add_option("--platform", volopts->egl.platform, "EGL platform: auto, device or surfaceless")
+      ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
+  volumes->callback([volopts] { bench::run_volume_bench(*volopts); });
 
   auto sopts = std::make_shared<bench::SlimBenchOptions>();
   CLI::App* slim = bench->add_subcommand(

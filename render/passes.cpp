@@ -499,6 +499,14 @@ class BeamPass final : public Pass {
  public:
   BeamPass()
       : plain_("beam"), fogged_("beam_medium") {}
+  ProgramPair& volumes_program(const Scene& scene, bool medium) {
+    if (!medium) {
+      if (!plain_volumes_) plain_volumes_.emplace("beam_volumes");
+      return *plain_volumes_;
+    }
+    if (!fogged_volumes_) fogged_volumes_.emplace("beam_medium_volumes");
+    return fogged_volumes_->get(scene);
+  }
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
     // Scenes with a medium use the program with it compiled in (built on
@@ -506,7 +514,12 @@ class BeamPass final : public Pass {
     const bool fog = ctx.scene.has_medium();
     const Medium settings = ctx.scene.medium.value_or(Medium{});
     const Medium* medium = fog ? &settings : nullptr;
-    ProgramPair& program = medium ? fogged_.get(ctx.scene) : plain_;
+    // Scenes with volumes: the programs with their transmittance knots
+    // compiled in (shaders/volumes_on.glsl), built on first use.
+    const bool volumes = ctx.plan.written("volume_t0");
+    ProgramPair& program = volumes ? volumes_program(ctx.scene, medium != nullptr)
+                           : medium ? fogged_.get(ctx.scene)
+                                    : plain_;
     glUseProgram(program.get(multi));
     glUniform3i(program.uniform(multi, "u_table_size"), ctx.resources.table_d(),
                 ctx.resources.table_s(), ctx.resources.table_f());
@@ -542,11 +555,10 @@ class BeamPass final : public Pass {
     glBindTextureUnit(2, surfaces ? ctx.targets.texture("view_depth") : 0);
     glBindTextureUnit(3, ctx.resources.warp_texture());
     if (medium) glBindTextureUnit(4, ctx.resources.moment_texture());
-    // Behind and inside volumes: their transmittance knots (volume_knots.glsl).
-    const bool volumes = ctx.plan.written("volume_t0");
-    glUniform1i(program.uniform(multi, "u_has_volumes"), volumes ? 1 : 0);
-    glBindTextureUnit(5, volumes ? ctx.targets.texture("volume_t0") : 0);
-    glBindTextureUnit(6, volumes ? ctx.targets.texture("volume_t1") : 0);
+    if (volumes) {
+      glBindTextureUnit(5, ctx.targets.texture("volume_t0"));
+      glBindTextureUnit(6, ctx.targets.texture("volume_t1"));
+    }
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx.resources.beam_buffer());
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
@@ -573,6 +585,8 @@ class BeamPass final : public Pass {
  private:
   ProgramPair plain_;
   RegionProgram fogged_;
+  std::optional<ProgramPair> plain_volumes_;
+  std::optional<RegionProgram> fogged_volumes_;
 };
 
 // HDR -> display values in the output's bit depth.

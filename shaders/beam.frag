@@ -26,10 +26,11 @@ layout(std430, binding = 1) readonly buffer Beams { BeamData beams[]; };
 
 layout(binding = 2) uniform VIEW_SAMPLER u_view_depth;  // surfaces' view depth (huge: none)
 uniform int u_has_surfaces;
+#ifdef BEAMCAST_VOLUMES
 // Scenes with volumes: their transmittance knots (volume_knots.glsl).
 layout(binding = 5) uniform VIEW_SAMPLER u_volume_t0;
 layout(binding = 6) uniform VIEW_SAMPLER u_volume_t1;
-uniform int u_has_volumes;
+#endif
 
 flat in int v_beam;
 layout(location = 0) out vec4 out_energy;
@@ -212,30 +213,30 @@ void main() {
     float z = VIEW_TEXEL(u_view_depth, ivec2(gl_FragCoord.xy)).r;
     t1 = min(t1, z / ray.cos_axis);
   }
+#ifdef BEAMCAST_VOLUMES
   // Behind and inside volumes: the light of each knot segment weighted by
   // the transmittance at its middle, beyond them by the whole volumes'
   // (piece 0: before the volumes, 1-7: the segments, 8: beyond). One call
   // site, so the energy's code is compiled once.
   float a = 0.0, c = 0.0;
-  bool volumes = u_has_volumes != 0 && volume_knot_interval(ray, t1, a, c);
-  vec4 k0 = vec4(1.0), k1 = vec4(1.0);
-  if (volumes) {
-    k0 = VIEW_TEXEL(u_volume_t0, ivec2(gl_FragCoord.xy));
-    k1 = VIEW_TEXEL(u_volume_t1, ivec2(gl_FragCoord.xy));
-  }
-  float knot[8] = float[8](k0.x, k0.y, k0.z, k0.w, k1.x, k1.y, k1.z, k1.w);
+  bool inside = volume_knot_interval(ray, t1, a, c);
+  vec4 k0 = VIEW_TEXEL(u_volume_t0, ivec2(gl_FragCoord.xy));
+  vec4 k1 = VIEW_TEXEL(u_volume_t1, ivec2(gl_FragCoord.xy));
   float h = (c - a) / kVolumeSegments;
-  int pieces = volumes ? kVolumeKnots + 1 : 1;
+  int pieces = inside ? kVolumeKnots + 1 : 1;
   float e = 0.0;
   for (int k = 0; k < pieces; ++k) {
     float sa = t0, sb = t1, weight = 1.0;
-    if (volumes) {
+    if (inside) {
       sa = k == 0 ? t0 : k == kVolumeKnots ? c : a + float(k - 1) * h;
       sb = k == 0 ? a : k >= kVolumeKnots - 1 ? (k == kVolumeKnots ? t1 : c) : a + float(k) * h;
-      weight = k == 0 ? 1.0 : knot[k - 1];
+      weight = k == 0 ? 1.0 : k <= 4 ? k0[k - 1] : k1[k - 5];
     }
     e += weight * beam_energy(b, ray, sa, sb);
   }
+#else
+  float e = beam_energy(b, ray, t0, t1);
+#endif
 #ifdef BEAMCAST_MEDIUM_REGIONS
   // Regions of medium (medium_regions.glsl): their optical depth to the
   // ray's point nearest the beam's centre (the scene-wide medium is exact,
