@@ -89,7 +89,7 @@ std::vector<Row> table_rows(bool quick) {
     r.settings.samples_per_voxel = spv;
     r.settings.opacity_correction = false;
     char buf[48];
-    std::snprintf(buf, sizeof buf, "%g/voxel, no correction", spv);
+    std::snprintf(buf, sizeof buf, "%g/voxel no correction", spv);
     r.value = buf;
     rows.push_back(r);
   }
@@ -124,7 +124,7 @@ std::vector<Row> ert_skip_rows() {
       r.settings.skip_empty = skip;
       r.settings.ert_threshold = ert;
       char buf[64];
-      std::snprintf(buf, sizeof buf, "ert %g, skipping %s", ert, skip ? "on" : "off");
+      std::snprintf(buf, sizeof buf, "ert %g skipping %s", ert, skip ? "on" : "off");
       r.value = buf;
       rows.push_back(r);
     }
