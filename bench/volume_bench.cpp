@@ -12,6 +12,7 @@
 #include "render/image.hpp"
 #include "render/reference.hpp"
 #include "render/renderer.hpp"
+#include "server/accuracy_controller.hpp"
 
 namespace beamcast::bench {
 
@@ -116,6 +117,16 @@ std::vector<Row> table_rows(bool quick) {
   return rows;
 }
 
+// The preview's ladder for volume scenes (server/accuracy_controller.hpp),
+// level by level: what a dragging user sees at each step.
+std::vector<Row> ladder_rows(const VolumeSettings& full) {
+  std::vector<Row> rows;
+  for (const AccuracyLevel& level : make_volume_ladder(RenderSettings{}, full)) {
+    rows.push_back({"preview ladder", level.label, level.volume.value_or(full), level.scale});
+  }
+  return rows;
+}
+
 std::vector<Row> ert_skip_rows() {
   std::vector<Row> rows;
   for (bool skip : {false, true}) {
@@ -196,11 +207,14 @@ void run_volume_bench(const VolumeBenchOptions& opts) {
     if (opts.images) write_png(opts.out / (c.name + "_reference.png"), ref);
     md << "\n## " << c.name << ": " << c.about << "\n\nReference: " << ref_s << " s.\n";
     std::string table;
+    double previous_mean = 0.0;  // the row above's, in the same table
     for (const Row& row : rows) {
       if (row.knob != table) {
         table = row.knob;
-        md << "\n### " << table << "\n\n| setting | GPU ms | volumes ms | rel. L1 | mean |\n"
-           << "|---|---|---|---|---|\n";
+        previous_mean = 0.0;
+        md << "\n### " << table
+           << "\n\n| setting | GPU ms | volumes ms | rel. L1 | mean | mean vs row above |\n"
+           << "|---|---|---|---|---|---|\n";
       }
       Scene scene = base;
       scene.volume = row.settings;
@@ -237,12 +251,22 @@ void run_volume_bench(const VolumeBenchOptions& opts) {
                     s.opacity_correction ? 1 : 0, s.ert_threshold, s.skip_empty ? 1 : 0, s.level,
                     pyramid, row.scale, size, median(gpu), median(pass), median(wall), e.rel_l1, e.mean);
       csv << line << std::flush;
-      std::snprintf(line, sizeof line, "| %s | %.1f | %.1f | %.4f | %.4f |\n", row.value.c_str(),
-                    median(gpu), median(pass), e.rel_l1, e.mean);
+      char change[32] = "";
+      if (previous_mean > 0.0) {
+        std::snprintf(change, sizeof change, "%+.2f%%", 100.0 * (e.mean / previous_mean - 1.0));
+      }
+      previous_mean = e.mean;
+      std::snprintf(line, sizeof line, "| %s | %.1f | %.1f | %.4f | %.4f | %s |\n", row.value.c_str(),
+                    median(gpu), median(pass), e.rel_l1, e.mean, change);
       md << line << std::flush;
     }
   };
-  for (const Case& c : tables) run_case(c, table_rows(opts.quick));
+  for (const Case& c : tables) {
+    std::vector<Row> rows = table_rows(opts.quick);
+    const std::vector<Row> ladder = ladder_rows(VolumeSettings{});
+    rows.insert(rows.end(), ladder.begin(), ladder.end());
+    run_case(c, rows);
+  }
   for (const Case& c : ert_cases) run_case(c, ert_skip_rows());
   std::printf("wrote %s and volumes.md\n", (opts.out / "volumes.csv").c_str());
 }

@@ -35,6 +35,7 @@ PhotonLod preview_lod(const GiSettings& gi, double scene_size) {
 }
 
 std::vector<AccuracyLevel> preview_ladder(const Scene& scene) {
+  if (!scene.volumes.empty()) return make_volume_ladder(scene.render, scene.volume);
   const Aabb box = scene_box(scene);
   const double size = box.empty() ? 0.0 : length(box.hi - box.lo);
   return make_accuracy_ladder(scene.render, scene.has_gi(), preview_lod(scene.gi, size));
@@ -42,6 +43,7 @@ std::vector<AccuracyLevel> preview_ladder(const Scene& scene) {
 
 void apply_accuracy_level(const AccuracyLevel& level, Scene* scene) {
   scene->render = level.render;
+  if (level.volume) scene->volume = *level.volume;
   scene->gi.display_fraction = level.photon_fraction;
   if (level.lod.groups > 0) {
     scene->gi.lod_groups = level.lod.groups;
@@ -80,6 +82,25 @@ std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full, bool
   // resolution at equal time (docs/media.md), so it only extends the
   // ladder below its cheapest level.
   if (lit && lod.groups > 0) ladder.push_back({fast_name + "+lod@1/4", 0.25, fast, 75, photons, lod});
+  return ladder;
+}
+
+std::vector<AccuracyLevel> make_volume_ladder(const RenderSettings& full, const VolumeSettings& vol) {
+  // The beams' cheap integration as in make_accuracy_ladder's second level.
+  const RenderSettings fast = make_accuracy_ladder(full).back().render;
+  std::vector<AccuracyLevel> ladder;
+  ladder.push_back({"full", 1.0, full, 92, 1.0, {}, vol});
+  VolumeSettings v = vol;
+  v.samples_per_voxel = std::min(vol.samples_per_voxel, 1.0);
+  v.ert_threshold = std::min(vol.ert_threshold, 0.98);
+  ladder.push_back({"sz1", 1.0, fast, 90, 1.0, {}, v});
+  ladder.push_back({"sz1@3/4", 0.75, fast, 85, 1.0, {}, v});
+  ladder.push_back({"sz1@1/2", 0.5, fast, 80, 1.0, {}, v});
+  v.samples_per_voxel = std::min(vol.samples_per_voxel, 0.5);
+  ladder.push_back({"sz1/2@1/2", 0.5, fast, 80, 1.0, {}, v});
+  v.level = std::max(vol.level, 1);
+  ladder.push_back({"sz1/2+rv1@1/2", 0.5, fast, 80, 1.0, {}, v});
+  ladder.push_back({"sz1/2+rv1@1/4", 0.25, fast, 75, 1.0, {}, v});
   return ladder;
 }
 

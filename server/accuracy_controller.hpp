@@ -35,6 +35,9 @@ struct AccuracyLevel {
   double photon_fraction = 1.0;
   // Lit scenes: the photon LOD of this level (replaces the scene's gi.lod).
   PhotonLod lod;
+  // Scenes with volumes: the ray caster's settings of this level (replace
+  // the scene's "volume"); none: the scene's own.
+  std::optional<VolumeSettings> volume;
 };
 
 // The ladder for a scene whose full-accuracy settings are `full`, ordered from
@@ -61,8 +64,17 @@ std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full, bool
 // the most pixels, go first (seed fig 6.1: about 2x frames/s).
 PhotonLod preview_lod(const GiSettings& gi, double scene_size);
 
+// The ladder of a scene with volumes (seed 004's policy: one knob a step,
+// full accuracy at rest): from `vol` (the scene's settings) to S_z 1 with
+// ERT 0.98, then resolution 3/4 and 1/2, then S_z 1/2, then R_v one level
+// down, then resolution 1/4. Opacity correction stays on (the scene's
+// choice), so the brightness holds from level to level (docs/volumes.md
+// measures each level's time, error and mean).
+std::vector<AccuracyLevel> make_volume_ladder(const RenderSettings& full, const VolumeSettings& vol);
+
 // make_accuracy_ladder for a scene: lit or not, with preview_lod over the
-// diagonal of its bounds (protocol/scene_bounds.hpp).
+// diagonal of its bounds (protocol/scene_bounds.hpp); make_volume_ladder
+// for a scene with volumes.
 std::vector<AccuracyLevel> preview_ladder(const Scene& scene);
 
 // The scene as `level` renders it: its integration settings, the share of

@@ -12,7 +12,9 @@ Checks the CSV's shape and what its rows must show whatever the machine:
   - R_v's max pyramid is brighter than its average one (max keeps peaks);
   - empty-space skipping leaves the error exactly as it was (it skips only
     samples that add nothing) at every ERT;
-  - a lower ERT threshold never lowers the error.
+  - a lower ERT threshold never lowers the error;
+  - the preview's ladder for volume scenes changes the frame's mean by under
+    2% from level to level (the issue's bound on brightness pops).
 Timing is recorded, never asserted (docs/volumes.md has the numbers).
 """
 import csv
@@ -57,6 +59,13 @@ def main():
         check(f"R_v level {level}: max brighter than average",
               float(by["max"]["mean"]) > float(by["average"]["mean"]),
               f"mean max {by['max']['mean']} vs average {by['average']['mean']}")
+    ladder = pick(first, "preview ladder")
+    means = [float(r["mean"]) for r in ladder]
+    steps = [abs(b / a - 1.0) for a, b in zip(means, means[1:])]
+    # The issue's bound: no brightness pop between adjacent preview levels.
+    check("preview ladder: the mean changes under 2% level to level",
+          len(ladder) >= 5 and max(steps) < 0.02,
+          f"{[(r['value'], r['mean']) for r in ladder]}, largest step {100 * max(steps):.2f}%")
     for volume in sorted({r["volume"] for r in rows if r["knob"] == "ERT / skipping"}):
         es = pick(volume, "ERT / skipping")
         for ert in sorted({r["ert"] for r in es}):

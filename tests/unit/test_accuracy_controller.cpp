@@ -28,6 +28,39 @@ TEST(AccuracyLadder, StartsAtTheSceneSettingsAndGetsCheaper) {
   EXPECT_EQ(ladder.back().scale, 0.25);
 }
 
+TEST(AccuracyLadder, VolumeScenesChangeOneKnobAStep) {
+  VolumeSettings vol;  // 2 samples a voxel, ERT 0.99, level 0
+  Scene scene;
+  scene.volumes.push_back(procedural_volume(VolumeSourceType::kHeat, 4));
+  scene.volume = vol;
+  const auto ladder = preview_ladder(scene);
+  ASSERT_EQ(ladder.size(), 7u);
+  ASSERT_TRUE(ladder[0].volume.has_value());
+  EXPECT_EQ(ladder[0].volume->samples_per_voxel, 2.0);
+  EXPECT_EQ(ladder[0].scale, 1.0);
+  // Each step below full changes one of S_z, S_xy and R_v (ERT and the
+  // beams' table change with the first), never back up.
+  for (std::size_t i = 2; i < ladder.size(); ++i) {
+    const AccuracyLevel& a = ladder[i - 1];
+    const AccuracyLevel& b = ladder[i];
+    ASSERT_TRUE(b.volume.has_value());
+    const int changed = (a.scale != b.scale) +
+                        (a.volume->samples_per_voxel != b.volume->samples_per_voxel) +
+                        (a.volume->level != b.volume->level);
+    EXPECT_EQ(changed, 1) << b.label;
+    EXPECT_LE(b.scale, a.scale);
+    EXPECT_LE(b.volume->samples_per_voxel, a.volume->samples_per_voxel);
+    EXPECT_GE(b.volume->level, a.volume->level);
+    EXPECT_TRUE(b.volume->opacity_correction);  // what keeps the brightness level to level
+  }
+  EXPECT_EQ(ladder.back().scale, 0.25);
+  EXPECT_EQ(ladder.back().volume->level, 1);
+  // Applying a level sets the scene's volume settings.
+  Scene moved = scene;
+  apply_accuracy_level(ladder[4], &moved);
+  EXPECT_EQ(moved.volume.samples_per_voxel, 0.5);
+}
+
 TEST(AccuracyLadder, MarchingSceneGetsATableAsItsCheapIntegration) {
   RenderSettings full;
   full.method = IntegrationMethod::kMarch;
