@@ -309,7 +309,7 @@ def read_inr(path):
     bits = int(fields["PIXSIZE"].split()[0])
     big = fields.get("CPU", "decm").lower() in ("sun", "sgi")
     kind = {"float": "f", "unsigned fixed": "u", "signed fixed": "i"}[fields["TYPE"].lower()]
-    dtype = np.dtype(("%s%s%d" % (">" if big else "<", kind, bits // 8)))
+    dtype = np.dtype("%s%s%d" % (">" if big else "<", kind, bits // 8))
     count = dims[0] * dims[1] * dims[2]
     vox = np.frombuffer(data, dtype=dtype, count=count, offset=header_len)
     spacing = [float(fields.get(k, "1")) for k in ("VX", "VY", "VZ")]
@@ -342,8 +342,9 @@ def volume_setups(a, notes):
                        capture_output=True, text=True)
     skull = os.path.join(cgal, "skull_2.9.inr")
     if p.returncode != 0 or not os.path.exists(skull):
+        said = (p.stderr or p.stdout).strip().splitlines()
         notes.append("skull skipped: scripts/fetch_cgal_volumes.sh failed (exit %d): %s" %
-                     (p.returncode, (p.stderr or p.stdout).strip().splitlines()[-1:]))
+                     (p.returncode, said[-1] if said else "no message"))
         return out
     vox, spacing = read_inr(skull)
     q, rng = quantize_like_beamcast(vox)
@@ -678,7 +679,7 @@ def write_outputs(a, rows, floors, notes, version, bc_renderer, vtk_renderer, lo
                 (version, a.size, a.size, time.perf_counter() - t_start, load_start[0],
                  load_end[0], os.cpu_count() or 0))
         st = os.stat(a.binary)
-        f.write("- Beamcast: %s (EGL, no X); %s, %d bytes, built %s\n- VTK: %s (GLX under "
+        f.write("- Beamcast: %s (EGL, no X); %s, %d bytes, modified %s\n- VTK: %s (GLX under "
                 "xvfb-run)\n\n" % (bc_renderer, a.binary, st.st_size,
                                     time.strftime("%Y-%m-%d %H:%M", time.localtime(st.st_mtime)),
                                     vtk_renderer))

@@ -37,6 +37,8 @@ struct SceneLimits {
   // (one per point or spot light, about gi.direct_samples per quad light)
   // x 6 cube faces x gi.shadow_size^2; 4 bytes each.
   std::int64_t max_shadow_texels = 256LL << 20;
+  // Voxels of a scene's volumes, summed (2 bytes each on the CPU and the GPU).
+  std::int64_t max_volume_voxels = kMaxVolumeVoxels;
 };
 
 // The server's scene limits (PROTOCOL.md, "Limits"), stricter than the
@@ -51,7 +53,10 @@ inline constexpr SceneLimits kServerSceneLimits{.max_beams = 10000,
                                                 .max_slim_spheres = 200000,
                                                 .max_lights = 64,
                                                 .max_photons = 4000000,
-                                                .max_shadow_texels = 32LL << 20};
+                                                .max_shadow_texels = 32LL << 20,
+                                                // 256^3: 32 MiB, built or read
+                                                // in well under a second.
+                                                .max_volume_voxels = 16LL << 20};
 
 struct SceneLoadOptions {
   // Mesh files are read only from below this directory; absolute paths and

@@ -220,7 +220,7 @@ std::optional<Vec3> direction_lengths(const VolumeFileRef& f, const std::string&
 }
 
 std::array<int, 3> header_dims(const VolumeFileRef& f, const std::array<std::int64_t, 3>& dims,
-                               std::int64_t budget, const std::string& what) {
+                               const VoxelBudget& budget, const std::string& what) {
   return check_volume_dims(dims, budget, quoted(f.name) + "'s " + what,
                            {f.json_path, f.json_path, f.json_path}, f.json_path);
 }
@@ -311,7 +311,7 @@ bool is_float(VolumeSampleType t) {
   return t == VolumeSampleType::kF32 || t == VolumeSampleType::kF64;
 }
 
-std::array<int, 3> check_volume_dims(const std::array<std::int64_t, 3>& dims, std::int64_t budget,
+std::array<int, 3> check_volume_dims(const std::array<std::int64_t, 3>& dims, const VoxelBudget& budget,
                                      const std::string& what,
                                      const std::array<std::string, 3>& axis_paths,
                                      const std::string& path) {
@@ -325,14 +325,14 @@ std::array<int, 3> check_volume_dims(const std::array<std::int64_t, 3>& dims, st
   std::int64_t product = dims[0];
   const bool overflow = __builtin_mul_overflow(product, dims[1], &product) ||
                         __builtin_mul_overflow(product, dims[2], &product);
-  const std::string limit = "max_volume_voxels = " + std::to_string(kMaxVolumeVoxels);
+  const std::string limit = "max_volume_voxels = " + std::to_string(budget.limit);
   if (overflow) {
     fail("limit_exceeded", path,
          what + " " + dims_text(dims) +
              " make more voxels than a 64-bit integer holds, far over the limit " + limit);
   }
-  if (product > budget) {
-    const std::int64_t used = kMaxVolumeVoxels - budget;
+  if (product > budget.left) {
+    const std::int64_t used = budget.limit - budget.left;
     fail(
         "limit_exceeded", path,
         what + " " + dims_text(dims) + " make " + std::to_string(product) + " voxels" +
@@ -361,7 +361,7 @@ VolumeFileData read_raw_volume(const VolumeFileRef& f, const std::array<int, 3>&
   return d;
 }
 
-VolumeFileData read_nrrd_volume(const VolumeFileRef& f, std::int64_t budget) {
+VolumeFileData read_nrrd_volume(const VolumeFileRef& f, const VoxelBudget& budget) {
   // The header ends at the first empty line; 64 KiB is far more than any
   // real header (a few hundred bytes) and bounds what a bad file costs.
   constexpr std::size_t kMaxHeader = 1 << 16;
@@ -503,7 +503,7 @@ VolumeFileData read_nrrd_volume(const VolumeFileRef& f, std::int64_t budget) {
   return d;
 }
 
-VolumeFileData read_inr_volume(const VolumeFileRef& f, std::int64_t budget) {
+VolumeFileData read_inr_volume(const VolumeFileRef& f, const VoxelBudget& budget) {
   const bool gz = ends_with(f.name, ".gz");
   // Header blocks of 256 bytes until one holds "##}"; real headers take
   // one block, 64 bound what a bad file costs.

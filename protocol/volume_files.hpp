@@ -20,6 +20,13 @@
 
 namespace beamcast {
 
+// The voxels a volume may still have: what the scene's limit
+// (SceneLimits::max_volume_voxels) leaves after its earlier volumes.
+struct VoxelBudget {
+  std::int64_t left = 0;
+  std::int64_t limit = 0;
+};
+
 enum class VolumeSampleType : std::uint8_t { kU8, kI8, kU16, kI16, kU32, kI32, kF32, kF64 };
 std::size_t sample_size(VolumeSampleType t);
 std::string_view sample_type_name(VolumeSampleType t);  // "uint8", ..., "float32", "float64"
@@ -48,7 +55,7 @@ struct VolumeFileRef {
 // max_volume_voxels, the room the scene's other volumes leave); each at most
 // kMaxVolumeDimension ("out_of_range"). `what` names them in messages
 // ("dimensions", "\"ct.nrrd\"'s sizes").
-std::array<int, 3> check_volume_dims(const std::array<std::int64_t, 3>& dims, std::int64_t budget,
+std::array<int, 3> check_volume_dims(const std::array<std::int64_t, 3>& dims, const VoxelBudget& budget,
                                      const std::string& what,
                                      const std::array<std::string, 3>& axis_paths,
                                      const std::string& path);
@@ -60,12 +67,12 @@ VolumeFileData read_raw_volume(const VolumeFileRef& f, const std::array<int, 3>&
 // An NRRD file with an attached header: dimension 3; types uint8, int8,
 // uint16, int16, float, double (and their NRRD aliases); encoding raw or
 // gzip; "spacings" (or the lengths of "space directions") as its spacing.
-VolumeFileData read_nrrd_volume(const VolumeFileRef& f, std::int64_t budget);
+VolumeFileData read_nrrd_volume(const VolumeFileRef& f, const VoxelBudget& budget);
 // An INRIA image: the "#INRIMAGE-4#{" header of 256-byte blocks ending
 // "##}", VDIM=1, TYPE unsigned fixed, signed fixed or float, PIXSIZE 8 to
 // 64 bits, CPU decm/alpha/pc (little-endian) or sun/sgi (big-endian),
 // VX/VY/VZ as its spacing. Gzip-compressed when the name ends ".gz".
-VolumeFileData read_inr_volume(const VolumeFileRef& f, std::int64_t budget);
+VolumeFileData read_inr_volume(const VolumeFileRef& f, const VoxelBudget& budget);
 
 // The smallest and largest sample; "bad_volume" naming the voxel (index and
 // x, y, z) if a float sample is NaN or infinite.

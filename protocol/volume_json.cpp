@@ -64,7 +64,7 @@ std::array<double, 2> default_range(const VolumeFileData& d, const std::array<do
 
 // Reads "source" into v's source, grid, range and file; the spacing the
 // source implies (procedural: filling [-1, 1]^3; files: the header's or 1).
-Vec3 read_source(const Node& n, const SceneLoadOptions& opts, std::int64_t budget,
+Vec3 read_source(const Node& n, const SceneLoadOptions& opts, const VoxelBudget& budget,
                  const std::optional<std::array<double, 2>>& range, Volume* v) {
   ObjectReader s(n, "a volume source");
   v->source = read_enum<VolumeSourceType>(s.required("type"),
@@ -192,7 +192,9 @@ Volume parse_volume(const Node& n, const SceneLoadOptions& opts, std::int64_t* v
   Volume v;
   std::optional<std::array<double, 2>> range;
   if (auto r = o.optional("range")) range = read_range(*r);
-  Vec3 spacing = read_source(o.required("source"), opts, kMaxVolumeVoxels - *voxels, range, &v);
+  Vec3 spacing = read_source(o.required("source"), opts,
+                             {opts.limits.max_volume_voxels - *voxels, opts.limits.max_volume_voxels},
+                             range, &v);
   *voxels += v.grid->voxels();
 
   const auto sp = o.optional("spacing");

@@ -55,6 +55,8 @@ const std::vector<LimitEntry>& limit_table() {
       BEAMCAST_LIMIT("max_shadow_texels", scene_limits.max_shadow_texels, 0, kI64,
                      "Most shadow-map texels of a lit scene's direct light (points x 6 x "
                      "gi.shadow_size^2)"),
+      BEAMCAST_LIMIT("max_volume_voxels", scene_limits.max_volume_voxels, 0, kI64,
+                     "Most voxels of a scene's volumes, summed (2 bytes each)"),
       BEAMCAST_LIMIT("max_mesh_triangles", scene_limits.max_mesh_triangles, 0, kI64,
                      "Most mesh triangles in a scene, all meshes together"),
       BEAMCAST_LIMIT("max_slim_spheres", scene_limits.max_slim_spheres, 0, kI64,
