@@ -15,7 +15,10 @@ std::vector<float> transfer_texels(const Volume& volume) {
     const double v = static_cast<double>(i) / (kTransferTexels - 1);
     const Color c = volume.transfer.color(v);
     for (int k = 0; k < 3; ++k) texels[4 * i + k] = static_cast<float>(c[k] * volume.intensity);
-    texels[4 * i + 3] = static_cast<float>(volume.transfer.opacity(v));
+    // log2(1 - opacity): the shader's 1 - alpha = exp2(this x ds / unit),
+    // one exp2 a sample instead of a pow; an opaque point is held at 2^-64
+    // (so neighbouring texels interpolate finite values).
+    texels[4 * i + 3] = static_cast<float>(std::max(std::log2(1.0 - volume.transfer.opacity(v)), -64.0));
   }
   return texels;
 }
@@ -34,7 +37,7 @@ std::vector<std::uint8_t> brick_occupancy(const VolumeGrid& grid, const std::vec
     const int b = std::clamp(static_cast<int>(std::ceil(hi * (kTransferTexels - 1))), 0,
                              kTransferTexels - 1);
     for (int i = a; i <= b; ++i) {
-      if (texels[4 * static_cast<std::size_t>(i) + 3] > 0.0f) return true;
+      if (texels[4 * static_cast<std::size_t>(i) + 3] < 0.0f) return true;  // log2(1 - opacity)
     }
     return false;
   };
@@ -161,6 +164,7 @@ class VolumePass final : public Pass {
     glUniform1f(program_.uniform(multi, "u_ert"), static_cast<float>(s.ert_threshold));
     glUniform1i(program_.uniform(multi, "u_jitter"), s.jitter ? 1 : 0);
     glUniform1i(program_.uniform(multi, "u_skip_empty"), s.skip_empty ? 1 : 0);
+    glUniform1i(program_.uniform(multi, "u_knots"), ctx.scene.beams.empty() ? 0 : 1);
     glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
     // hdr = volume colour + (1 - volume opacity) hdr, hdr's alpha kept; the
     // transmittance knots multiplied over the volumes.

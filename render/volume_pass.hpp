@@ -39,7 +39,7 @@ class VolumeResources {
     std::array<int, 3> dims{0, 0, 0};  // of the uploaded level
     Vec3 spacing{};                    // world spacing at that level (grid convention kept)
     GlTexture values;                  // GL_R16, 3D
-    GlTexture transfer;                // GL_RGBA32F, 1D: (colour x intensity, opacity)
+    GlTexture transfer;                // GL_RGBA32F, 1D: (colour x intensity, log2(1 - opacity))
     // Empty-space skipping: per brick of kBrickCells^3 cells, 1 if any value
     // in it (its corner voxels included) has a non-zero opacity in the
     // transfer table, else 0 (GL_R8, 3D, nearest).
@@ -58,7 +58,7 @@ class ProgramPair;
 struct FrameContext;
 void set_volume_box(ProgramPair& program, bool multiview, const FrameContext& ctx, int view);
 
-// The RGBA texels of a transfer function (colour x intensity, opacity),
+// The RGBA texels of a transfer function (colour x intensity, log2(1 - opacity)),
 // exposed for tests.
 std::vector<float> transfer_texels(const Volume& volume);
 

@@ -11,7 +11,7 @@
 // volume_t0/volume_t1 over the volumes) for the beams.
 layout(binding = 0) uniform VIEW_SAMPLER u_view_depth;  // surfaces' view depth
 layout(binding = 1) uniform sampler3D u_values;         // normalized values, GL_R16
-layout(binding = 2) uniform sampler1D u_transfer;       // (colour x intensity, opacity)
+layout(binding = 2) uniform sampler1D u_transfer;       // (colour x intensity, log2(1 - opacity))
 layout(binding = 3) uniform usampler3D u_bricks;        // 1: the brick can show something
 uniform int u_has_surfaces;
 uniform mat3 u_rotation;  // world from (grid x spacing)
@@ -24,6 +24,7 @@ uniform float u_fixed_exponent;  // < 0: opacity correction; else every sample's
 uniform float u_ert;
 uniform int u_jitter;
 uniform int u_skip_empty;
+uniform int u_knots;  // 0: no beams read the knots (none are tracked)
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out vec4 out_knots0;  // knots 0-3
@@ -67,7 +68,8 @@ void main() {
   vec3 color = vec3(0.0);
   float transmittance = 1.0;
   float knot[kVolumeKnots];
-  int next_knot = knots ? 0 : kVolumeKnots;
+  int next_knot = knots && u_knots != 0 ? 0 : kVolumeKnots;
+  float knot_t = next_knot < kVolumeKnots ? volume_knot(next_knot, knot_a, knot_b) : 1e30;
   for (int i = 0; i < kVolumeKnots; ++i) knot[i] = 1.0;
   int steps = int(ceil((t1 - t0) / u_step));
   int k = 0;
@@ -96,14 +98,16 @@ void main() {
     k = following;
     float v = texture(u_values, (g + 0.5) / u_dims).r;
     vec4 tf = texture(u_transfer, (v * (kTransferTexels - 1.0) + 0.5) / kTransferTexels);
+    // 1 - alpha = (1 - opacity)^e: the table holds log2(1 - opacity).
     float e = u_fixed_exponent >= 0.0 ? u_fixed_exponent : len / u_opacity_unit;
-    float alpha = 1.0 - pow(max(1.0 - tf.a, 0.0), e);
+    float alpha = 1.0 - exp2(tf.a * e);
     // Knots within this step: the transmittance up to them, the step's
     // extinction taken as uniform over it.
-    while (next_knot < kVolumeKnots && volume_knot(next_knot, knot_a, knot_b) < s0 + len) {
-      float part = clamp((volume_knot(next_knot, knot_a, knot_b) - s0) / len, 0.0, 1.0);
-      knot[next_knot] = transmittance * pow(max(1.0 - alpha, 0.0), part);
+    while (knot_t < s0 + len) {
+      float part = clamp((knot_t - s0) / len, 0.0, 1.0);
+      knot[next_knot] = transmittance * exp2(tf.a * e * part);
       ++next_knot;
+      knot_t = next_knot < kVolumeKnots ? volume_knot(next_knot, knot_a, knot_b) : 1e30;
     }
     color += transmittance * alpha * tf.rgb;
     transmittance *= 1.0 - alpha;
