@@ -62,6 +62,7 @@ struct Renderer::Impl {
   std::array<std::unique_ptr<Pass>, kPassCount> passes;  // by PassId
   TableCache tables;
   PhotonCache photons;  // photon maps by what they depend on (gi/photon_cache.hpp)
+  VolumeTextureCache volumes;  // volume textures across frames (render/volume_pass.hpp)
   FrameTargets targets;
   FrameTargets layered;  // multi-view batches
   GlVertexArray empty_vao;
@@ -485,7 +486,7 @@ std::vector<std::vector<std::size_t>> camera_batches(const std::vector<Camera>& 
 std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<Camera>& cameras,
                                           const FrameOptions& opts) {
   const FramePlan plan = make_plan(PlanInput{scene, opts.resolution_scale});
-  SceneResources res(scene, impl_->tables, plan, &impl_->photons);
+  SceneResources res(scene, impl_->tables, plan, &impl_->photons, &impl_->volumes);
   if (std::exchange(impl_->fail_next, false)) {
     glEnable(0);  // GL_INVALID_ENUM
     gl_check("glEnable(0) (injected test failure)");

@@ -142,7 +142,7 @@ class VertexSink final : public TriangleSink {
 }  // namespace
 
 SceneResources::SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan,
-                               PhotonCache* photons)
+                               PhotonCache* photons, VolumeTextureCache* volumes)
     : scene_(scene) {
   if (plan.uploads_group("beams")) upload_beams(tables);
   if (plan.uploads_group("occluders")) upload_occluders();
@@ -159,7 +159,7 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
   }
   if (plan.uploads_group("shadows")) upload_direct();
   if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene);
-  if (plan.uploads_group("volumes")) volumes_ = std::make_unique<VolumeResources>(scene);
+  if (plan.uploads_group("volumes")) volumes_ = std::make_unique<VolumeResources>(scene, volumes);
   upload_medium_meshes();
   if (plan.uploads_group("specular")) {
     if (!photons)

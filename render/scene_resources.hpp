@@ -43,7 +43,7 @@ class SceneResources {
   // beam instances), "occluders" (triangles, analytic occluders), "photons"
   // (the scene's photon maps from `photons`, traced there unless cached).
   SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan,
-                 PhotonCache* photons = nullptr);
+                 PhotonCache* photons = nullptr, VolumeTextureCache* volumes = nullptr);
   // Uploads the camera block and camera-relative beam and occluder data.
   void bind_camera(const Camera& cam, const CameraBasis& basis);
   // Multi-view: uploads one camera block per view (the CameraBlocks uniform

@@ -66,53 +66,88 @@ std::vector<std::uint8_t> brick_occupancy(const VolumeGrid& grid, const std::vec
   return occupied;
 }
 
-VolumeResources::VolumeResources(const Scene& scene) {
+namespace {
+
+std::shared_ptr<const VolumeTextures> upload_volume(const Volume& vol, const VolumeSettings& s,
+                                                    const std::vector<float>& tf) {
+  auto u = std::make_shared<VolumeTextures>();
+  std::shared_ptr<const VolumeGrid> grid = vol.grid;
+  if (s.level > 0) grid = volume_level(*vol.grid, s.level, s.pyramid);
+  u->dims = grid->dims;
+  GLuint tex = 0;
+  glCreateTextures(GL_TEXTURE_3D, 1, &tex);
+  u->values = GlTexture(tex);
+  glTextureStorage3D(tex, 1, GL_R16, u->dims[0], u->dims[1], u->dims[2]);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
+  glTextureSubImage3D(tex, 0, 0, 0, 0, u->dims[0], u->dims[1], u->dims[2], GL_RED, GL_UNSIGNED_SHORT,
+                      grid->values.data());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) {
+    glTextureParameteri(tex, wrap, GL_CLAMP_TO_EDGE);
+  }
+  glCreateTextures(GL_TEXTURE_1D, 1, &tex);
+  u->transfer = GlTexture(tex);
+  glTextureStorage1D(tex, 1, GL_RGBA32F, kTransferTexels);
+  glTextureSubImage1D(tex, 0, 0, kTransferTexels, GL_RGBA, GL_FLOAT, tf.data());
+  glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  const std::vector<std::uint8_t> bricks = brick_occupancy(*grid, tf, &u->brick_dims);
+  glCreateTextures(GL_TEXTURE_3D, 1, &tex);
+  u->bricks = GlTexture(tex);
+  glTextureStorage3D(tex, 1, GL_R8UI, u->brick_dims[0], u->brick_dims[1], u->brick_dims[2]);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTextureSubImage3D(tex, 0, 0, 0, 0, u->brick_dims[0], u->brick_dims[1], u->brick_dims[2],
+                      GL_RED_INTEGER, GL_UNSIGNED_BYTE, bricks.data());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  // An integer texture with a linear filter (the default magnification
+  // filter) is incomplete and reads as 0 everywhere: nearest.
+  glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  gl_check("volume upload");
+  return u;
+}
+
+}  // namespace
+
+std::shared_ptr<const VolumeTextures> VolumeTextureCache::get(const Volume& volume,
+                                                              const VolumeSettings& settings) {
+  const std::vector<float> tf = transfer_texels(volume);
+  const int level = settings.level;
+  const VolumePyramid pyramid = level > 0 ? settings.pyramid : VolumePyramid::kAverage;
+  for (auto it = entries_.begin(); it != entries_.end();) {
+    if (it->grid.expired()) {  // its scene is gone: so are its textures
+      it = entries_.erase(it);
+      continue;
+    }
+    if (it->grid_id == volume.grid.get() && it->level == level && it->pyramid == pyramid &&
+        it->transfer == tf) {
+      entries_.splice(entries_.begin(), entries_, it);
+      return entries_.front().textures;
+    }
+    ++it;
+  }
+  VolumeSettings s = settings;
+  s.pyramid = pyramid;
+  entries_.push_front({volume.grid, volume.grid.get(), level, pyramid, tf, upload_volume(volume, s, tf)});
+  while (entries_.size() > max_entries_) entries_.pop_back();
+  return entries_.front().textures;
+}
+
+VolumeResources::VolumeResources(const Scene& scene, VolumeTextureCache* cache) {
   for (const Volume& vol : scene.volumes) {
     Uploaded u;
     u.volume = &vol;
-    std::shared_ptr<const VolumeGrid> grid = vol.grid;
-    if (scene.volume.level > 0) grid = volume_level(*vol.grid, scene.volume.level, scene.volume.pyramid);
-    u.dims = grid->dims;
+    u.gpu = cache ? cache->get(vol, scene.volume)
+                  : upload_volume(vol, scene.volume, transfer_texels(vol));
     // The level spans the same box, voxel centre to voxel centre.
     for (int a = 0; a < 3; ++a) {
-      u.spacing[a] = vol.spacing[a] * (vol.grid->dims[a] - 1) / static_cast<double>(u.dims[a] - 1);
+      u.spacing[a] = vol.spacing[a] * (vol.grid->dims[a] - 1) / static_cast<double>(u.gpu->dims[a] - 1);
     }
-    GLuint tex = 0;
-    glCreateTextures(GL_TEXTURE_3D, 1, &tex);
-    u.values = GlTexture(tex);
-    glTextureStorage3D(tex, 1, GL_R16, u.dims[0], u.dims[1], u.dims[2]);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
-    glTextureSubImage3D(tex, 0, 0, 0, 0, u.dims[0], u.dims[1], u.dims[2], GL_RED, GL_UNSIGNED_SHORT,
-                        grid->values.data());
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) {
-      glTextureParameteri(tex, wrap, GL_CLAMP_TO_EDGE);
-    }
-    const std::vector<float> tf = transfer_texels(vol);
-    glCreateTextures(GL_TEXTURE_1D, 1, &tex);
-    u.transfer = GlTexture(tex);
-    glTextureStorage1D(tex, 1, GL_RGBA32F, kTransferTexels);
-    glTextureSubImage1D(tex, 0, 0, kTransferTexels, GL_RGBA, GL_FLOAT, tf.data());
-    glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    const std::vector<std::uint8_t> bricks = brick_occupancy(*grid, tf, &u.brick_dims);
-    glCreateTextures(GL_TEXTURE_3D, 1, &tex);
-    u.bricks = GlTexture(tex);
-    glTextureStorage3D(tex, 1, GL_R8UI, u.brick_dims[0], u.brick_dims[1], u.brick_dims[2]);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage3D(tex, 0, 0, 0, 0, u.brick_dims[0], u.brick_dims[1], u.brick_dims[2],
-                        GL_RED_INTEGER, GL_UNSIGNED_BYTE, bricks.data());
-    // An integer texture with a linear filter (the default magnification
-    // filter) is incomplete and reads as 0 everywhere: nearest.
-    glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     volumes_.push_back(std::move(u));
   }
-  gl_check("volume upload");
 }
 
 void set_volume_box(ProgramPair& program, bool multiview, const FrameContext& ctx, int view) {
@@ -198,8 +233,8 @@ class VolumePass final : public Pass {
       glUniformMatrix3fv(program_.uniform(multi, "u_rotation"), 1, GL_TRUE, rot);
       glUniform3f(program_.uniform(multi, "u_spacing"), static_cast<float>(u.spacing[0]),
                   static_cast<float>(u.spacing[1]), static_cast<float>(u.spacing[2]));
-      glUniform3f(program_.uniform(multi, "u_dims"), static_cast<float>(u.dims[0]),
-                  static_cast<float>(u.dims[1]), static_cast<float>(u.dims[2]));
+      glUniform3f(program_.uniform(multi, "u_dims"), static_cast<float>(u.gpu->dims[0]),
+                  static_cast<float>(u.gpu->dims[1]), static_cast<float>(u.gpu->dims[2]));
       const double step = march_step(u, s);
       glUniform1f(program_.uniform(multi, "u_step"), static_cast<float>(step));
       // Opacity of a sample: corrected for its segment's length, or the
@@ -211,9 +246,9 @@ class VolumePass final : public Pass {
                   static_cast<float>(vol.transfer.opacity_unit));
       glUniform1f(program_.uniform(multi, "u_fixed_exponent"),
                   s.opacity_correction ? -1.0f : static_cast<float>(base_step / vol.transfer.opacity_unit));
-      glBindTextureUnit(1, u.values.get());
-      glBindTextureUnit(2, u.transfer.get());
-      glBindTextureUnit(3, u.bricks.get());
+      glBindTextureUnit(1, u.gpu->values.get());
+      glBindTextureUnit(2, u.gpu->transfer.get());
+      glBindTextureUnit(3, u.gpu->bricks.get());
       int view = 0;
       for_each_view_offset(ctx, self, program_, "u_origin", vol.origin, [&] {
         set_volume_box(program_, multi, ctx, view++);

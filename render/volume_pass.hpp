@@ -6,6 +6,7 @@
 // the rays ending at the nearest surface (view_depth).
 #pragma once
 
+#include <list>
 #include <memory>
 #include <vector>
 
@@ -31,20 +32,50 @@ inline constexpr int kBrickCells = 8;
 std::vector<std::uint8_t> brick_occupancy(const VolumeGrid& grid, const std::vector<float>& texels,
                                           std::array<int, 3>* brick_dims);
 
+// One volume on the GPU at one pyramid level with one transfer table.
+struct VolumeTextures {
+  std::array<int, 3> dims{0, 0, 0};  // of the uploaded level
+  GlTexture values;                  // GL_R16, 3D
+  GlTexture transfer;                // GL_RGBA32F, 1D: (colour x intensity, log2(1 - opacity))
+  // Empty-space skipping: per brick of kBrickCells^3 cells, 1 if any value
+  // in it (its corner voxels included) has a non-zero opacity in the
+  // transfer table, else 0 (GL_R8UI, 3D, nearest).
+  GlTexture bricks;
+  std::array<int, 3> brick_dims{0, 0, 0};
+};
+
+// The volumes' textures across frames (a renderer's, like its TableCache):
+// keyed by the grid (the same shared grid: a stored scene's, its camera
+// overrides', the preview's levels), the pyramid level and rule, and the
+// transfer table, least recently used evicted first. Uploading a 256^3
+// volume and its brick grid takes about 100 ms on llvmpipe; a preview frame
+// must not pay it again.
+class VolumeTextureCache {
+ public:
+  explicit VolumeTextureCache(std::size_t max_entries = 4) : max_entries_(max_entries) {}
+  std::shared_ptr<const VolumeTextures> get(const Volume& volume, const VolumeSettings& settings);
+
+ private:
+  struct Entry {
+    std::weak_ptr<const VolumeGrid> grid;
+    const VolumeGrid* grid_id = nullptr;
+    int level = 0;
+    VolumePyramid pyramid = VolumePyramid::kAverage;
+    std::vector<float> transfer;
+    std::shared_ptr<const VolumeTextures> textures;
+  };
+  std::size_t max_entries_;
+  std::list<Entry> entries_;  // most recently used first
+};
+
 class VolumeResources {
  public:
-  explicit VolumeResources(const Scene& scene);
+  // `cache` may be null (everything uploaded for this scene alone).
+  VolumeResources(const Scene& scene, VolumeTextureCache* cache);
   struct Uploaded {
     const Volume* volume = nullptr;
-    std::array<int, 3> dims{0, 0, 0};  // of the uploaded level
-    Vec3 spacing{};                    // world spacing at that level (grid convention kept)
-    GlTexture values;                  // GL_R16, 3D
-    GlTexture transfer;                // GL_RGBA32F, 1D: (colour x intensity, log2(1 - opacity))
-    // Empty-space skipping: per brick of kBrickCells^3 cells, 1 if any value
-    // in it (its corner voxels included) has a non-zero opacity in the
-    // transfer table, else 0 (GL_R8, 3D, nearest).
-    GlTexture bricks;
-    std::array<int, 3> brick_dims{0, 0, 0};
+    Vec3 spacing{};  // world spacing at the uploaded level (grid convention kept)
+    std::shared_ptr<const VolumeTextures> gpu;
   };
   const std::vector<Uploaded>& volumes() const { return volumes_; }
 

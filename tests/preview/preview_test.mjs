@@ -9,6 +9,9 @@
 //
 // node preview_test.mjs --server BIN --cli BIN --artifacts DIR
 //     [--scene demo] [--size 512] [--drag-ms 2000] [--budget 33]
+//     [--still-deadline-ms 1000]
+// --scene names a stored scene or an example file (volume_ml256.json: the
+// page stores it, as its picker does).
 import {spawn, execFileSync} from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
@@ -31,7 +34,9 @@ const dragMs = parseInt(opt('drag-ms', '2000'), 10);
 const budget = opt('budget', '33');
 // The issue's requirement: the full-accuracy frame within one second of the
 // release (nominally still_ms 300 + the frames in flight + one full frame).
-const stillDeadlineMs = 1000;
+// A scene whose full frame alone takes most of a second here (the 256^3
+// volume at 512^2: about 600 ms on llvmpipe) is given --still-deadline-ms.
+const stillDeadlineMs = parseInt(opt('still-deadline-ms', '1000'), 10);
 // Frames in the first part of the drag are excluded from the rate: the
 // controller starts from its first measurement and the pipeline fills.
 const warmupMs = 300;
@@ -170,7 +175,10 @@ try {
   });
   const stillPng = Buffer.from(still.png, 'base64');
   fs.writeFileSync(path.join(artifacts, 'still_frame.png'), stillPng);
-  const scene = await (await fetch(`${server.url}api/scenes/${sceneId}`)).json();
+  // The scene as the server stored it (an example, `--scene NAME.json`, is
+  // stored by the page under its own id).
+  const storedId = await page.evaluate(() => window.beamcastPreview.sceneId);
+  const scene = await (await fetch(`${server.url}api/scenes/${storedId}`)).json();
   scene.cameras = [still.camera];
   const scenePath = path.join(artifacts, 'final_pose_scene.json');
   fs.writeFileSync(scenePath, JSON.stringify(scene, null, 1));
