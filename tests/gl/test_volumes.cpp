@@ -47,6 +47,14 @@ HdrImage gpu_hdr(const Scene& scene) {
   return renderer().render(scene, FrameOptions{.read_hdr = true}).at(0).hdr;
 }
 
+// The GPU frame of `scene` against the reference's, printed under `what`.
+HdrError against_reference(const Scene& scene, const char* what) {
+  const HdrError e = compare_hdr(gpu_hdr(scene), render_reference(scene, scene.cameras[0]));
+  std::printf("%s: relative L1 %.4f, max abs %.4f\n", what, e.rel_l1, e.max_abs);
+  EXPECT_EQ(e.nonfinite, 0) << what;
+  return e;
+}
+
 // Per-pixel opacity of the volume from two renders over black and white
 // backgrounds: I_white - I_black = transmittance (the background's share).
 double mean_opacity(const HdrImage& black, const HdrImage& white) {
@@ -69,11 +77,7 @@ TEST(Volumes, OnlyVolumeScenesPlanTheVolumePass) {
 
 TEST(Volumes, DefaultImageMatchesTheReference) {
   // Jitter off: the GPU samples each step's middle as the reference does.
-  const Scene scene = parse_scene(ml_scene(64, {{"jitter", false}}), {});
-  const HdrImage ref = render_reference(scene, scene.cameras[0]);
-  const HdrError e = compare_hdr(gpu_hdr(scene), ref);
-  std::printf("default: relative L1 %.4f, max abs %.4f\n", e.rel_l1, e.max_abs);
-  EXPECT_EQ(e.nonfinite, 0);
+  const HdrError e = against_reference(parse_scene(ml_scene(64, {{"jitter", false}}), {}), "default");
   // Bound: the GPU marches 2 samples a voxel against the reference's 16
   // (the composite's step error, ~1/S_z of the opacity's variation over a
   // step), in float, through a 1024-texel transfer table.
@@ -117,11 +121,8 @@ TEST(Volumes, SurfacesInsideTheVolumeEndItsRays) {
   const json box = {{"occluders",
                      {{{"type", "box"}, {"center", {0.2, -0.2, 0.1}}, {"size", {0.8, 0.8, 0.8}},
                        {"albedo", {0.9, 0.5, 0.2}}}}}};
-  const Scene scene = parse_scene(ml_scene(64, {{"jitter", false}}, {0, 0, 0}, box), {});
-  const HdrImage ref = render_reference(scene, scene.cameras[0]);
-  const HdrError e = compare_hdr(gpu_hdr(scene), ref);
-  std::printf("box inside: relative L1 %.4f, max abs %.4f\n", e.rel_l1, e.max_abs);
-  EXPECT_EQ(e.nonfinite, 0);
+  const HdrError e =
+      against_reference(parse_scene(ml_scene(64, {{"jitter", false}}, {0, 0, 0}, box), {}), "box inside");
   // The march's error as above, plus the box's silhouette (the GPU's view
   // depth is rasterized: its edge pixels may take the other side).
   EXPECT_LT(e.rel_l1, 0.03) << "max abs " << e.max_abs;

@@ -45,3 +45,16 @@ export function pointerMoves(page, ms, radius, cx, cy) {
     }, 16);
   }), {ms, radius, cx, cy});
 }
+
+// The time (page clock) of the first full-accuracy frame after `t`, or null
+// if none comes within `timeoutMs`.
+export async function stillAfter(page, t, timeoutMs = 10000) {
+  try {
+    const h = await page.waitForFunction(
+        (after) => window.beamcastPreview.frames.find((f) => f.still && f.t > after)?.t, t,
+        {timeout: timeoutMs});
+    return await h.jsonValue();
+  } catch {
+    return null;
+  }
+}

@@ -24,7 +24,7 @@ import os from 'node:os';
 import path from 'node:path';
 import readline from 'node:readline';
 import {fileURLToPath} from 'node:url';
-import {launchBrowser, pointerMoves, requireChromium} from './browser.mjs';
+import {launchBrowser, pointerMoves, requireChromium, stillAfter} from './browser.mjs';
 import {decodePng} from './png.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -256,15 +256,7 @@ try {
   await page.mouse.up();
   const tRelease = await page.evaluate(() => performance.now());
   const killB = await awaitResume(page, kB, 2);
-  let stillAt = null;
-  try {
-    const h = await page.waitForFunction(
-        (t) => window.beamcastPreview.frames.find((f) => f.still && f.t > t)?.t, tRelease,
-        {timeout: 10000});
-    stillAt = await h.jsonValue();
-  } catch {
-    stillAt = null;
-  }
+  const stillAt = await stillAfter(page, tRelease);
   await page.screenshot({path: path.join(artifacts, 'still_after_drag.png')});
   const frames = await page.evaluate(() => window.beamcastPreview.frames);
   fs.writeFileSync(path.join(artifacts, 'frames.json'),

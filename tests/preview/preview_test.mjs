@@ -17,7 +17,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import readline from 'node:readline';
-import {launchBrowser, pointerMoves, requireChromium} from './browser.mjs';
+import {launchBrowser, pointerMoves, requireChromium, stillAfter} from './browser.mjs';
 import {decodePng} from './png.mjs';
 
 const argv = process.argv.slice(2);
@@ -120,15 +120,7 @@ try {
   const tRelease = await page.evaluate(() => performance.now());
 
   // The still frame of the final pose.
-  let stillAt = null;
-  try {
-    const h = await page.waitForFunction(
-        (t) => window.beamcastPreview.frames.find((f) => f.still && f.t > t)?.t, tRelease,
-        {timeout: 10000});
-    stillAt = await h.jsonValue();
-  } catch {
-    stillAt = null;
-  }
+  const stillAt = await stillAfter(page, tRelease);
   await page.screenshot({path: path.join(artifacts, 'still.png')});
 
   const frames = await page.evaluate(() => window.beamcastPreview.frames);
