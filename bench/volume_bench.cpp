@@ -25,7 +25,7 @@ struct Case {
 };
 
 struct Row {
-  std::string knob;  // the table the row belongs to
+  std::string knob;   // the table the row belongs to
   std::string value;  // the knob's value, as printed
   VolumeSettings settings;
   double scale = 1.0;  // S_xy: render scale
@@ -69,14 +69,16 @@ DisplayError display_error(const Image& a, const Image& r) {
     sum += r.rgb[i];
     mean += a.rgb[i];
   }
-  return {sum > 0.0 ? diff / sum : 0.0, mean / top / static_cast<double>(std::max<std::size_t>(1, a.rgb.size()))};
+  return {sum > 0.0 ? diff / sum : 0.0,
+          mean / top / static_cast<double>(std::max<std::size_t>(1, a.rgb.size()))};
 }
 
 std::vector<Row> table_rows(bool quick) {
   std::vector<Row> rows;
   // Table 2 (S_z): samples per voxel spacing; the seed's 512 samples a ray
   // through its 256^3 bonsai are about 2 a voxel.
-  for (double spv : quick ? std::vector<double>{0.5, 1, 2, 4} : std::vector<double>{0.25, 0.5, 1, 2, 4, 8}) {
+  for (double spv :
+       quick ? std::vector<double>{0.5, 1, 2, 4} : std::vector<double>{0.25, 0.5, 1, 2, 4, 8}) {
     Row r{"S_z", "", {}, 1.0};
     r.settings.samples_per_voxel = spv;
     char buf[32];
@@ -104,9 +106,9 @@ std::vector<Row> table_rows(bool quick) {
   }
   // Table 4 (R_v): pyramid levels, by each of the seed's three rules.
   for (int level : {1, 2}) {
-    for (auto [how, name] : {std::pair{VolumePyramid::kAverage, "average"},
-                             std::pair{VolumePyramid::kMax, "max"},
-                             std::pair{VolumePyramid::kNonZero, "nonzero"}}) {
+    for (auto [how, name] :
+         {std::pair{VolumePyramid::kAverage, "average"}, std::pair{VolumePyramid::kMax, "max"},
+          std::pair{VolumePyramid::kNonZero, "nonzero"}}) {
       Row r{"R_v", "", {}, 1.0};
       r.settings.level = level;
       r.settings.pyramid = how;
@@ -163,15 +165,17 @@ void run_volume_bench(const VolumeBenchOptions& opts) {
   if (!opts.skull.empty()) {
     SceneLoadOptions load;
     load.assets_dir = opts.skull.parent_path();
-    const nlohmann::json j = {{"volumes",
-                               {{{"source", {{"type", "inr"}, {"file", opts.skull.filename().string()}}},
-                                 {"transfer", {{"preset", "bone"}}}}}},
-                              {"cameras", {{{"position", {0, 0, 1}}}}}};
+    const nlohmann::json j = {
+        {"volumes",
+         {{{"source", {{"type", "inr"}, {"file", opts.skull.filename().string()}}},
+           {"transfer", {{"preset", "bone"}}}}}},
+        {"cameras", {{{"position", {0, 0, 1}}}}}};
     ert_cases.push_back({"skull", parse_scene(j, load).volumes.at(0),
                          "sparse: skull_2.9.inr (64^3 float), preset bone"});
   } else {
     Volume sparse = procedural_volume(VolumeSourceType::kMarschnerLobb, main_n, "ml");
-    sparse.transfer.points = {{0.0, {0, 0, 0}, 0.0}, {0.55, {0.9, 0.6, 0.2}, 0.0}, {1.0, {1, 0.9, 0.6}, 0.8}};
+    sparse.transfer.points = {
+        {0.0, {0, 0, 0}, 0.0}, {0.55, {0.9, 0.6, 0.2}, 0.0}, {1.0, {1, 0.9, 0.6}, 0.8}};
     ert_cases.push_back({"ml_sparse", sparse, "sparse: Marschner-Lobb, nothing below 0.55"});
   }
 
@@ -188,7 +192,8 @@ void run_volume_bench(const VolumeBenchOptions& opts) {
      << opts.reference_spv
      << " samples a voxel, each step's middle, full resolution). GPU ms: the whole frame, median "
         "of "
-     << opts.repeats << "; volumes ms: the volume pass alone. Defaults: 2 samples a voxel, "
+     << opts.repeats
+     << "; volumes ms: the volume pass alone. Defaults: 2 samples a voxel, "
         "opacity correction, jitter, ERT 0.99, skipping on, level 0, scale 1.\n";
 
   auto run_case = [&](const Case& c, const std::vector<Row>& rows) {
@@ -238,7 +243,9 @@ void run_volume_bench(const VolumeBenchOptions& opts) {
       const DisplayError e = display_error(last->image, ref);
       if (opts.images) {
         std::string file = c.name + "_" + row.knob + "_" + row.value + ".png";
-        std::replace_if(file.begin(), file.end(), [](char ch) { return ch == ' ' || ch == '/' || ch == ','; }, '_');
+        std::replace_if(
+            file.begin(), file.end(), [](char ch) { return ch == ' ' || ch == '/' || ch == ','; },
+            '_');
         write_png(opts.out / file, last->image);
       }
       const VolumeSettings& s = row.settings;
@@ -246,18 +253,19 @@ void run_volume_bench(const VolumeBenchOptions& opts) {
                             : s.pyramid == VolumePyramid::kNonZero ? "nonzero"
                                                                    : "average";
       char line[512];
-      std::snprintf(line, sizeof line, "%s,%s,%s,%g,%d,%g,%d,%d,%s,%g,%d,%.3f,%.3f,%.3f,%.6f,%.6f\n",
-                    c.name.c_str(), row.knob.c_str(), row.value.c_str(), s.samples_per_voxel,
-                    s.opacity_correction ? 1 : 0, s.ert_threshold, s.skip_empty ? 1 : 0, s.level,
-                    pyramid, row.scale, size, median(gpu), median(pass), median(wall), e.rel_l1, e.mean);
+      std::snprintf(
+          line, sizeof line, "%s,%s,%s,%g,%d,%g,%d,%d,%s,%g,%d,%.3f,%.3f,%.3f,%.6f,%.6f\n",
+          c.name.c_str(), row.knob.c_str(), row.value.c_str(), s.samples_per_voxel,
+          s.opacity_correction ? 1 : 0, s.ert_threshold, s.skip_empty ? 1 : 0, s.level, pyramid,
+          row.scale, size, median(gpu), median(pass), median(wall), e.rel_l1, e.mean);
       csv << line << std::flush;
       char change[32] = "";
       if (previous_mean > 0.0) {
         std::snprintf(change, sizeof change, "%+.2f%%", 100.0 * (e.mean / previous_mean - 1.0));
       }
       previous_mean = e.mean;
-      std::snprintf(line, sizeof line, "| %s | %.1f | %.1f | %.4f | %.4f | %s |\n", row.value.c_str(),
-                    median(gpu), median(pass), e.rel_l1, e.mean, change);
+      std::snprintf(line, sizeof line, "| %s | %.1f | %.1f | %.4f | %.4f | %s |\n",
+                    row.value.c_str(), median(gpu), median(pass), e.rel_l1, e.mean, change);
       md << line << std::flush;
     }
   };

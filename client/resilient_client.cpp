@@ -8,7 +8,8 @@
 
 namespace beamcast::client {
 
-RetryBudget::RetryBudget(double ratio, double burst) : ratio_(ratio), burst_(burst), tokens_(burst) {}
+RetryBudget::RetryBudget(double ratio, double burst)
+    : ratio_(ratio), burst_(burst), tokens_(burst) {}
 
 void RetryBudget::on_request() {
   std::lock_guard lock(mu_);
@@ -31,7 +32,8 @@ std::uint64_t RetryBudget::refused() const {
   return refused_;
 }
 
-std::chrono::microseconds backoff_delay(const RetryPolicy& policy, int attempt, std::mt19937_64& rng) {
+std::chrono::microseconds backoff_delay(const RetryPolicy& policy, int attempt,
+                                        std::mt19937_64& rng) {
   const double base_us = std::chrono::duration<double, std::micro>(policy.base).count();
   const double cap_us = std::chrono::duration<double, std::micro>(policy.cap).count();
   const double top = std::min(cap_us, base_us * std::ldexp(1.0, std::min(attempt, 30)));
@@ -96,9 +98,8 @@ auto ResilientClient::attempt(F&& fn) -> decltype(fn(std::declval<Client&>())) {
         char when[64];
         std::snprintf(when, sizeof when, "%.2f s", s);
         throw std::runtime_error(std::string(e.what()) + " (gave up after " +
-                                 std::to_string(tries) + (tries == 1 ? " try" : " tries") +
-                                 " in " + when +
-                                 (out_of_tries ? "" : "; the retry budget is spent") + ")");
+                                 std::to_string(tries) + (tries == 1 ? " try" : " tries") + " in " +
+                                 when + (out_of_tries ? "" : "; the retry budget is spent") + ")");
       }
       ++stats_.retries;
       std::this_thread::sleep_for(backoff_delay(options_.policy, tries, rng_));

@@ -12,11 +12,10 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <stdexcept>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "client/client.hpp"
 
@@ -50,7 +49,8 @@ struct RetryPolicy {
 
 // "Full jitter": uniform in [0, min(cap, base * 2^attempt)], so clients cut
 // off together do not come back together.
-std::chrono::microseconds backoff_delay(const RetryPolicy& policy, int attempt, std::mt19937_64& rng);
+std::chrono::microseconds backoff_delay(const RetryPolicy& policy, int attempt,
+                                        std::mt19937_64& rng);
 
 // A request the server answered with an error that retrying cannot mend
 // (wrong token, bad scene): thrown, not retried.
@@ -73,10 +73,10 @@ struct ResilientOptions {
 };
 
 struct RetryStats {
-  std::uint64_t requests = 0;    // made by the caller
-  std::uint64_t retries = 0;     // sent again after a dropped or refused connection
-  std::uint64_t reputs = 0;      // scenes put again after unknown_scene
-  std::uint64_t connections = 0; // opened (the first included)
+  std::uint64_t requests = 0;     // made by the caller
+  std::uint64_t retries = 0;      // sent again after a dropped or refused connection
+  std::uint64_t reputs = 0;       // scenes put again after unknown_scene
+  std::uint64_t connections = 0;  // opened (the first included)
 };
 
 // One connection at a time to one endpoint (a server or a balancer), opened on

@@ -18,7 +18,8 @@ std::vector<float> transfer_texels(const Volume& volume) {
     // log2(1 - opacity): the shader's 1 - alpha = exp2(this x ds / unit),
     // one exp2 a sample instead of a pow; an opaque point is held at 2^-64
     // (so neighbouring texels interpolate finite values).
-    texels[4 * i + 3] = static_cast<float>(std::max(std::log2(1.0 - volume.transfer.opacity(v)), -64.0));
+    texels[4 * i + 3] =
+        static_cast<float>(std::max(std::log2(1.0 - volume.transfer.opacity(v)), -64.0));
   }
   return texels;
 }
@@ -34,8 +35,8 @@ std::vector<std::uint8_t> brick_occupancy(const VolumeGrid& grid, const std::vec
     // blend texels floor(lo (K - 1)) .. ceil(hi (K - 1)).
     const int a = std::clamp(static_cast<int>(std::floor(lo * (kTransferTexels - 1))), 0,
                              kTransferTexels - 1);
-    const int b = std::clamp(static_cast<int>(std::ceil(hi * (kTransferTexels - 1))), 0,
-                             kTransferTexels - 1);
+    const int b =
+        std::clamp(static_cast<int>(std::ceil(hi * (kTransferTexels - 1))), 0, kTransferTexels - 1);
     for (int i = a; i <= b; ++i) {
       if (texels[4 * static_cast<std::size_t>(i) + 3] < 0.0f) return true;  // log2(1 - opacity)
     }
@@ -79,8 +80,8 @@ std::shared_ptr<const VolumeTextures> upload_volume(const Volume& vol, const Vol
   u->values = GlTexture(tex);
   glTextureStorage3D(tex, 1, GL_R16, u->dims[0], u->dims[1], u->dims[2]);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
-  glTextureSubImage3D(tex, 0, 0, 0, 0, u->dims[0], u->dims[1], u->dims[2], GL_RED, GL_UNSIGNED_SHORT,
-                      grid->values.data());
+  glTextureSubImage3D(tex, 0, 0, 0, 0, u->dims[0], u->dims[1], u->dims[2], GL_RED,
+                      GL_UNSIGNED_SHORT, grid->values.data());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -131,7 +132,8 @@ std::shared_ptr<const VolumeTextures> VolumeTextureCache::get(const Volume& volu
   }
   VolumeSettings s = settings;
   s.pyramid = pyramid;
-  entries_.push_front({volume.grid, volume.grid.get(), level, pyramid, tf, upload_volume(volume, s, tf)});
+  entries_.push_front(
+      {volume.grid, volume.grid.get(), level, pyramid, tf, upload_volume(volume, s, tf)});
   while (entries_.size() > max_entries_) entries_.pop_back();
   return entries_.front().textures;
 }
@@ -144,7 +146,8 @@ VolumeResources::VolumeResources(const Scene& scene, VolumeTextureCache* cache) 
                   : upload_volume(vol, scene.volume, transfer_texels(vol));
     // The level spans the same box, voxel centre to voxel centre.
     for (int a = 0; a < 3; ++a) {
-      u.spacing[a] = vol.spacing[a] * (vol.grid->dims[a] - 1) / static_cast<double>(u.gpu->dims[a] - 1);
+      u.spacing[a] =
+          vol.spacing[a] * (vol.grid->dims[a] - 1) / static_cast<double>(u.gpu->dims[a] - 1);
     }
     volumes_.push_back(std::move(u));
   }
@@ -160,8 +163,8 @@ void set_volume_box(ProgramPair& program, bool multiview, const FrameContext& ct
       hi[k] = std::max(hi[k], b[k]);
     }
   }
-  const Vec3& eye = ctx.views > 0 && view >= 0 ? ctx.view_eyes[static_cast<std::size_t>(view)]
-                                               : ctx.basis.eye;
+  const Vec3& eye =
+      ctx.views > 0 && view >= 0 ? ctx.view_eyes[static_cast<std::size_t>(view)] : ctx.basis.eye;
   const Vec3 l = lo - eye, h = hi - eye;
   glUniform3f(program.uniform(multiview, "u_volume_lo"), static_cast<float>(l[0]),
               static_cast<float>(l[1]), static_cast<float>(l[2]));
@@ -221,7 +224,8 @@ class VolumePass final : public Pass {
       res->volumes()[i].volume->world_bounds(&lo, &hi);
       dist[i] = length(0.5 * (lo + hi) - ctx.basis.eye);
     }
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return dist[a] > dist[b]; });
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return dist[a] > dist[b]; });
 
     for (std::size_t i : order) {
       const VolumeResources::Uploaded& u = res->volumes()[i];
@@ -240,12 +244,13 @@ class VolumePass final : public Pass {
       // Opacity of a sample: corrected for its segment's length, or the
       // seed's fixed per-sample opacity (the one the default step, level 0,
       // gets): too transparent when the step grows.
-      const double base_step =
-          std::min({vol.spacing[0], vol.spacing[1], vol.spacing[2]}) / VolumeSettings{}.samples_per_voxel;
+      const double base_step = std::min({vol.spacing[0], vol.spacing[1], vol.spacing[2]}) /
+                               VolumeSettings{}.samples_per_voxel;
       glUniform1f(program_.uniform(multi, "u_opacity_unit"),
                   static_cast<float>(vol.transfer.opacity_unit));
-      glUniform1f(program_.uniform(multi, "u_fixed_exponent"),
-                  s.opacity_correction ? -1.0f : static_cast<float>(base_step / vol.transfer.opacity_unit));
+      glUniform1f(
+          program_.uniform(multi, "u_fixed_exponent"),
+          s.opacity_correction ? -1.0f : static_cast<float>(base_step / vol.transfer.opacity_unit));
       glBindTextureUnit(1, u.gpu->values.get());
       glBindTextureUnit(2, u.gpu->transfer.get());
       glBindTextureUnit(3, u.gpu->bricks.get());

@@ -37,7 +37,9 @@ json ml_scene(int size, const json& settings, const json& background = json::arr
                {"transfer", {{"preset", "ml"}}}}}},
             {"volume", settings},
             {"cameras",
-             {{{"position", {2.2, 1.6, 3.0}}, {"target", {0, 0, 0}}, {"width", size},
+             {{{"position", {2.2, 1.6, 3.0}},
+               {"target", {0, 0, 0}},
+               {"width", size},
                {"height", size}}}}};
   j.update(extra);
   return j;
@@ -67,17 +69,18 @@ TEST(Volumes, OnlyVolumeScenesPlanTheVolumePass) {
   const Scene vol = parse_scene(ml_scene(16, json::object()), {});
   const auto passes = plan_passes(vol);
   EXPECT_NE(std::find(passes.begin(), passes.end(), "volumes"), passes.end());
-  const Scene beams = parse_scene(
-      {{"beams", {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1}}}},
-       {"cameras", {{{"position", {0, 0, 4}}, {"width", 16}, {"height", 16}}}}},
-      {});
+  const Scene beams =
+      parse_scene({{"beams", {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1}}}},
+                   {"cameras", {{{"position", {0, 0, 4}}, {"width", 16}, {"height", 16}}}}},
+                  {});
   const auto bp = plan_passes(beams);
   EXPECT_EQ(std::find(bp.begin(), bp.end(), "volumes"), bp.end());
 }
 
 TEST(Volumes, DefaultImageMatchesTheReference) {
   // Jitter off: the GPU samples each step's middle as the reference does.
-  const HdrError e = against_reference(parse_scene(ml_scene(64, {{"jitter", false}}), {}), "default");
+  const HdrError e =
+      against_reference(parse_scene(ml_scene(64, {{"jitter", false}}), {}), "default");
   // Bound: the GPU marches 2 samples a voxel against the reference's 16
   // (the composite's step error, ~1/S_z of the opacity's variation over a
   // step), in float, through a 1024-texel transfer table.
@@ -87,7 +90,8 @@ TEST(Volumes, DefaultImageMatchesTheReference) {
 TEST(Volumes, HalfTheSamplesWithOpacityCorrectionStaysCloseWithoutItGoesTransparent) {
   const json fine = {{"jitter", false}};
   const json half_corrected = {{"jitter", false}, {"samples_per_voxel", 1}};
-  const json half_seed = {{"jitter", false}, {"samples_per_voxel", 1}, {"opacity_correction", false}};
+  const json half_seed = {
+      {"jitter", false}, {"samples_per_voxel", 1}, {"opacity_correction", false}};
   auto opacity_of = [](const json& settings, bool reference) {
     const Scene black = parse_scene(ml_scene(48, settings, {0, 0, 0}), {});
     const Scene white = parse_scene(ml_scene(48, settings, {1, 1, 1}), {});
@@ -119,10 +123,12 @@ TEST(Volumes, SurfacesInsideTheVolumeEndItsRays) {
   // A box occluder through the middle of the volume: rays stop on it, the
   // volume in front of it is composited over its shading.
   const json box = {{"occluders",
-                     {{{"type", "box"}, {"center", {0.2, -0.2, 0.1}}, {"size", {0.8, 0.8, 0.8}},
+                     {{{"type", "box"},
+                       {"center", {0.2, -0.2, 0.1}},
+                       {"size", {0.8, 0.8, 0.8}},
                        {"albedo", {0.9, 0.5, 0.2}}}}}};
-  const HdrError e =
-      against_reference(parse_scene(ml_scene(64, {{"jitter", false}}, {0, 0, 0}, box), {}), "box inside");
+  const HdrError e = against_reference(
+      parse_scene(ml_scene(64, {{"jitter", false}}, {0, 0, 0}, box), {}), "box inside");
   // The march's error as above, plus the box's silhouette (the GPU's view
   // depth is rasterized: its edge pixels may take the other side).
   EXPECT_LT(e.rel_l1, 0.03) << "max abs " << e.max_abs;
@@ -133,10 +139,18 @@ TEST(Volumes, ABeamInsideAVolumeIsAttenuatedByWhatLiesInFrontOfIt) {
   // each point of their light dimmed by the volume between it and the eye.
   const json j = {
       {"beams",
-       {{{"type", "sphere"}, {"center", {0.3, 0.1, 0.0}}, {"radius", 0.5},
-         {"density", "quadratic"}, {"color", {1.0, 0.8, 0.3}}, {"intensity", 1.5}},
-        {{"type", "capsule"}, {"p0", {-1.8, -0.6, 0.4}}, {"p1", {1.6, 0.7, -0.3}},
-         {"radius", 0.25}, {"density", "gaussian"}, {"color", {0.3, 0.7, 1.0}},
+       {{{"type", "sphere"},
+         {"center", {0.3, 0.1, 0.0}},
+         {"radius", 0.5},
+         {"density", "quadratic"},
+         {"color", {1.0, 0.8, 0.3}},
+         {"intensity", 1.5}},
+        {{"type", "capsule"},
+         {"p0", {-1.8, -0.6, 0.4}},
+         {"p1", {1.6, 0.7, -0.3}},
+         {"radius", 0.25},
+         {"density", "gaussian"},
+         {"color", {0.3, 0.7, 1.0}},
          {"intensity", 2.0}}}},
       {"volumes",
        {{{"source", {{"type", "heat"}, {"resolution", 32}}},
