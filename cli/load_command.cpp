@@ -82,14 +82,14 @@ struct LoadArgs {
   int batch_size = 256;
   double batch_rate = 0;  // requests/s over the batch connections; 0: closed loop
   int batch_pipeline = 1;
-  double busy_backoff_ms = 20;  // closed loop: pause after a "busy" answer, as a polite client does  // open loop: more than this is a client-side skip
-  double timeout_s = 60;
-  std::string token;
   // Retries (docs/deploy.md): a connection that drops or cannot be made is
   // opened again after a backoff with full jitter, and its unanswered
   // requests are sent again while the retry budget allows.
   int max_attempts = 5;  // consecutive tries of a connection; 1: no retries
+  double busy_backoff_ms = 20;  // closed loop: pause after a "busy" answer, as a polite client does  // open loop: more than this is a client-side skip
+  double timeout_s = 60;
   double timeline_ms = 1000;  // width of the report's timeline buckets
+  std::string token;
   bool json_out = false;
   bool quiet = false;
 };
