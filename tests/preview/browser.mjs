@@ -58,3 +58,16 @@ export async function stillAfter(page, t, timeoutMs = 10000) {
     return null;
   }
 }
+
+export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// A test's checks: check(ok, what) prints "ok" or "FAIL" and keeps the
+// failures for the exit status.
+export function checkList() {
+  const failures = [];
+  const check = (ok, what) => {
+    console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+    if (!ok) failures.push(what);
+  };
+  return {failures, check};
+}

@@ -24,7 +24,7 @@ import os from 'node:os';
 import path from 'node:path';
 import readline from 'node:readline';
 import {fileURLToPath} from 'node:url';
-import {launchBrowser, pointerMoves, requireChromium, stillAfter} from './browser.mjs';
+import {launchBrowser, pointerMoves, requireChromium, sleep, stillAfter, checkList} from './browser.mjs';
 import {decodePng} from './png.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -59,12 +59,7 @@ const frameAfterKillMs = 5000;
 // first server had built and this one builds now.
 const stillAfterReleaseMs = 2000;
 
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-const failures = [];
-const check = (ok, what) => {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!ok) failures.push(what);
-};
+const {failures, check} = checkList();
 
 if (!serverBin) {
   console.error('usage: haproxy_test.mjs --server BIN --artifacts DIR');

@@ -17,7 +17,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import readline from 'node:readline';
-import {launchBrowser, pointerMoves, requireChromium, stillAfter} from './browser.mjs';
+import {launchBrowser, pointerMoves, requireChromium, stillAfter, checkList} from './browser.mjs';
 import {decodePng} from './png.mjs';
 
 const argv = process.argv.slice(2);
@@ -41,12 +41,7 @@ const stillDeadlineMs = parseInt(opt('still-deadline-ms', '1000'), 10);
 // controller starts from its first measurement and the pipeline fills.
 const warmupMs = 300;
 
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-const failures = [];
-const check = (ok, what) => {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!ok) failures.push(what);
-};
+const {failures, check} = checkList();
 
 if (!serverBin || !cliBin) {
   console.error('usage: preview_test.mjs --server BIN --cli BIN --artifacts DIR');
