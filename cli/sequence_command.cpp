@@ -110,9 +110,9 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
   out.description = "beamcast-server at " + args.server;
 
   std::mutex mu;
-  std::deque<std::size_t> todo;  // first view of each batch not yet delivered
-  for (std::size_t at = 0; at < cams.size(); at += batch) todo.push_back(at);
-  std::size_t delivered = 0, in_flight = 0, batches = todo.size();
+  std::deque<std::size_t> waiting;  // first view of each batch not yet delivered
+  for (std::size_t at = 0; at < cams.size(); at += batch) waiting.push_back(at);
+  std::size_t delivered = 0, in_flight = 0, batches = waiting.size();
   std::condition_variable changed;
   std::string refusal;  // a server's error answer: the job's end
 
@@ -147,10 +147,10 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
           {
             // Idle workers wait while batches are out: one may come back.
             std::unique_lock lock(mu);
-            changed.wait(lock, [&] { return !todo.empty() || in_flight == 0 || !refusal.empty(); });
-            if (todo.empty() || !refusal.empty()) break;
-            mine = todo.front();
-            todo.pop_front();
+            changed.wait(lock, [&] { return !waiting.empty() || in_flight == 0 || !refusal.empty(); });
+            if (waiting.empty() || !refusal.empty()) break;
+            mine = waiting.front();
+            waiting.pop_front();
             ++in_flight;
           }
           const std::size_t at = *mine;
@@ -194,7 +194,7 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
         std::lock_guard lock(mu);
         me.error = e.what();
         if (mine) {
-          todo.push_front(*mine);
+          waiting.push_front(*mine);
           --in_flight;
         }
         changed.notify_all();
