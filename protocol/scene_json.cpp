@@ -974,6 +974,7 @@ nlohmann::json scene_capabilities() {
           {"volume_transfer_presets", names(kVolumeTransferPresets)},
           {"volume_settings", names(kVolumeSettingFields)},
           {"volume_pyramids", names(kVolumePyramids)},
+          {"volume_integrations", names(kVolumeIntegrations)},
           {"volume_limits",
            {{"max_volumes", kMaxVolumes},
             {"max_volume_voxels", kMaxVolumeVoxels},

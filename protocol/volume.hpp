@@ -102,6 +102,12 @@ struct Volume {
 // The ray caster's accuracy knobs ("volume" in JSON), the seed's S_z, R_v and
 // early ray termination, measured in docs/volumes.md.
 enum class VolumePyramid : std::uint8_t { kAverage, kMax, kNonZero };
+// How a step's colour and opacity come from the transfer function: at one
+// point of the step (the seed's way), or pre-integrated (Engel, Kraus and
+// Ertl 2001): the step's integral with the value taken as linear between its
+// two ends, looked up in a 2D table of (front value, back value) made for
+// the step's length (render/volume_pass.hpp, docs/volumes.md).
+enum class VolumeIntegration : std::uint8_t { kPoint, kPreintegrated };
 struct VolumeSettings {
   // S_z: samples per voxel spacing along a ray (the step is the smallest
   // spacing over this; at R_v level L, 2^L times the spacing).
@@ -121,6 +127,10 @@ struct VolumeSettings {
   // every axis) and how a level's voxel is made from the 8 below.
   int level = 0;
   VolumePyramid pyramid = VolumePyramid::kAverage;
+  // Pre-integration needs opacity correction (its table is made for the
+  // step's length): with "opacity_correction": false the default is kPoint,
+  // and asking for both is refused.
+  VolumeIntegration integration = VolumeIntegration::kPoint;
 };
 
 // The analytic fields of the procedural sources on [-1, 1]^3, in [0, 1].
@@ -184,8 +194,10 @@ inline constexpr std::string_view kVolumeRawFormats[] = {"uint8", "uint16", "flo
 inline constexpr std::string_view kVolumeTransferFields[] = {"preset", "points", "opacity_unit"};
 inline constexpr std::string_view kVolumeTransferPresets[] = {"grey", "bone", "ml"};
 inline constexpr std::string_view kVolumeSettingFields[] = {
-    "samples_per_voxel", "opacity_correction", "ert", "jitter", "skip_empty", "level", "pyramid"};
+    "samples_per_voxel", "opacity_correction", "ert", "jitter", "skip_empty", "level", "pyramid",
+    "integration"};
 inline constexpr std::string_view kVolumePyramids[] = {"average", "max", "nonzero"};
+inline constexpr std::string_view kVolumeIntegrations[] = {"point", "preintegrated"};
 
 // One entry of "volumes" (docs/scene-format.md, "Volumes"): its source (a
 // file below the options' assets directory, refused outside it as meshes

@@ -267,6 +267,18 @@ VolumeSettings parse_volume_settings(const Node& n) {
                                               {"max", VolumePyramid::kMax},
                                               {"nonzero", VolumePyramid::kNonZero}});
   }
+  if (auto v = o.optional("integration")) {
+    s.integration = read_enum<VolumeIntegration>(
+        *v, {{"point", VolumeIntegration::kPoint},
+             {"preintegrated", VolumeIntegration::kPreintegrated}});
+    if (s.integration == VolumeIntegration::kPreintegrated && !s.opacity_correction) {
+      fail("conflicting_fields", v->path,
+           "pre-integration needs opacity correction (its table is made for the step's "
+           "length): use \"integration\": \"point\" with \"opacity_correction\": false");
+    }
+  } else if (!s.opacity_correction) {
+    s.integration = VolumeIntegration::kPoint;  // the seed's uncorrected samples
+  }
   return s;
 }
 

@@ -146,8 +146,14 @@ const std::vector<PassDecl>& pass_catalog() {
        {"hdr"}, {"view_depth"}, {"hdr"}, {"volume_photons"}},
       // Scalar volumes (seed 004; render/volume_pass.hpp): each ray cast up
       // to the nearest surface and composited over hdr, farther volumes
-      // first; the transmittance knots for the beams.
-      {PassId::kVolumes, "volumes", [](const PlanInput& in) { return !in.scene.volumes.empty(); },
+      // first; with beams in the scene, the same pass also writes the
+      // transmittance knots they read (two float targets cleared and
+      // blended: 12 ms of a 512^2 frame on llvmpipe, not paid without beams).
+      {PassId::kVolumes, "volumes",
+       [](const PlanInput& in) { return !in.scene.volumes.empty() && in.scene.beams.empty(); },
+       {"hdr"}, {"view_depth"}, {"hdr"}, {"volumes"}},
+      {PassId::kVolumesForBeams, "volumes",
+       [](const PlanInput& in) { return !in.scene.volumes.empty() && !in.scene.beams.empty(); },
        {"hdr"}, {"view_depth"}, {"hdr", "volume_t0", "volume_t1"}, {"volumes"}},
       // Beams: energy added to hdr; a ray ends at the nearest surface if
       // anything wrote view_depth.

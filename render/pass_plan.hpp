@@ -34,11 +34,12 @@ enum class PassId {
   kMedium,
   kVolumePhotons,
   kVolumes,
+  kVolumesForBeams,
   kBeams,
   kTonemap,
   kUpscale
 };
-inline constexpr std::size_t kPassCount = 16;
+inline constexpr std::size_t kPassCount = 17;
 
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {

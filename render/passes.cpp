@@ -705,6 +705,7 @@ std::unique_ptr<Pass> make_pass(PassId id) {
     case PassId::kVolumePhotons:
       return make_volume_photon_pass();
     case PassId::kVolumes:
+    case PassId::kVolumesForBeams:
       return make_volume_pass();
     case PassId::kBeams:
       return std::make_unique<BeamPass>();

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
+#include <optional>
 
 #include "render/passes.hpp"
 #include "render/scene_resources.hpp"
@@ -24,6 +26,68 @@ std::vector<float> transfer_texels(const Volume& volume) {
   return texels;
 }
 
+std::vector<float> preintegration_texels(const Volume& volume, double step) {
+  constexpr int kN = kPreintegrationTexels;
+  constexpr int kSub = 16;  // trapezoid points a table cell
+  constexpr int kFine = (kN - 1) * kSub;
+  const TransferFunction& tf = volume.transfer;
+  // lambda(v) = -log2(1 - opacity) / unit (an opaque point held at 2^-64,
+  // as the point sampler's table), and the running integrals of lambda and
+  // of c sigma = c lambda ln 2 over [0, v] at the fine points.
+  std::vector<double> lam_int(kFine + 1), col_int(3 * static_cast<std::size_t>(kFine + 1));
+  double prev_lam = 0.0;
+  Color prev_col{0.0, 0.0, 0.0};
+  for (int f = 0; f <= kFine; ++f) {
+    const double v = static_cast<double>(f) / kFine;
+    const double lam = -std::max(std::log2(1.0 - tf.opacity(v)), -64.0) / tf.opacity_unit;
+    const Color c = tf.color(v);
+    Color cs{};
+    for (int k = 0; k < 3; ++k) cs[k] = c[k] * lam * std::numbers::ln2;
+    if (f == 0) {
+      lam_int[0] = 0.0;
+      for (int k = 0; k < 3; ++k) col_int[k] = 0.0;
+    } else {
+      const double h = 1.0 / kFine;
+      lam_int[f] = lam_int[f - 1] + 0.5 * h * (lam + prev_lam);
+      for (int k = 0; k < 3; ++k) {
+        col_int[3 * static_cast<std::size_t>(f) + k] =
+            col_int[3 * static_cast<std::size_t>(f - 1) + k] + 0.5 * h * (cs[k] + prev_col[k]);
+      }
+    }
+    prev_lam = lam;
+    prev_col = cs;
+  }
+  std::vector<float> texels(4 * static_cast<std::size_t>(kN) * kN);
+  for (int j = 0; j < kN; ++j) {    // back value
+    for (int i = 0; i < kN; ++i) {  // front value
+      double lam = 0.0;
+      Color cs{};
+      if (i == j) {
+        const double v = static_cast<double>(i) / (kN - 1);
+        lam = -std::max(std::log2(1.0 - tf.opacity(v)), -64.0) / tf.opacity_unit;
+        const Color c = tf.color(v);
+        for (int k = 0; k < 3; ++k) cs[k] = c[k] * lam * std::numbers::ln2;
+      } else {
+        const std::size_t a = static_cast<std::size_t>(i) * kSub;
+        const std::size_t b = static_cast<std::size_t>(j) * kSub;
+        const double dv = static_cast<double>(j - i) / (kN - 1);
+        lam = (lam_int[b] - lam_int[a]) / dv;
+        for (int k = 0; k < 3; ++k) cs[k] = (col_int[3 * b + k] - col_int[3 * a + k]) / dv;
+      }
+      const double log2_t = -lam * step;
+      const double alpha = 1.0 - std::exp2(log2_t);
+      const double tau = lam * step * std::numbers::ln2;
+      const double scale = tau > 1e-12 ? alpha / tau : 1.0;
+      float* t = &texels[4 * (static_cast<std::size_t>(j) * kN + i)];
+      for (int k = 0; k < 3; ++k) {
+        t[k] = static_cast<float>(cs[k] * step * scale * volume.intensity);
+      }
+      t[3] = static_cast<float>(log2_t);
+    }
+  }
+  return texels;
+}
+
 std::vector<std::uint8_t> brick_occupancy(const VolumeGrid& grid, const std::vector<float>& texels,
                                           std::array<int, 3>* brick_dims) {
   std::array<int, 3>& bd = *brick_dims;
@@ -31,6 +95,12 @@ std::vector<std::uint8_t> brick_occupancy(const VolumeGrid& grid, const std::vec
   // Any non-zero opacity among the table texels a value range can reach
   // (a direct scan: the table is small).
   auto any_opacity = [&](double lo, double hi) {
+    // A pre-integrated step between values in [lo, hi] blends the table's
+    // entries for floor(lo (P - 1)) .. ceil(hi (P - 1)): the range widened
+    // to them (so one occupancy serves both integrations).
+    constexpr double kP = kPreintegrationTexels - 1;
+    lo = std::floor(lo * kP) / kP;
+    hi = std::ceil(hi * kP) / kP;
     // The shader reads texel coordinate v (K - 1) + 0.5: values in [lo, hi]
     // blend texels floor(lo (K - 1)) .. ceil(hi (K - 1)).
     const int a = std::clamp(static_cast<int>(std::floor(lo * (kTransferTexels - 1))), 0,
@@ -96,6 +166,7 @@ std::shared_ptr<const VolumeTextures> upload_volume(const Volume& vol, const Vol
   glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   const std::vector<std::uint8_t> bricks = brick_occupancy(*grid, tf, &u->brick_dims);
+  u->any_empty = std::find(bricks.begin(), bricks.end(), 0) != bricks.end();
   glCreateTextures(GL_TEXTURE_3D, 1, &tex);
   u->bricks = GlTexture(tex);
   glTextureStorage3D(tex, 1, GL_R8UI, u->brick_dims[0], u->brick_dims[1], u->brick_dims[2]);
@@ -111,7 +182,44 @@ std::shared_ptr<const VolumeTextures> upload_volume(const Volume& vol, const Vol
   return u;
 }
 
+std::shared_ptr<const GlTexture> upload_preintegration(const Volume& volume, double step) {
+  const std::vector<float> texels = preintegration_texels(volume, step);
+  GLuint tex = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &tex);
+  auto t = std::make_shared<GlTexture>(tex);
+  glTextureStorage2D(tex, 1, GL_RGBA32F, kPreintegrationTexels, kPreintegrationTexels);
+  glTextureSubImage2D(tex, 0, 0, 0, kPreintegrationTexels, kPreintegrationTexels, GL_RGBA,
+                      GL_FLOAT, texels.data());
+  glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  gl_check("pre-integration table upload");
+  return t;
+}
+
+// The world step of a volume's ray march: the smallest spacing of the
+// uploaded level over the samples per voxel.
+double march_step(const Vec3& level_spacing, const VolumeSettings& s) {
+  return std::min({level_spacing[0], level_spacing[1], level_spacing[2]}) / s.samples_per_voxel;
+}
+
 }  // namespace
+
+std::shared_ptr<const GlTexture> VolumeTextureCache::preintegration(const Volume& volume,
+                                                                    double step) {
+  const std::vector<float> tf = transfer_texels(volume);
+  for (auto it = tables_.begin(); it != tables_.end(); ++it) {
+    // Same table texels (colour, intensity, opacity) and unit: the same table.
+    if (it->step == step && it->unit == volume.transfer.opacity_unit && it->transfer == tf) {
+      tables_.splice(tables_.begin(), tables_, it);
+      return tables_.front().texture;
+    }
+  }
+  tables_.push_front({tf, step, volume.transfer.opacity_unit, upload_preintegration(volume, step)});
+  while (tables_.size() > 2 * max_entries_) tables_.pop_back();
+  return tables_.front().texture;
+}
 
 std::shared_ptr<const VolumeTextures> VolumeTextureCache::get(const Volume& volume,
                                                               const VolumeSettings& settings) {
@@ -149,6 +257,11 @@ VolumeResources::VolumeResources(const Scene& scene, VolumeTextureCache* cache) 
       u.spacing[a] =
           vol.spacing[a] * (vol.grid->dims[a] - 1) / static_cast<double>(u.gpu->dims[a] - 1);
     }
+    if (preintegrated(scene.volume)) {
+      const double step = march_step(u.spacing, scene.volume);
+      u.preintegration =
+          cache ? cache->preintegration(vol, step) : upload_preintegration(vol, step);
+    }
     volumes_.push_back(std::move(u));
   }
 }
@@ -182,27 +295,15 @@ std::array<double, 9> rotation_matrix(const std::array<double, 4>& q) {
           2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
 }
 
-// The world step of a volume's ray march: the smallest spacing of the
-// uploaded level over the samples per voxel.
-double march_step(const VolumeResources::Uploaded& u, const VolumeSettings& s) {
-  return std::min({u.spacing[0], u.spacing[1], u.spacing[2]}) / s.samples_per_voxel;
-}
-
 class VolumePass final : public Pass {
  public:
-  VolumePass() : program_("volume_cast") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const VolumeResources* res = ctx.resources.volumes();
     if (!res) throw GlError("volume pass: the scene's volumes were not uploaded");
-    const bool multi = ctx.views > 0;
-    glUseProgram(program_.get(multi));
-    const bool surfaces = ctx.plan.written("view_depth");
     const VolumeSettings& s = ctx.scene.volume;
-    glUniform1i(program_.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
-    glUniform1f(program_.uniform(multi, "u_ert"), static_cast<float>(s.ert_threshold));
-    glUniform1i(program_.uniform(multi, "u_jitter"), s.jitter ? 1 : 0);
-    glUniform1i(program_.uniform(multi, "u_skip_empty"), s.skip_empty ? 1 : 0);
-    glUniform1i(program_.uniform(multi, "u_knots"), ctx.scene.beams.empty() ? 0 : 1);
+    const bool knots = self.id == PassId::kVolumesForBeams;
+    const bool multi = ctx.views > 0;
+    const bool surfaces = ctx.plan.written("view_depth");
     glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
     // hdr = volume colour + (1 - volume opacity) hdr, hdr's alpha kept; the
     // transmittance knots multiplied over the volumes.
@@ -230,33 +331,41 @@ class VolumePass final : public Pass {
     for (std::size_t i : order) {
       const VolumeResources::Uploaded& u = res->volumes()[i];
       const Volume& vol = *u.volume;
+      // Skipping where some brick is empty (a dense volume's march would pay
+      // for the test and skip nothing).
+      ProgramPair& program = program_for(preintegrated(s), s.skip_empty && u.gpu->any_empty, knots);
+      glUseProgram(program.get(multi));
+      glUniform1i(program.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
+      glUniform1f(program.uniform(multi, "u_ert"), static_cast<float>(s.ert_threshold));
+      glUniform1i(program.uniform(multi, "u_jitter"), s.jitter ? 1 : 0);
       const std::array<double, 9> r = rotation_matrix(vol.rotation);
       float rot[9];
       for (int k = 0; k < 9; ++k) rot[k] = static_cast<float>(r[k]);
       // mat3 from row-major: transpose on upload.
-      glUniformMatrix3fv(program_.uniform(multi, "u_rotation"), 1, GL_TRUE, rot);
-      glUniform3f(program_.uniform(multi, "u_spacing"), static_cast<float>(u.spacing[0]),
+      glUniformMatrix3fv(program.uniform(multi, "u_rotation"), 1, GL_TRUE, rot);
+      glUniform3f(program.uniform(multi, "u_spacing"), static_cast<float>(u.spacing[0]),
                   static_cast<float>(u.spacing[1]), static_cast<float>(u.spacing[2]));
-      glUniform3f(program_.uniform(multi, "u_dims"), static_cast<float>(u.gpu->dims[0]),
+      glUniform3f(program.uniform(multi, "u_dims"), static_cast<float>(u.gpu->dims[0]),
                   static_cast<float>(u.gpu->dims[1]), static_cast<float>(u.gpu->dims[2]));
-      const double step = march_step(u, s);
-      glUniform1f(program_.uniform(multi, "u_step"), static_cast<float>(step));
+      const double step = march_step(u.spacing, s);
+      glUniform1f(program.uniform(multi, "u_step"), static_cast<float>(step));
       // Opacity of a sample: corrected for its segment's length, or the
       // seed's fixed per-sample opacity (the one the default step, level 0,
       // gets): too transparent when the step grows.
       const double base_step = std::min({vol.spacing[0], vol.spacing[1], vol.spacing[2]}) /
                                VolumeSettings{}.samples_per_voxel;
-      glUniform1f(program_.uniform(multi, "u_opacity_unit"),
+      glUniform1f(program.uniform(multi, "u_opacity_unit"),
                   static_cast<float>(vol.transfer.opacity_unit));
       glUniform1f(
-          program_.uniform(multi, "u_fixed_exponent"),
+          program.uniform(multi, "u_fixed_exponent"),
           s.opacity_correction ? -1.0f : static_cast<float>(base_step / vol.transfer.opacity_unit));
       glBindTextureUnit(1, u.gpu->values.get());
       glBindTextureUnit(2, u.gpu->transfer.get());
       glBindTextureUnit(3, u.gpu->bricks.get());
+      glBindTextureUnit(4, u.preintegration ? u.preintegration->get() : 0);
       int view = 0;
-      for_each_view_offset(ctx, self, program_, "u_origin", vol.origin, [&] {
-        set_volume_box(program_, multi, ctx, view++);
+      for_each_view_offset(ctx, self, program, "u_origin", vol.origin, [&] {
+        set_volume_box(program, multi, ctx, view++);
         glDrawArrays(GL_TRIANGLES, 0, 3);
       });
     }
@@ -266,7 +375,18 @@ class VolumePass final : public Pass {
   }
 
  private:
-  ProgramPair program_;
+  // The march's programs (shaders/programs.txt "volume_cast[_preint][_skip]
+  // [_knots]"), each built on first use: a renderer compiles only those its
+  // scenes need.
+  ProgramPair& program_for(bool preint, bool skip, bool knots) {
+    const std::size_t k = (preint ? 4 : 0) + (skip ? 2 : 0) + (knots ? 1 : 0);
+    if (!programs_[k]) {
+      programs_[k].emplace(std::string("volume_cast") + (preint ? "_preint" : "") +
+                           (skip ? "_skip" : "") + (knots ? "_knots" : ""));
+    }
+    return *programs_[k];
+  }
+  std::array<std::optional<ProgramPair>, 8> programs_;
 };
 
 }  // namespace

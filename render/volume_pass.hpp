@@ -22,12 +22,16 @@ class Pass;
 // centres reproduces it exactly between those samples (only a knot that
 // falls between two samples is rounded off, by at most one sample's width).
 inline constexpr int kTransferTexels = 1024;
+// Entries per axis of a pre-integration table (front value x back value,
+// each i / (N - 1)); docs/volumes.md measures its size.
+inline constexpr int kPreintegrationTexels = 256;
 // Cells per brick edge of the empty-space grid.
 inline constexpr int kBrickCells = 8;
 
 // The occupancy of each brick (x fastest): 1 where the transfer table's
 // opacity is non-zero anywhere between the brick's smallest and largest
-// value (over the table texels the GPU's linear filter can blend there),
+// value (over the table texels the GPU's linear filter can blend there, the
+// range first widened to the pre-integration table's entries around it),
 // exposed for tests.
 std::vector<std::uint8_t> brick_occupancy(const VolumeGrid& grid, const std::vector<float>& texels,
                                           std::array<int, 3>* brick_dims);
@@ -42,6 +46,7 @@ struct VolumeTextures {
   // transfer table, else 0 (GL_R8UI, 3D, nearest).
   GlTexture bricks;
   std::array<int, 3> brick_dims{0, 0, 0};
+  bool any_empty = false;  // some brick is empty (else the pass does not test them)
 };
 
 // The volumes' textures across frames (a renderer's, like its TableCache):
@@ -54,6 +59,10 @@ class VolumeTextureCache {
  public:
   explicit VolumeTextureCache(std::size_t max_entries = 4) : max_entries_(max_entries) {}
   std::shared_ptr<const VolumeTextures> get(const Volume& volume, const VolumeSettings& settings);
+  // The pre-integration table of `volume`'s transfer function for steps of
+  // `step` (GL_RGBA32F, 2D, linear), kept for the last few (transfer, step)
+  // pairs: the preview's levels each have their own step.
+  std::shared_ptr<const GlTexture> preintegration(const Volume& volume, double step);
 
  private:
   struct Entry {
@@ -64,8 +73,15 @@ class VolumeTextureCache {
     std::vector<float> transfer;
     std::shared_ptr<const VolumeTextures> textures;
   };
+  struct Table {
+    std::vector<float> transfer;
+    double step = 0.0;
+    double unit = 0.0;  // the opacity unit
+    std::shared_ptr<const GlTexture> texture;
+  };
   std::size_t max_entries_;
   std::list<Entry> entries_;  // most recently used first
+  std::list<Table> tables_;   // most recently used first
 };
 
 class VolumeResources {
@@ -76,6 +92,9 @@ class VolumeResources {
     const Volume* volume = nullptr;
     Vec3 spacing{};  // world spacing at the uploaded level (grid convention kept)
     std::shared_ptr<const VolumeTextures> gpu;
+    // The pre-integration table for this level's step (null with point
+    // sampling).
+    std::shared_ptr<const GlTexture> preintegration;
   };
   const std::vector<Uploaded>& volumes() const { return volumes_; }
 
@@ -92,6 +111,30 @@ void set_volume_box(ProgramPair& program, bool multiview, const FrameContext& ct
 // The RGBA texels of a transfer function (colour x intensity, log2(1 - opacity)),
 // exposed for tests.
 std::vector<float> transfer_texels(const Volume& volume);
+
+// The pre-integration table of a transfer function for steps of length
+// `step` (world units): kPreintegrationTexels^2 RGBA texels, front value
+// i / (N - 1) along x, back value j / (N - 1) along y, each holding what a
+// step whose value runs linearly from front to back adds: its colour
+// (x intensity, already weighted by its opacity and attenuated within the
+// step) and log2 of its transmittance. The transmittance is exact for a
+// linear value: 2^-(L mean lambda), lambda(v) = -log2(1 - opacity(v)) /
+// opacity_unit averaged over [front, back]. The colour is the integral of
+// c sigma over the step, sigma = lambda ln 2, scaled by alpha / tau (the
+// step's opacity over its optical depth): exact for a constant value (where
+// it is c alpha, the point sample's), and otherwise the attenuation inside
+// the step taken as spread evenly (docs/volumes.md measures what that
+// costs). The integrals of lambda and c sigma come from the piecewise
+// linear transfer function by the trapezoid rule on 16 points a table cell,
+// in double.
+std::vector<float> preintegration_texels(const Volume& volume, double step);
+
+// Whether the pass pre-integrates: asked for, and with opacity correction
+// (the parser refuses pre-integration without it; settings made in code
+// fall back to point samples).
+inline bool preintegrated(const VolumeSettings& s) {
+  return s.integration == VolumeIntegration::kPreintegrated && s.opacity_correction;
+}
 
 std::unique_ptr<Pass> make_volume_pass();
 

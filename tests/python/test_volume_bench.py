@@ -49,6 +49,10 @@ def main():
         check(f"no correction at {r['samples_per_voxel']}/voxel: worse and darker",
               float(r["rel_l1"]) > float(same["rel_l1"]) and float(r["mean"]) < float(same["mean"]),
               f"rel L1 {r['rel_l1']} vs {same['rel_l1']}, mean {r['mean']} vs {same['mean']}")
+    for r in pick(first, "integration"):
+        same = [c for c in sz if float(c["samples_per_voxel"]) == float(r["samples_per_voxel"])][0]
+        check(f"pre-integrated at {r['samples_per_voxel']}/voxel: closer than point samples",
+              float(r["rel_l1"]) < float(same["rel_l1"]), f"rel L1 {r['rel_l1']} vs {same['rel_l1']}")
     sxy = pick(first, "S_xy")
     errs = [float(r["rel_l1"]) for r in sxy]
     check("S_xy: error grows as the scale falls", len(sxy) >= 3 and all(

@@ -310,6 +310,7 @@ TEST(VolumeSettingsJson, DefaultsAndEveryField) {
   EXPECT_TRUE(d.volume.opacity_correction);
   EXPECT_EQ(d.volume.ert_threshold, 0.99);
   EXPECT_EQ(d.volume.level, 0);
+  EXPECT_EQ(d.volume.integration, VolumeIntegration::kPoint);
   json j = volume_scene(ml());
   j["volume"] = {{"samples_per_voxel", 0.5},
                  {"opacity_correction", false},
@@ -324,6 +325,12 @@ TEST(VolumeSettingsJson, DefaultsAndEveryField) {
   EXPECT_FALSE(s.volume.jitter);
   EXPECT_EQ(s.volume.level, 4);
   EXPECT_EQ(s.volume.pyramid, VolumePyramid::kNonZero);
+  // Without opacity correction the integration stays with point samples.
+  EXPECT_EQ(s.volume.integration, VolumeIntegration::kPoint);
+  j["volume"] = {{"integration", "preintegrated"}};
+  EXPECT_EQ(parse_scene(j, {}).volume.integration, VolumeIntegration::kPreintegrated);
+  j["volume"] = {{"integration", "point"}, {"opacity_correction", false}};
+  EXPECT_EQ(parse_scene(j, {}).volume.integration, VolumeIntegration::kPoint);
   // Settings without volumes are fine (a scene that adds them later by update).
   EXPECT_NO_THROW(parse_scene({{"volume", {{"level", 1}}}, {"cameras", {json::object()}}}, {}));
 }
@@ -346,6 +353,12 @@ TEST(VolumeSettingsJson, Refusals) {
   EXPECT_VOLUME_ERROR(with({{"level", 1.5}}), o, "wrong_type", "/volume/level");
   EXPECT_VOLUME_ERROR(with({{"pyramid", "median"}}), o, "invalid_value", "/volume/pyramid");
   EXPECT_VOLUME_ERROR(with({{"jitter", 1}}), o, "wrong_type", "/volume/jitter");
+  EXPECT_VOLUME_ERROR(with({{"integration", "simpson"}}), o, "invalid_value",
+                      "/volume/integration");
+  // The pre-integration table is made for the step's length: it needs the
+  // correction.
+  EXPECT_VOLUME_ERROR(with({{"integration", "preintegrated"}, {"opacity_correction", false}}), o,
+                      "conflicting_fields", "/volume/integration");
   EXPECT_VOLUME_ERROR(with({{"ert_threshold", 0.9}}), o, "unknown_field", "/volume/ert_threshold");
 }
 
@@ -441,6 +454,7 @@ TEST(VolumeJson, Capabilities) {
   EXPECT_EQ(caps["volume_sources"]["raw"], json({"file", "dimensions", "format", "endian"}));
   EXPECT_EQ(caps["volume_transfer_presets"], json({"grey", "bone", "ml"}));
   EXPECT_EQ(caps["volume_pyramids"], json({"average", "max", "nonzero"}));
+  EXPECT_EQ(caps["volume_integrations"], json({"point", "preintegrated"}));
   EXPECT_EQ(caps["volume_limits"]["max_volume_voxels"], kMaxVolumeVoxels);
   EXPECT_EQ(caps["volume_settings"].size(), std::size(kVolumeSettingFields));
 }
