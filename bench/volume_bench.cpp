@@ -268,7 +268,8 @@ void run_volume_bench(const VolumeBenchOptions& opts) {
           line, sizeof line, "%s,%s,%s,%g,%d,%g,%d,%d,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.6f,%.6f\n",
           c.name.c_str(), row.knob.c_str(), row.value.c_str(), s.samples_per_voxel,
           s.opacity_correction ? 1 : 0, s.ert_threshold, s.skip_empty ? 1 : 0, s.level, pyramid,
-          s.integration == VolumeIntegration::kPreintegrated ? "preintegrated" : "point", row.scale, size, median(gpu), median(pass), median(wall), e.rel_l1, e.mean);
+          s.integration == VolumeIntegration::kPreintegrated ? "preintegrated" : "point", row.scale,
+          size, median(gpu), median(pass), median(wall), e.rel_l1, e.mean);
       csv << line << std::flush;
       char change[32] = "";
       if (previous_mean > 0.0) {

@@ -370,6 +370,11 @@ def placement(v):
     return dims, origin
 
 
+# Beamcast's "volume.integration" (--integration): "point", its default, or
+# "preintegrated".
+INTEGRATION = {"value": "point"}
+
+
 def scene_for(v, size, spv, jitter, cameras=None, native=False):
     dims, origin = placement(v)
     if native:  # the procedural or INR source, default range: for the identity check
@@ -385,7 +390,7 @@ def scene_for(v, size, spv, jitter, cameras=None, native=False):
     return {"background": [0, 0, 0], "output": {"tone": "clamp", "exposure": 1.0},
             "volumes": [vol],
             "volume": {"samples_per_voxel": spv, "opacity_correction": True, "ert": VTK_ERT,
-                       "jitter": jitter},
+                       "jitter": jitter, "integration": INTEGRATION["value"]},
             "cameras": cameras(cam) if cameras else [cam]}
 
 
@@ -501,6 +506,8 @@ def main():
     ap.add_argument("--out", help="output directory (required)")
     ap.add_argument("--size", type=int, default=None, help="image size (default 512; --quick 256)")
     ap.add_argument("--quick", action="store_true", help="256^2, fewer settings and repeats")
+    ap.add_argument("--integration", choices=["point", "preintegrated"], default="point",
+                    help="Beamcast's volume.integration (default point, its default)")
     ap.add_argument("--vtk-worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.vtk_worker:
@@ -509,6 +516,7 @@ def main():
     if not a.out:
         ap.error("--out DIR is required")
     a.size = a.size or (256 if a.quick else 512)
+    INTEGRATION["value"] = a.integration
     a.out = os.path.abspath(a.out)
     a.binary = os.path.abspath(a.binary)
     os.makedirs(a.out, exist_ok=True)
@@ -571,6 +579,7 @@ def main():
         for k, (spv, jit) in enumerate(settings):
             setting = "%g samples/voxel (step %.4g)%s" % (spv, step0 / spv,
                                                           "" if jit else ", no jitter")
+            bc_setting = setting + (", pre-integrated" if a.integration == "preintegrated" else "")
             # The frames for the error (Beamcast's HDR buffer; VTK's after its warm-up),
             # then the timing runs.
             summary, _ = run_render(a.binary, scene_for(v, a.size, spv, jit),
@@ -591,7 +600,7 @@ def main():
                          "ms_batch4": round(t["batch4_ms"], 2),
                          "rel_l1": e8["rel_l1"], "rel_l1_float": errors(bc, ref)["rel_l1"],
                          "max8": e8["max8"], "rms8": e8["rms8"], "mean_ratio": e8["mean_ratio"],
-                         "setting": setting})
+                         "setting": bc_setting})
             print(json.dumps(rows[-1]), flush=True)
             vk = np.load(vtk_frame).astype(np.float64) / 255.0
             e = errors(vk, ref)

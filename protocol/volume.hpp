@@ -44,14 +44,12 @@ enum class VolumeSourceType : std::uint8_t {
 // between copies of a scene (the server's store, requests that override
 // cameras).
 struct VolumeGrid {
-  std::array<int, 3> dims{0, 0, 0};  // x (fastest), y, z; each >= 2
+  std::array<int, 3> dims{0, 0, 0};   // x (fastest), y, z; each >= 2
   std::vector<std::uint16_t> values;  // dims[0] * dims[1] * dims[2]
   double value(int i, int j, int k) const {
     return values[(static_cast<std::size_t>(k) * dims[1] + j) * dims[0] + i] / 65535.0;
   }
-  std::int64_t voxels() const {
-    return std::int64_t{dims[0]} * dims[1] * dims[2];
-  }
+  std::int64_t voxels() const { return std::int64_t{dims[0]} * dims[1] * dims[2]; }
 };
 
 // One control point of a 1D transfer function: at normalized value `value`
@@ -174,11 +172,12 @@ std::array<int, 3> volume_level_dims(const std::array<int, 3>& dims, int level);
 std::shared_ptr<const VolumeGrid> volume_level(const VolumeGrid& g, int level, VolumePyramid how);
 
 // Bounds of the scene format (docs/scene-format.md, "Volumes").
-inline constexpr int kMaxVolumes = 8;                           // volumes per scene
-inline constexpr std::int64_t kMaxVolumeVoxels = 64LL << 20;    // summed over the scene (2 bytes each)
-inline constexpr int kMaxVolumeDimension = 2048;                // voxels per axis
+inline constexpr int kMaxVolumes = 8;  // volumes per scene
+inline constexpr std::int64_t kMaxVolumeVoxels = 64LL
+                                                 << 20;  // summed over the scene (2 bytes each)
+inline constexpr int kMaxVolumeDimension = 2048;         // voxels per axis
 inline constexpr int kMaxTransferPoints = 256;
-inline constexpr int kMaxVolumeLevel = 4;                       // VolumeSettings::level's largest
+inline constexpr int kMaxVolumeLevel = 4;  // VolumeSettings::level's largest
 
 // The scene format's names, for the parser and `hello`'s capabilities.
 inline constexpr std::string_view kVolumeFields[] = {"source", "origin",   "spacing",  "rotation",
@@ -194,8 +193,8 @@ inline constexpr std::string_view kVolumeRawFormats[] = {"uint8", "uint16", "flo
 inline constexpr std::string_view kVolumeTransferFields[] = {"preset", "points", "opacity_unit"};
 inline constexpr std::string_view kVolumeTransferPresets[] = {"grey", "bone", "ml"};
 inline constexpr std::string_view kVolumeSettingFields[] = {
-    "samples_per_voxel", "opacity_correction", "ert", "jitter", "skip_empty", "level", "pyramid",
-    "integration"};
+    "samples_per_voxel", "opacity_correction", "ert", "jitter", "skip_empty", "level",
+    "pyramid",           "integration"};
 inline constexpr std::string_view kVolumePyramids[] = {"average", "max", "nonzero"};
 inline constexpr std::string_view kVolumeIntegrations[] = {"point", "preintegrated"};
 

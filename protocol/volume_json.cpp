@@ -192,9 +192,9 @@ Volume parse_volume(const Node& n, const SceneLoadOptions& opts, std::int64_t* v
   Volume v;
   std::optional<std::array<double, 2>> range;
   if (auto r = o.optional("range")) range = read_range(*r);
-  Vec3 spacing = read_source(o.required("source"), opts,
-                             {opts.limits.max_volume_voxels - *voxels, opts.limits.max_volume_voxels},
-                             range, &v);
+  Vec3 spacing = read_source(
+      o.required("source"), opts,
+      {opts.limits.max_volume_voxels - *voxels, opts.limits.max_volume_voxels}, range, &v);
   *voxels += v.grid->voxels();
 
   const auto sp = o.optional("spacing");
@@ -268,9 +268,9 @@ VolumeSettings parse_volume_settings(const Node& n) {
                                               {"nonzero", VolumePyramid::kNonZero}});
   }
   if (auto v = o.optional("integration")) {
-    s.integration = read_enum<VolumeIntegration>(
-        *v, {{"point", VolumeIntegration::kPoint},
-             {"preintegrated", VolumeIntegration::kPreintegrated}});
+    s.integration =
+        read_enum<VolumeIntegration>(*v, {{"point", VolumeIntegration::kPoint},
+                                          {"preintegrated", VolumeIntegration::kPreintegrated}});
     if (s.integration == VolumeIntegration::kPreintegrated && !s.opacity_correction) {
       fail("conflicting_fields", v->path,
            "pre-integration needs opacity correction (its table is made for the step's "

@@ -184,16 +184,13 @@ std::shared_ptr<const VolumeTextures> upload_volume(const Volume& vol, const Vol
 
 std::shared_ptr<const GlTexture> upload_preintegration(const Volume& volume, double step) {
   const std::vector<float> texels = preintegration_texels(volume, step);
-  GLuint tex = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &tex);
-  auto t = std::make_shared<GlTexture>(tex);
-  glTextureStorage2D(tex, 1, GL_RGBA32F, kPreintegrationTexels, kPreintegrationTexels);
-  glTextureSubImage2D(tex, 0, 0, 0, kPreintegrationTexels, kPreintegrationTexels, GL_RGBA,
+  auto t = std::make_shared<GlTexture>(
+      make_texture_2d(GL_RGBA32F, kPreintegrationTexels, kPreintegrationTexels));
+  glTextureSubImage2D(t->get(), 0, 0, 0, kPreintegrationTexels, kPreintegrationTexels, GL_RGBA,
                       GL_FLOAT, texels.data());
-  glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  // Linear between entries: a step's (front, back) falls between them.
+  glTextureParameteri(t->get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(t->get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   gl_check("pre-integration table upload");
   return t;
 }

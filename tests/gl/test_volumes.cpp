@@ -109,8 +109,8 @@ Segment segment_integral(const Volume& v, double vf, double vb, double step) {
   Color c{0.0, 0.0, 0.0};
   for (int i = 0; i < kN; ++i) {
     const double val = vf + (vb - vf) * (i + 0.5) / kN;
-    const double sigma =
-        -std::log(std::max(1.0 - v.transfer.opacity(val), std::exp2(-64.0))) / v.transfer.opacity_unit;
+    const double sigma = -std::log(std::max(1.0 - v.transfer.opacity(val), std::exp2(-64.0))) /
+                         v.transfer.opacity_unit;
     // The sub-step's own attenuation exactly: (1 - exp(-sigma h)) e^-tau.
     const double a = std::exp(-tau) * (1.0 - std::exp(-sigma * h));
     const Color col = v.transfer.color(val);
@@ -293,7 +293,8 @@ TEST(Volumes, EmptySpaceSkippingChangesNoPixel) {
   for (int run = 0; run < 4; ++run) {
     const bool jitter = (run & 1) != 0;
     const char* integration = run < 2 ? "point" : "preintegrated";
-    json j = ml_scene(64, {{"jitter", jitter}, {"skip_empty", false}, {"integration", integration}});
+    json j =
+        ml_scene(64, {{"jitter", jitter}, {"skip_empty", false}, {"integration", integration}});
     j["volumes"][0]["transfer"] = {
         {"points", {{0, 0.0, 0.0, 0.0, 0.0}, {0.55, 0.9, 0.6, 0.2, 0.0}, {1, 1.0, 0.9, 0.6, 0.8}}},
         {"opacity_unit", 0.1}};
