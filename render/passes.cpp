@@ -171,8 +171,7 @@ namespace {
 // spheres, depth-tested together; writes shaded colour and view depth.
 class SurfacePass final : public Pass {
  public:
-  SurfacePass()
-      : raster_("surface"), analytic_("analytic_occluder") {}
+  SurfacePass() : raster_("surface"), analytic_("analytic_occluder") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
     glEnable(GL_DEPTH_TEST);
@@ -233,8 +232,7 @@ std::array<float, 16> cube_face_matrix(int face, float near) {
   const auto& r = kRows[face];
   return {r[0][0], r[0][1], r[0][2], 0.0f,  //
           r[1][0], r[1][1], r[1][2], 0.0f,  //
-          r[2][0], r[2][1], r[2][2], -2.0f * near,
-          r[2][0], r[2][1], r[2][2], 0.0f};
+          r[2][0], r[2][1], r[2][2], -2.0f * near, r[2][0], r[2][1], r[2][2], 0.0f};
 }
 
 // Direct light (shaders/direct_light.frag): one full-screen draw per view
@@ -263,7 +261,8 @@ class DirectPass final : public Pass {
     glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
     glBindTextureUnit(3, cubes_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, res.direct_buffer());
-    if (res.analytic_count() > 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, res.analytic_buffer());
+    if (res.analytic_count() > 0)
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, res.analytic_buffer());
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
     glBlendEquation(GL_FUNC_ADD);
@@ -368,18 +367,18 @@ class GiResolvePass final : public Pass {
   static constexpr std::size_t kMaxAaLights = 8;  // shaders/gi_resolve.frag
 
  public:
-  GiResolvePass() : program_("gi_resolve") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
-    glUseProgram(program_.get(multi));
-    glUniform1f(program_.uniform(multi, "u_radius"),
+    ProgramPair& program =
+        programs_.get(std::string("gi_resolve") + kernel_suffix(ctx.scene.gi.kernel));
+    glUseProgram(program.get(multi));
+    glUniform1f(program.uniform(multi, "u_radius"),
                 static_cast<float>(ctx.resources.photon_radius()));
-    glUniform1i(program_.uniform(multi, "u_kernel"), static_cast<int>(ctx.scene.gi.kernel));
-    glUniform1f(program_.uniform(multi, "u_min_cos"), kSplatMinCos);
-    glUniform1f(program_.uniform(multi, "u_max_plane"), kSplatMaxPlane);
-    set_photon_lod(program_, multi, ctx.scene.gi);
-    glUniform1i(program_.uniform(multi, "u_correct"), ctx.scene.gi.edge_correction ? 1 : 0);
-    glUniform1i(program_.uniform(multi, "u_splat_scale"), ctx.plan.splat_scale);
+    glUniform1f(program.uniform(multi, "u_min_cos"), kSplatMinCos);
+    glUniform1f(program.uniform(multi, "u_max_plane"), kSplatMaxPlane);
+    set_photon_lod(program, multi, ctx.scene.gi);
+    glUniform1i(program.uniform(multi, "u_correct"), ctx.scene.gi.edge_correction ? 1 : 0);
+    glUniform1i(program.uniform(multi, "u_splat_scale"), ctx.plan.splat_scale);
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
     glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
@@ -400,13 +399,13 @@ class GiResolvePass final : public Pass {
       }
     }
     const Vec3 anchor = quads.empty() ? Vec3{} : std::get<QuadLight>(quads[0]->shape).corner;
-    glUniform1i(program_.uniform(multi, "u_aa_lights"), static_cast<GLint>(quads.size()));
+    glUniform1i(program.uniform(multi, "u_aa_lights"), static_cast<GLint>(quads.size()));
     for (std::size_t k = 0; k < quads.size(); ++k) {
       const auto& q = std::get<QuadLight>(quads[k]->shape);
       const Color radiance = q.radiance_scale() * quads[k]->flux;
       const std::string i = "[" + std::to_string(k) + "]";
       auto set = [&](const char* name, const Vec3& v) {
-        glUniform3f(program_.uniform(multi, (name + i).c_str()), static_cast<float>(v[0]),
+        glUniform3f(program.uniform(multi, (name + i).c_str()), static_cast<float>(v[0]),
                     static_cast<float>(v[1]), static_cast<float>(v[2]));
       };
       set("u_light_corner", q.corner - anchor);
@@ -414,14 +413,14 @@ class GiResolvePass final : public Pass {
       set("u_light_v", q.edge_v);
       set("u_light_radiance", Vec3{radiance[0], radiance[1], radiance[2]});
     }
-    for_each_view_offset(ctx, self, program_, "u_light_offset", anchor,
+    for_each_view_offset(ctx, self, program, "u_light_offset", anchor,
                          [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
     glDisable(GL_BLEND);
     gl_check("gi_resolve pass");
   }
 
  private:
-  ProgramPair program_;
+  LazyPrograms programs_;  // by kernel
 };
 
 // Photon splatting: one instanced draw of camera-facing quads, one per
@@ -429,17 +428,17 @@ class GiResolvePass final : public Pass {
 // reflected radiance (shaders/photon_splat.frag), additively into hdr.
 class PhotonPass final : public Pass {
  public:
-  PhotonPass() : program_("photon_splat") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     if (ctx.resources.photon_count() == 0) return;
     const bool multi = ctx.views > 0;
-    glUseProgram(program_.get(multi));
+    ProgramPair& program =
+        programs_.get(std::string("photon_splat") + kernel_suffix(ctx.scene.gi.kernel));
+    glUseProgram(program.get(multi));
     const float radius = static_cast<float>(ctx.resources.photon_radius());
-    glUniform1f(program_.uniform(multi, "u_radius"), radius);
-    glUniform1i(program_.uniform(multi, "u_kernel"), static_cast<int>(ctx.scene.gi.kernel));
-    glUniform1f(program_.uniform(multi, "u_min_cos"), kSplatMinCos);
-    glUniform1f(program_.uniform(multi, "u_max_plane"), kSplatMaxPlane);
-    set_photon_lod(program_, multi, ctx.scene.gi);
+    glUniform1f(program.uniform(multi, "u_radius"), radius);
+    glUniform1f(program.uniform(multi, "u_min_cos"), kSplatMinCos);
+    glUniform1f(program.uniform(multi, "u_max_plane"), kSplatMaxPlane);
+    set_photon_lod(program, multi, ctx.scene.gi);
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
     glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
@@ -452,14 +451,14 @@ class PhotonPass final : public Pass {
     glBindVertexArray(ctx.empty_vao);
     // Splatted at the kSplat size: the viewport shrinks for this pass.
     const int scale = ctx.plan.splat_scale;
-    glUniform1i(program_.uniform(multi, "u_splat_scale"), scale);
+    glUniform1i(program.uniform(multi, "u_splat_scale"), scale);
     GLint viewport[4];
     glGetIntegerv(GL_VIEWPORT, viewport);
     glViewport(0, 0, splat_size(viewport[2], scale), splat_size(viewport[3], scale));
     // Two draws: the global map's photons, then the caustic map's with their
     // own (smaller) radius.
-    const GLint first_uniform = program_.uniform(multi, "u_first");
-    const GLint radius_uniform = program_.uniform(multi, "u_radius");
+    const GLint first_uniform = program.uniform(multi, "u_first");
+    const GLint radius_uniform = program.uniform(multi, "u_radius");
     const GLsizei split_all = ctx.resources.photon_caustic_first();
     const GLsizei total_all = ctx.resources.photon_count();
     // gi.display_fraction: the first share of each map, power scaled up.
@@ -469,9 +468,9 @@ class PhotonPass final : public Pass {
     };
     const GLsizei split = part(split_all);
     const GLsizei caustic = part(total_all - split_all);
-    glUniform1f(program_.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
+    glUniform1f(program.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
     const float caustic_radius = static_cast<float>(ctx.resources.caustic_radius());
-    for_each_view_offset(ctx, self, program_, "u_photon_offset", ctx.resources.photon_anchor(), [&] {
+    for_each_view_offset(ctx, self, program, "u_photon_offset", ctx.resources.photon_anchor(), [&] {
       if (split > 0) {
         glUniform1i(first_uniform, 0);
         glUniform1f(radius_uniform, radius);
@@ -489,7 +488,7 @@ class PhotonPass final : public Pass {
   }
 
  private:
-  ProgramPair program_;
+  LazyPrograms programs_;  // by kernel
 };
 
 // Beams: additive energy from the line-integral tables, one instanced draw of
@@ -497,8 +496,7 @@ class PhotonPass final : public Pass {
 // multi-view batch.
 class BeamPass final : public Pass {
  public:
-  BeamPass()
-      : plain_("beam"), fogged_("beam_medium") {}
+  BeamPass() : plain_("beam"), fogged_("beam_medium") {}
   ProgramPair& volumes_program(const Scene& scene, bool medium) {
     if (!medium) {
       if (!plain_volumes_) plain_volumes_.emplace("beam_volumes");
@@ -517,7 +515,7 @@ class BeamPass final : public Pass {
     // Scenes with volumes: the programs with their transmittance knots
     // compiled in (shaders/volumes_on.glsl), built on first use.
     const bool volumes = ctx.plan.written("volume_t0");
-    ProgramPair& program = volumes ? volumes_program(ctx.scene, medium != nullptr)
+    ProgramPair& program = volumes  ? volumes_program(ctx.scene, medium != nullptr)
                            : medium ? fogged_.get(ctx.scene)
                                     : plain_;
     glUseProgram(program.get(multi));
@@ -531,8 +529,7 @@ class BeamPass final : public Pass {
     GLint region_eye = -1;
     if (medium) {
       region_eye = set_medium_uniforms(program, multi, ctx);
-      glUniform1f(program.uniform(multi, "u_medium_step"),
-                  static_cast<float>(medium->beam_step));
+      glUniform1f(program.uniform(multi, "u_medium_step"), static_cast<float>(medium->beam_step));
       glUniform1i(program.uniform(multi, "u_medium_rule"),
                   medium->beam_rule == BeamMediumRule::kMidpoint ? 1 : 0);
     }
@@ -592,8 +589,7 @@ class BeamPass final : public Pass {
 // HDR -> display values in the output's bit depth.
 class TonemapPass final : public Pass {
  public:
-  TonemapPass()
-      : program_("tonemap") {}
+  TonemapPass() : program_("tonemap") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
     glUseProgram(program_.get(multi));
@@ -670,8 +666,8 @@ GLint set_medium_uniforms(ProgramPair& program, bool multiview, const FrameConte
 }
 
 void set_region_eye(const FrameContext& ctx, GLint location, int view) {
-  const Vec3& eye = ctx.views > 0 && view >= 0 ? ctx.view_eyes[static_cast<std::size_t>(view)]
-                                               : ctx.basis.eye;
+  const Vec3& eye =
+      ctx.views > 0 && view >= 0 ? ctx.view_eyes[static_cast<std::size_t>(view)] : ctx.basis.eye;
   glUniform3f(location, static_cast<float>(eye[0]), static_cast<float>(eye[1]),
               static_cast<float>(eye[2]));
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -122,6 +123,30 @@ class ProgramPair {
   std::string name_;
   GlProgram single_, multi_;
 };
+
+// A pass's compile-time variants of a program (shaders/programs.txt names
+// each one), each built on first use: a renderer compiles only those its
+// scenes need. Variants stand in for uniform branches, which llvmpipe pays
+// for even where they are never taken (docs/volumes.md, "Speed").
+class LazyPrograms {
+ public:
+  ProgramPair& get(const std::string& name) {
+    auto it = programs_.find(name);
+    if (it == programs_.end()) {
+      it = programs_.emplace(name, std::make_unique<ProgramPair>(name)).first;
+    }
+    return *it->second;
+  }
+
+ private:
+  std::map<std::string, std::unique_ptr<ProgramPair>> programs_;
+};
+
+// The program-name suffix of a splatting kernel (shaders/gi_kernel_*.glsl;
+// Epanechnikov, the default, has none).
+inline const char* kernel_suffix(SplatKernel k) {
+  return k == SplatKernel::kBox ? "_box" : k == SplatKernel::kCone ? "_cone" : "";
+}
 
 // A program and its "<name>_regions" variant (shaders/medium_regions.glsl
 // compiled in, for scenes with regions of medium; built on first use).

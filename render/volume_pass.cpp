@@ -4,7 +4,6 @@
 #include <cmath>
 #include <numbers>
 #include <numeric>
-#include <optional>
 
 #include "render/passes.hpp"
 #include "render/scene_resources.hpp"
@@ -372,18 +371,12 @@ class VolumePass final : public Pass {
   }
 
  private:
-  // The march's programs (shaders/programs.txt "volume_cast[_preint][_skip]
-  // [_knots]"), each built on first use: a renderer compiles only those its
-  // scenes need.
+  // The march's programs: shaders/programs.txt "volume_cast[_preint][_skip][_knots]".
   ProgramPair& program_for(bool preint, bool skip, bool knots) {
-    const std::size_t k = (preint ? 4 : 0) + (skip ? 2 : 0) + (knots ? 1 : 0);
-    if (!programs_[k]) {
-      programs_[k].emplace(std::string("volume_cast") + (preint ? "_preint" : "") +
-                           (skip ? "_skip" : "") + (knots ? "_knots" : ""));
-    }
-    return *programs_[k];
+    return programs_.get(std::string("volume_cast") + (preint ? "_preint" : "") +
+                         (skip ? "_skip" : "") + (knots ? "_knots" : ""));
   }
-  std::array<std::optional<ProgramPair>, 8> programs_;
+  LazyPrograms programs_;
 };
 
 }  // namespace

@@ -35,7 +35,11 @@ layout(binding = 1) uniform VIEW_SAMPLER u_gb_normal;
 layout(binding = 2) uniform VIEW_SAMPLER u_gb_albedo;
 layout(binding = 3) uniform VIEW_SAMPLER u_indirect;
 uniform float u_radius;
-uniform int u_kernel;       // SplatKernel: 0 box, 1 cone, 2 epanechnikov
+// The kernel, SplatKernel: 0 box, 1 cone, 2 Epanechnikov (set by the
+// programs' preludes, gi_kernel_*.glsl).
+#ifndef GI_KERNEL
+#define GI_KERNEL 2
+#endif
 uniform float u_min_cos;    // the splats' normal test
 uniform float u_max_plane;  // the splats' plane test, x radius
 uniform int u_correct;      // 0: no share correction (gi.edge_correction off)
@@ -62,9 +66,13 @@ vec3 surface_point(ivec2 px, float z) {
 
 // The kernel's profile at distance fraction s = d / r (unnormalized).
 float profile(float s) {
-  if (u_kernel == 0) return 1.0;
-  if (u_kernel == 1) return 1.0 - s;
+#if GI_KERNEL == 0
+  return 1.0;
+#elif GI_KERNEL == 1
+  return 1.0 - s;
+#else
   return 1.0 - s * s;
+#endif
 }
 
 // True if the G-buffer pixel q lies on the surface of x (normal n): the

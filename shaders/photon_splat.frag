@@ -10,7 +10,11 @@ layout(binding = 0) uniform VIEW_SAMPLER u_view_depth;
 layout(binding = 1) uniform VIEW_SAMPLER u_gb_normal;
 layout(binding = 2) uniform VIEW_SAMPLER u_gb_albedo;
 uniform float u_radius;
-uniform int u_kernel;      // SplatKernel: 0 box, 1 cone, 2 epanechnikov
+// The kernel, SplatKernel: 0 box, 1 cone, 2 Epanechnikov (set by the
+// programs' preludes, gi_kernel_*.glsl).
+#ifndef GI_KERNEL
+#define GI_KERNEL 2
+#endif
 uniform float u_min_cos;   // normal test: cos of the largest angle between the normals
 uniform float u_max_plane; // plane test: largest distance off the surface's plane, x radius
 uniform int u_splat_scale; // this target has 1/u_splat_scale of the G-buffer's pixels per side
@@ -42,14 +46,13 @@ void main() {
   if (d2 >= r2) discard;
   if (dot(n, v_normal) < u_min_cos) discard;
   if (abs(dot(d, n)) > u_max_plane * u_radius) discard;
-  float w;
-  if (u_kernel == 0) {
-    w = 1.0 / (kPi * r2);
-  } else if (u_kernel == 1) {
-    w = 3.0 / (kPi * r2) * (1.0 - sqrt(d2 / r2));
-  } else {
-    w = 2.0 / (kPi * r2) * (1.0 - d2 / r2);
-  }
+#if GI_KERNEL == 0
+  float w = 1.0 / (kPi * r2);
+#elif GI_KERNEL == 1
+  float w = 3.0 / (kPi * r2) * (1.0 - sqrt(d2 / r2));
+#else
+  float w = 2.0 / (kPi * r2) * (1.0 - d2 / r2);
+#endif
   // Irradiance / pi: gi_resolve multiplies by the albedo of each pixel.
   out_color = vec4(v_power * (w / kPi), 0.0);
 }
