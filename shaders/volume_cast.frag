@@ -45,8 +45,8 @@ float brick_exit(vec3 cell, vec3 og, vec3 dg) {
   return exit_t;
 }
 
-// The brick of grid point g, or -1 when it is empty (its values all have
-// zero opacity).
+// Whether the brick of grid point g (its cell in the brick grid: `cell`) is
+// empty, its values all of zero opacity.
 bool brick_empty(vec3 g, out vec3 cell) {
   cell = clamp(floor(g / kBrickCells), vec3(0.0), vec3(textureSize(u_bricks, 0)) - 1.0);
   return texelFetch(u_bricks, ivec3(cell), 0).r == 0u;
