@@ -117,7 +117,7 @@ def rel_l1(img, ref, mask=None):
 
 
 def default_radius(scene, photons):
-    """gi/photon_map.cpp default_photon_radius: 50 photons per disk at 1e5 (200 with the
+    """gi/photon_map.cpp default_photon_radius: 50 photons per disk at 1e5 (800 with the
     direct pass carrying direct light), r ~ photons^(-1/6)."""
     pts = []
     for q in scene["occluders"]:
@@ -130,7 +130,7 @@ def default_radius(scene, photons):
     pts = np.array(pts)
     s = pts.max(axis=0) - pts.min(axis=0)
     area = 2 * (s[0] * s[1] + s[1] * s[2] + s[2] * s[0])
-    k0 = 50 if scene.get("gi", {}).get("direct") == "photons" else 200
+    k0 = 50 if scene.get("gi", {}).get("direct") == "photons" else 800
     k = k0 * (photons / 1e5) ** (2 / 3)
     return math.sqrt(k * area / (math.pi * photons))
 

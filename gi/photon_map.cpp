@@ -260,28 +260,43 @@ double default_volume_radius(const Scene& scene, std::int64_t volume_photons) {
                    (4.0 * std::numbers::pi * static_cast<double>(volume_photons)));
 }
 
-double default_photon_radius(const Scene& scene, std::int64_t photons) {
+namespace {
+
+// The radius that puts k photons in pi r^2 of the scene box's surface area
+// spread over `photons`, k = k0 at 1e5 and growing as photons^(2/3): r ~
+// photons^(-1/6), the radius that balances a density estimate's bias
+// (~ r^2) against its noise (~ 1 / sqrt(N r^2)), so the error falls as
+// photons^(-1/3). A fixed k would keep the noise fixed.
+double radius_for(const Scene& scene, std::int64_t photons, double k0) {
   const Aabb box = scene_box(scene);
   if (box.empty() || photons <= 0) return 1.0;
   const Vec3 s = box.hi - box.lo;
   const double area = 2.0 * (s[0] * s[1] + s[1] * s[2] + s[2] * s[0]);
   if (!(area > 0.0)) return 1.0;
-  // k photons in pi r^2 of `area` spread over `photons`, k = k0 at 1e5 and
-  // growing as photons^(2/3): r ~ photons^(-1/6), the radius that balances a
-  // density estimate's bias (~ r^2) against its noise (~ 1 / sqrt(N r^2)), so
-  // the error falls as photons^(-1/3). A fixed k would keep the noise fixed.
-  // k0 = 50 where photons carry direct light (sharp: shadows, the light's
-  // falloff); 200 (twice the radius) where they carry only the later
-  // bounces, which vary slowly: measured on the Cornell box (docs/gi.md).
-  const double k0 = scene.gi.direct == DirectLightMethod::kShadowMaps ? 200.0 : 50.0;
   const double n = static_cast<double>(photons);
   const double k = k0 * std::cbrt((n / 1e5) * (n / 1e5));
   return std::sqrt(k * area / (std::numbers::pi * n));
 }
 
+}  // namespace
+
+double default_photon_radius(const Scene& scene, std::int64_t photons) {
+  // k0 = 50 where photons carry direct light (sharp: shadows, the light's
+  // falloff); 800 (four times the radius) where they carry only the later
+  // bounces, which vary slowly: on the Cornell box at 1e5 photons that
+  // radius keeps every wall within 5% of the reference, the radius half as
+  // large (k0 200, the default before 2026-11-26) left the floor and the
+  // red wall at 5.7% and 5.4% (docs/gi.md).
+  return radius_for(scene, photons,
+                    scene.gi.direct == DirectLightMethod::kShadowMaps ? 800.0 : 50.0);
+}
+
 double default_caustic_radius(const Scene& scene, std::int64_t caustic_photons) {
+  // Caustics are sharp whoever carries direct light: k0 200 with the direct
+  // pass (as before 2026-11-26), 50 without.
   return kCausticRadiusScale *
-         default_photon_radius(scene, std::max<std::int64_t>(caustic_photons, 1));
+         radius_for(scene, std::max<std::int64_t>(caustic_photons, 1),
+                    scene.gi.direct == DirectLightMethod::kShadowMaps ? 200.0 : 50.0);
 }
 
 SplatRadii splat_radii(const Scene& scene, double drawn) {

@@ -60,9 +60,10 @@ PhotonMaps trace_photons(const Scene& scene, const GiScene& surfaces,
 bool has_specular(const Scene& scene);
 
 // The splat / gather radius when gi.radius is 0: with the global map's
-// photons spread evenly over the six faces of the scene's bounding box, 50
-// photons per disk at 1e5 photons, and r proportional to photons^(-1/6)
-// (the bias-variance balance of a 2D density estimate).
+// photons spread evenly over the six faces of the scene's bounding box, 800
+// photons per disk at 1e5 photons when the direct pass carries direct light
+// (50 when photons do), and r proportional to photons^(-1/6) (the
+// bias-variance balance of a 2D density estimate).
 double default_photon_radius(const Scene& scene, std::int64_t photons);
 
 // The volume photons' kernel radius when medium.radius is 0: `volume_photons`
@@ -71,7 +72,8 @@ double default_photon_radius(const Scene& scene, std::int64_t photons);
 double default_volume_radius(const Scene& scene, std::int64_t volume_photons);
 
 // The caustic map's splat radius when gi.caustic_radius is 0: the same rule
-// at the caustic photon count (gi.caustic_photons, or the share drawn), times
+// with 200 photons per disk (50 when photons carry direct light) at the
+// caustic photon count (gi.caustic_photons, or the share drawn), times
 // kCausticRadiusScale. Caustic photons
 // crowd into the small regions light is focused on, far denser than the
 // global map's even spread, so a smaller disk holds as many; and the

@@ -106,9 +106,13 @@ TEST(Lights, MaterialsAndGiSettingsParse) {
   EXPECT_DOUBLE_EQ(splat_radii(s).global, 0.25);
   json d = lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"caustic_photons", 5000}}}});
   const Scene s0 = parse_scene(d, {});
-  EXPECT_DOUBLE_EQ(splat_radii(s0).caustic, kCausticRadiusScale * default_photon_radius(s0, 5000));
+  EXPECT_DOUBLE_EQ(splat_radii(s0).caustic, default_caustic_radius(s0, 5000));
+  // With the direct pass the caustic rule holds 200 photons a disk, the
+  // global one 800: half the radius at the same count.
+  EXPECT_DOUBLE_EQ(default_caustic_radius(s0, 5000),
+                   kCausticRadiusScale * 0.5 * default_photon_radius(s0, 5000));
   // A share of the maps drawn: the radii at the drawn counts (larger).
-  EXPECT_DOUBLE_EQ(splat_radii(s0, 0.1).caustic, kCausticRadiusScale * default_photon_radius(s0, 500));
+  EXPECT_DOUBLE_EQ(splat_radii(s0, 0.1).caustic, default_caustic_radius(s0, 500));
   EXPECT_GT(splat_radii(s0, 0.1).global, splat_radii(s0).global);
 }
 

@@ -197,9 +197,9 @@ TEST(PhotonMap, KernelsAreNormalizedOverTheDisk) {
 
 TEST(PhotonMap, DefaultRadiusFollowsTheSceneAndPhotonCount) {
   Scene scene = parse_scene(closed_sphere(0.5, 1.0, 1000), {});
-  // Bounding box 2 x 2 x 2: area 24; 200 photons per pi r^2 at 1e5 photons
+  // Bounding box 2 x 2 x 2: area 24; 800 photons per pi r^2 at 1e5 photons
   // with the direct pass, 50 where photons carry direct light too.
-  EXPECT_NEAR(default_photon_radius(scene, 100000), std::sqrt(200.0 * 24.0 / (std::numbers::pi * 1e5)),
+  EXPECT_NEAR(default_photon_radius(scene, 100000), std::sqrt(800.0 * 24.0 / (std::numbers::pi * 1e5)),
               1e-12);
   scene.gi.direct = DirectLightMethod::kPhotons;
   EXPECT_NEAR(default_photon_radius(scene, 100000), std::sqrt(50.0 * 24.0 / (std::numbers::pi * 1e5)),
