@@ -58,6 +58,7 @@ struct TransferPoint {
   double value = 0.0;  // in [0, 1], strictly increasing along the list
   Color color{1.0, 1.0, 1.0};
   double opacity = 0.0;  // in [0, 1]: the opacity of a slab `opacity_unit` thick
+  bool operator==(const TransferPoint&) const = default;
 };
 
 struct TransferFunction {
@@ -69,6 +70,7 @@ struct TransferFunction {
   // Piecewise linear between points, clamped outside them.
   Color color(double v) const;
   double opacity(double v) const;
+  bool operator==(const TransferFunction&) const = default;
 };
 
 struct Volume {

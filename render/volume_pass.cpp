@@ -204,15 +204,16 @@ double march_step(const Vec3& level_spacing, const VolumeSettings& s) {
 
 std::shared_ptr<const GlTexture> VolumeTextureCache::preintegration(const Volume& volume,
                                                                     double step) {
-  const std::vector<float> tf = transfer_texels(volume);
   for (auto it = tables_.begin(); it != tables_.end(); ++it) {
-    // Same table texels (colour, intensity, opacity) and unit: the same table.
-    if (it->step == step && it->unit == volume.transfer.opacity_unit && it->transfer == tf) {
+    // The table is made from the transfer function itself (not its
+    // 1024-texel table), its intensity and the step.
+    if (it->step == step && it->intensity == volume.intensity && it->transfer == volume.transfer) {
       tables_.splice(tables_.begin(), tables_, it);
       return tables_.front().texture;
     }
   }
-  tables_.push_front({tf, step, volume.transfer.opacity_unit, upload_preintegration(volume, step)});
+  tables_.push_front(
+      {volume.transfer, volume.intensity, step, upload_preintegration(volume, step)});
   while (tables_.size() > 2 * max_entries_) tables_.pop_back();
   return tables_.front().texture;
 }

@@ -60,8 +60,8 @@ class VolumeTextureCache {
   explicit VolumeTextureCache(std::size_t max_entries = 4) : max_entries_(max_entries) {}
   std::shared_ptr<const VolumeTextures> get(const Volume& volume, const VolumeSettings& settings);
   // The pre-integration table of `volume`'s transfer function for steps of
-  // `step` (GL_RGBA32F, 2D, linear), kept for the last few (transfer, step)
-  // pairs: the preview's levels each have their own step.
+  // `step` (GL_RGBA32F, 2D, linear), kept for the last few (transfer
+  // function, intensity, step): the preview's levels each have their own step.
   std::shared_ptr<const GlTexture> preintegration(const Volume& volume, double step);
 
  private:
@@ -74,9 +74,9 @@ class VolumeTextureCache {
     std::shared_ptr<const VolumeTextures> textures;
   };
   struct Table {
-    std::vector<float> transfer;
+    TransferFunction transfer;
+    double intensity = 1.0;
     double step = 0.0;
-    double unit = 0.0;  // the opacity unit
     std::shared_ptr<const GlTexture> texture;
   };
   std::size_t max_entries_;
