@@ -24,7 +24,8 @@ server's HTTP /health). Checks, each printed with its numbers:
      killed with SIGKILL 2.5 s in and restarted 2 s later: every request
      answered correctly, the connections cut reconnected and their requests
      sent again within the budget (amplification <= 1.1, the issue's
-     bound), and the p99 of the timeline's 250 ms buckets around the kill
+     bound), the kill detected within 2 s (the machine saturated: see
+     load_failover), and the p99 of the timeline's 250 ms buckets around the kill
      printed beside the steady ones (measured, not asserted: a timing bound
      on a shared 2-core machine belongs to docs/deploy.md's record);
   5. `beamcast render --rig orbit:36` split over the three servers
@@ -157,8 +158,15 @@ def load_failover(cluster, cli_bin, run_dir, check):
         return
     r = json.loads(out)
     req, retries, verify = r["requests"], r["retries"], r["verify"]
-    check("beamcast load: the kill detected within 1 s",
-          detect is not None and detect <= 1.0, f"{detect} s")
+    # The 1 s bound is asserted in check 2. Here the machine is
+    # saturated (beamcast load's four closed-loop connections, and under
+    # ASan servers 2-3x slower), and what is timed includes the scheduler's
+    # delays to HAProxy's check timer and to this poller: CI once read
+    # 1.07 s here while check 2 read 0.16 s in the same run. 2 s still
+    # tells the configured schedule (inter 250 ms, fastinter 100 ms, fall 3:
+    # ~0.45 s) from HAProxy's defaults (inter 2 s, fall 3: ~6 s).
+    check("beamcast load: the kill detected within 2 s (1 s asserted in check 2)",
+          detect is not None and detect <= 2.0, f"{detect} s")
     check("beamcast load: no request lost or failed, frames verified",
           proc.returncode == 0 and req["errors"] == 0 and req["ok"] == req["sent"] and
           verify["all_frames_correct"] and verify["reference_checked"] > 0,
