@@ -59,6 +59,39 @@ def run_render(binary, scene, out_dir, extra):
     return json.loads(p.stdout), wall
 
 
+def frame_rate(server_binary, scene, frames=12):
+    """A camera-only change as the preview makes it: one camera per request
+    to a beamcast-server holding the scene (maps traced by the first
+    request, cached after), the camera nudged each time. Medians over
+    `frames` requests after the first: the server's render_ms (photon
+    upload, GPU, readback; not the PNG encoding), gpu_ms and each pass."""
+    sys.path.insert(0, os.path.join(ROOT, "client", "python"))
+    from beamcast_client import BeamcastClient
+    proc = subprocess.Popen([server_binary, "--port", "0", "--http-port", "-1"],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    try:
+        port = int(proc.stdout.readline().rsplit(":", 1)[-1].split()[0])
+        cam0 = scene["cameras"][0]
+        rows = []
+        with BeamcastClient("127.0.0.1", port, timeout=300) as c:
+            c.scene_put("gi", scene)
+            for i in range(frames + 1):
+                cam = dict(cam0, position=[cam0["position"][0] + 3.0 * (i % 5)] + cam0["position"][1:])
+                got, result = c.render(scene_id="gi", cameras=[cam])
+                if i:
+                    rows.append((result["timings"]["render_ms"], got[0]))
+    finally:
+        proc.terminate()
+        proc.wait()
+    med = statistics.median
+    out = {"render_ms": round(med(r for r, _ in rows), 1),
+           "gpu_ms": round(med(f["gpu_ms"] for _, f in rows), 1),
+           "upload_ms": round(med(f["photons"]["upload_ms"] for _, f in rows), 1),
+           "passes": {n: round(med(f["pass_ms"][n] for _, f in rows), 1) for n in rows[0][1]["pass_ms"]}}
+    out["frames_per_s"] = round(1000.0 / out["render_ms"], 2)
+    return out
+
+
 def load_hdr(frame):
     w, h = frame["width"], frame["height"]
     return np.fromfile(frame["hdr_file"], dtype=np.float32).reshape(h, w, 3).astype(np.float64)
@@ -202,7 +235,10 @@ def main():
     # The splats' edge correction off, and splatting at 1/2 and 1/4 size.
     settings += [("splat", mid, "epanechnikov", 1.0, {"edge_correction": False}, "no edge corr.")]
     settings += [("splat", mid, "epanechnikov", 1.0, {"splat_scale": k}, f"splat 1/{k}")
-                 for k in (2, 4)]
+                 for k in (2, 8)]
+    # Photons merged into disks (gi.cluster; default 0.35): none, finer, coarser.
+    settings += [("cluster", mid, "epanechnikov", 1.0, {"cluster": c}, f"cluster {c}")
+                 for c in (0.0, 0.25, 0.5)]
     regions = sorted(set(CORNELL_LABELS)) if len(base["occluders"]) == len(CORNELL_LABELS) else []
 
     rows = []
@@ -221,6 +257,7 @@ def main():
         row = {"knob": knob, "photons": n, "kernel": kernel, "radius": round(r, 3),
                "radius_scale": rscale, "direct": varied or "shadow maps",
                "stored": frames[0]["photons"]["count"],
+               "disks": frames[0]["photons"]["disks"],
                "trace_ms": round(frames[0]["photons"]["trace_ms"], 1),
                "upload_ms": round(frames[0]["photons"]["upload_ms"], 1),
                "gpu_ms": round(statistics.median(f["gpu_ms"] for f in frames), 1),
@@ -248,6 +285,12 @@ def main():
             write_png(os.path.join(a.out, "gpu_1e5.png"), img, exposure)
         if knob == "photons" and n == counts[-1]:
             write_png(os.path.join(a.out, f"gpu_{n}.png"), img, exposure)
+
+    # The default frame as the preview gets it, one camera per request.
+    server = os.path.join(os.path.dirname(a.binary), "beamcast-server")
+    rate = frame_rate(server, dict(base, cameras=[dict(cam, name="v")])) if os.path.exists(server) else None
+    if rate:
+        print("camera-only change, one camera per request: " + json.dumps(rate), flush=True)
 
     # The path tracer itself at a few sample counts (another seed than the
     # reference's): its time to reach a given error, against the photons'.
@@ -279,6 +322,12 @@ def main():
         f.write(f"Reference: 2 x {spp} spp path traced ({ref_wall[0]:.0f} + {ref_wall[1]:.0f} s "
                 f"wall); its own noise (rel. L1): {ref_noise:.4f}.\n")
         f.write(f"Log-log slope of error against photon count: {slope:.2f}.\n\n")
+        if rate:
+            f.write("Camera-only change at the defaults, one camera per request to a "
+                    f"beamcast-server (maps cached; median of 12): render {rate['render_ms']} ms "
+                    f"(**{rate['frames_per_s']} frames/s**; photon upload {rate['upload_ms']} ms, "
+                    f"GPU {rate['gpu_ms']} ms: " +
+                    ", ".join(f"{k} {v}" for k, v in rate["passes"].items()) + " ms).\n\n")
         cols = list(rows[0].keys())
         f.write("| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n")
         for r in rows:
@@ -299,7 +348,7 @@ def main():
         ax[0].set_ylabel("relative L1 error")
         ax[0].legend(fontsize=7)
         for knob, mk in (("photons", "o"), ("kernel", "s"), ("radius", "^"), ("direct", "d"),
-                         ("splat", "v")):
+                         ("splat", "v"), ("cluster", "P")):
             pts = [r for r in rows if r["knob"] == knob]
             ax[1].loglog([r["frame_ms"] for r in pts], [r["rel_l1"] for r in pts], mk, label=knob)
         pts = [r for r in rows if r["knob"] == "path_tracer"]

@@ -149,6 +149,7 @@ int run_render(const RenderArgs& args) {
       if (fr.slim_points > 0) jf["slim_points"] = fr.slim_points;
       if (scene.has_gi()) {
         jf["photons"] = {{"count", fr.photons},
+                         {"disks", fr.photon_disks},
                          {"trace_ms", fr.photon_trace_ms},
                          {"upload_ms", fr.photon_upload_ms}};
         if (fr.volume_photons > 0) jf["photons"]["volume"] = fr.volume_photons;

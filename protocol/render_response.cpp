@@ -46,6 +46,7 @@ json to_json(const RenderFrame& f) {
   }
   if (f.photons) {
     j["photons"] = {{"count", f.photons->count},
+                    {"disks", f.photons->disks},
                     {"trace_ms", f.photons->trace_ms},
                     {"upload_ms", f.photons->upload_ms}};
   }
@@ -160,6 +161,9 @@ RenderFrame read_frame(const Node& n) {
     const ObjectReader pr(*p, "photons");
     f.photons = PhotonReport{read_integer(pr.required("count")), read_number(pr.required("trace_ms")),
                              read_number(pr.required("upload_ms"))};
+    // Servers before gi.cluster sent no disks: one per photon.
+    const auto disks = pr.optional("disks");
+    f.photons->disks = disks ? read_integer(*disks) : f.photons->count;
   }
   f.x = read_optional<int>(r, "x", read_int);
   f.y = read_optional<int>(r, "y", read_int);

@@ -29,13 +29,15 @@ struct GpuBatch {
   bool operator==(const GpuBatch&) const = default;
 };
 
-// Lit scenes: the photons splatted into the frame and the CPU time of the
-// render's photon tracing (0 when the maps came from the server's cache) and
-// upload.
+// Lit scenes: the photons splatted into the frame, the disks they were
+// drawn as (gi.cluster merges photons; without it, one each) and the CPU
+// time of the render's photon tracing (0 when the maps came from the
+// server's cache) and upload.
 struct PhotonReport {
   std::int64_t count = 0;
   double trace_ms = 0.0;
   double upload_ms = 0.0;
+  std::int64_t disks = 0;
   bool operator==(const PhotonReport&) const = default;
 };
 

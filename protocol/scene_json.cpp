@@ -300,7 +300,7 @@ void check_shadow_budget(const Scene& scene, const SceneLimits& limits, const st
 GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "gi settings");
   o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth", "direct",
-                "direct_samples", "shadow_size", "edge_correction", "splat_scale",
+                "direct_samples", "shadow_size", "edge_correction", "splat_scale", "cluster",
                 "light_antialias", "caustic_radius", "specular_samples", "lod"});
   GiSettings g;
   std::int64_t total = 0;
@@ -362,6 +362,7 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   if (auto v = o.optional("edge_correction")) g.edge_correction = read_bool(*v);
   if (auto v = o.optional("light_antialias")) g.light_antialias = read_bool(*v);
   if (auto v = o.optional("splat_scale")) g.splat_scale = read_int_in(*v, 1, 8);
+  if (auto v = o.optional("cluster")) g.cluster = check_closed(*v, read_number(*v), 0.0, 1.0);
   if (auto v = o.optional("specular_samples")) g.specular_samples = read_int_in(*v, 1, 8);
   if (auto v = o.optional("lod")) {
     ObjectReader lod(*v, "photon level of detail");

@@ -242,14 +242,16 @@ std::array<float, 16> cube_face_matrix(int face, float near) {
 // (SceneResources::shadow_key), so a camera-only change renders none.
 class DirectPass final : public Pass {
  public:
-  DirectPass() : programs_("direct_light"), shadow_("shadow_depth") {}
+  DirectPass() : programs_("direct_light"), lean_("direct_light_lean"), shadow_("shadow_depth") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     SceneResources& res = ctx.resources;
     const auto count = static_cast<GLsizei>(res.direct_points().size());
     if (count == 0) return;
     if (res.shadow_key() != key_) render_shadows(ctx);
     const bool multi = ctx.views > 0;
-    ProgramPair& program = programs_.get(ctx.scene);
+    // Without analytic occluders or a medium: the program without their code.
+    const bool lean = res.analytic_count() == 0 && !ctx.scene.has_medium();
+    ProgramPair& program = lean ? lean_ : programs_.get(ctx.scene);
     glUseProgram(program.get(multi));
     glUniform1i(program.uniform(multi, "u_point_count"), count);
     glUniform1f(program.uniform(multi, "u_far"), far_);
@@ -345,6 +347,7 @@ class DirectPass final : public Pass {
   }
 
   RegionProgram programs_;
+  ProgramPair lean_;
   ProgramPair shadow_;
   std::string key_;  // the SceneResources::shadow_key the maps are for
   GlTexture cubes_;  // depth cube-map array, 6 layers per direct point
@@ -360,17 +363,18 @@ class DirectPass final : public Pass {
 constexpr float kSplatMinCos = 0.906f;
 constexpr float kSplatMaxPlane = 0.1f;
 
-// The splats' sum (gi_indirect) into hdr, each pixel divided by the
-// kernel-weighted share of its disk that lies on its own surface
-// (shaders/gi_resolve.frag), or passed through with gi.edge_correction off.
+// The splats' sum (gi_indirect) into hdr, upsampled, each splat pixel
+// divided by the kernel-weighted share of its disk that lies on its own
+// surface (its alpha, from the photon pass's share draw), or passed through
+// with gi.edge_correction off (shaders/gi_resolve.frag).
 class GiResolvePass final : public Pass {
   static constexpr std::size_t kMaxAaLights = 8;  // shaders/gi_resolve.frag
 
  public:
+  GiResolvePass() : program_("gi_resolve") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const bool multi = ctx.views > 0;
-    ProgramPair& program =
-        programs_.get(std::string("gi_resolve") + kernel_suffix(ctx.scene.gi.kernel));
+    ProgramPair& program = program_;
     glUseProgram(program.get(multi));
     glUniform1f(program.uniform(multi, "u_radius"),
                 static_cast<float>(ctx.resources.photon_radius()));
@@ -420,7 +424,7 @@ class GiResolvePass final : public Pass {
   }
 
  private:
-  LazyPrograms programs_;  // by kernel
+  ProgramPair program_;
 };
 
 // Photon splatting: one instanced draw of camera-facing quads, one per
@@ -455,20 +459,29 @@ class PhotonPass final : public Pass {
     GLint viewport[4];
     glGetIntegerv(GL_VIEWPORT, viewport);
     glViewport(0, 0, splat_size(viewport[2], scale), splat_size(viewport[3], scale));
+    // gi.edge_correction: each splat pixel's share of its disk on its own
+    // surface into the target's alpha (shaders/gi_share.frag), for gi_resolve.
+    if (ctx.scene.gi.edge_correction) {
+      ProgramPair& share =
+          programs_.get(std::string("gi_share") + kernel_suffix(ctx.scene.gi.kernel));
+      glUseProgram(share.get(multi));
+      glUniform1f(share.uniform(multi, "u_radius"), radius);
+      glUniform1f(share.uniform(multi, "u_min_cos"), kSplatMinCos);
+      glUniform1f(share.uniform(multi, "u_max_plane"), kSplatMaxPlane);
+      glUniform1i(share.uniform(multi, "u_splat_scale"), scale);
+      for_each_view(ctx, self, share, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+      glUseProgram(program.get(multi));
+    }
     // Two draws: the global map's photons, then the caustic map's with their
     // own (smaller) radius.
     const GLint first_uniform = program.uniform(multi, "u_first");
     const GLint radius_uniform = program.uniform(multi, "u_radius");
+    // The buffer holds the drawn share of each map (gi.display_fraction),
+    // its power already scaled, clustered (gi.cluster): all of it is drawn.
     const GLsizei split_all = ctx.resources.photon_caustic_first();
-    const GLsizei total_all = ctx.resources.photon_count();
-    // gi.display_fraction: the first share of each map, power scaled up.
-    const double share = display_share(ctx.scene.gi.display_fraction);
-    auto part = [&](GLsizei n) {
-      return static_cast<GLsizei>(std::llround(share * static_cast<double>(n)));
-    };
-    const GLsizei split = part(split_all);
-    const GLsizei caustic = part(total_all - split_all);
-    glUniform1f(program.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
+    const GLsizei split = split_all;
+    const GLsizei caustic = ctx.resources.photon_count() - split_all;
+    glUniform1f(program.uniform(multi, "u_power_scale"), 1.0f);
     const float caustic_radius = static_cast<float>(ctx.resources.caustic_radius());
     for_each_view_offset(ctx, self, program, "u_photon_offset", ctx.resources.photon_anchor(), [&] {
       if (split > 0) {

@@ -514,7 +514,8 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
     for (std::size_t i : batches[b]) frames[i].batch.index = static_cast<int>(b);
   }
   for (FrameResult& f : frames) {
-    f.photons = res.photon_count();
+    f.photons = res.photons_kept();
+    f.photon_disks = res.photon_count();
     f.volume_photons = res.volume_count();
     f.photon_trace_ms = res.photon_trace_ms();
     f.photon_upload_ms = res.photon_upload_ms();

@@ -104,6 +104,7 @@ struct FrameResult {
   // Lit scenes: photons splatted, and the CPU time of this render call's
   // photon tracing (0 when the maps came from the cache) and upload.
   std::int64_t photons = 0;
+  std::int64_t photon_disks = 0;  // the disks they were drawn as (gi.cluster)
   std::int64_t volume_photons = 0;  // scenes with a scattering medium: the volume map's
   double photon_trace_ms = 0.0;
   double photon_upload_ms = 0.0;

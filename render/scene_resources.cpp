@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "gi/photon_clusters.hpp"
+
 namespace beamcast {
 
 std::shared_ptr<const LineIntegralTable> TableCache::get(const Density& density, int nd, int ns,
@@ -274,39 +276,33 @@ void SceneResources::upload_photons(PhotonCache& cache, bool skip_direct) {
     for (const Photon& p : *map) box.grow(Vec3{p.p[0], p.p[1], p.p[2]});
   }
   photon_anchor_ = box.empty() ? Vec3{0.0, 0.0, 0.0} : box.centre();
-  struct PhotonData {
-    float position[4];
-    float power[4];
-    float normal[4];
-  };
-  std::vector<PhotonData> data;
-  data.reserve(maps_->global.size() + maps_->caustic.size());
+  // A share of the maps drawn (gi.display_fraction, their first photons, power
+  // scaled up): the default radii at the drawn photon counts.
+  const double share = display_share(scene_.gi.display_fraction);
+  const SplatRadii radii = splat_radii(scene_, scene_.gi.display_fraction);
+  photon_radius_ = radii.global;
+  caustic_radius_ = radii.caustic;
+  std::vector<SplatDisk> data;
   for (const auto* map : {&maps_->global, &maps_->caustic}) {
-    if (map == &maps_->caustic) photon_caustic_first_ = static_cast<GLsizei>(data.size());
-    for (const Photon& p : *map) {
-      if (skip_direct && p.bounces == 0) continue;
-      PhotonData d{};
-      for (int k = 0; k < 3; ++k) {
-        d.position[k] = static_cast<float>(p.p[k] - photon_anchor_[static_cast<std::size_t>(k)]);
-        d.power[k] = p.power[k];
-        d.normal[k] = p.n[k];
-      }
-      d.position[3] = p.bounces == 0 ? 1.0f : 0.0f;
-      data.push_back(d);
-    }
+    const bool caustic = map == &maps_->caustic;
+    if (caustic) photon_caustic_first_ = static_cast<GLsizei>(data.size());
+    const auto kept = static_cast<std::size_t>(std::count_if(
+        map->begin(), map->end(), [&](const Photon& p) { return !(skip_direct && p.bounces == 0); }));
+    photons_kept_ += static_cast<std::int64_t>(kept);
+    const auto drawn = static_cast<std::size_t>(std::llround(share * static_cast<double>(kept)));
+    const ClusterOptions options{caustic ? caustic_radius_ : photon_radius_, scene_.gi.cluster,
+                                 1.0 / share};
+    const std::vector<SplatDisk> disks =
+        cluster_photons(*map, drawn, skip_direct, photon_anchor_, options);
+    data.insert(data.end(), disks.begin(), disks.end());
   }
   photon_count_ = static_cast<GLsizei>(data.size());
   if (!data.empty()) {
     GLuint id = 0;
     glCreateBuffers(1, &id);
     photon_ssbo_ = GlBuffer(id);
-    glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(PhotonData)), data.data(), 0);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(SplatDisk)), data.data(), 0);
   }
-  // A share of the maps drawn (gi.display_fraction): the default radii at
-  // the drawn photon counts.
-  const SplatRadii radii = splat_radii(scene_, scene_.gi.display_fraction);
-  photon_radius_ = radii.global;
-  caustic_radius_ = radii.caustic;
   photon_upload_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() -
       photon_trace_ms_;

@@ -74,7 +74,11 @@ class SceneResources {
   GLsizei analytic_count() const { return static_cast<GLsizei>(analytic_.size()); }
   // Photons (both maps), positions relative to photon_anchor().
   GLuint photon_buffer() const { return photon_ssbo_.get(); }
+  // Disks in photon_buffer() (the drawn share of the maps, clustered by
+  // gi.cluster), and the photons they hold (both maps, without those
+  // straight from the lights when the direct pass carries direct light).
   GLsizei photon_count() const { return photon_count_; }
+  std::int64_t photons_kept() const { return photons_kept_; }
   const Vec3& photon_anchor() const { return photon_anchor_; }
   double photon_radius() const { return photon_radius_; }
   // The photon buffer holds the global map's photons, then from this index
@@ -145,6 +149,7 @@ class SceneResources {
   std::shared_ptr<const PhotonMaps> maps_;
   GlBuffer photon_ssbo_;
   GLsizei photon_count_ = 0;
+  std::int64_t photons_kept_ = 0;
   Vec3 photon_anchor_{};
   double photon_radius_ = 1.0;
   GLsizei photon_caustic_first_ = 0;

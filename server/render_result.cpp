@@ -80,7 +80,7 @@ RenderResponse build_render_response(const RenderOutcome& out, const RenderResul
     f.gpu_batch = GpuBatch{fr.batch.index, fr.batch.views, fr.batch.gpu_ms, fr.batch.readback_ms};
     if (std::find_if(fr.passes.begin(), fr.passes.end(),
                      [](const PassTiming& p) { return p.name == "photons"; }) != fr.passes.end()) {
-      f.photons = PhotonReport{fr.photons, fr.photon_trace_ms, fr.photon_upload_ms};
+      f.photons = PhotonReport{fr.photons, fr.photon_trace_ms, fr.photon_upload_ms, fr.photon_disks};
     }
     readback_ms += fr.readback_ms;
     if (out.atlas) {
