@@ -152,7 +152,7 @@ std::shared_ptr<const PhotonMaps> PhotonCache::get(const Scene& scene, bool* tra
   if (traced) *traced = true;
   const std::size_t bytes =
       (maps->global.size() + maps->caustic.size() + maps->volume.size()) * sizeof(Photon);
-  entries_.push_front({key, maps, bytes, {}});
+  entries_.push_front({key, maps, bytes, {}, {}});
   bytes_ += bytes;
   // Evict the least recently used, but keep the one just traced.
   while (bytes_ > max_bytes_ && entries_.size() > 1) {
@@ -177,6 +177,33 @@ std::shared_ptr<const PhotonGather> PhotonCache::gather(
     return g;
   }
   return std::make_shared<const PhotonGather>(*maps, skip_direct);
+}
+
+std::shared_ptr<const SplatDiskSet> PhotonCache::disks(const std::shared_ptr<const PhotonMaps>& maps,
+                                                       const SplatDiskOptions& options) {
+  constexpr std::size_t kKept = 4;
+  for (Entry& e : entries_) {
+    if (e.maps != maps) continue;
+    for (auto it = e.disk_sets.begin(); it != e.disk_sets.end(); ++it) {
+      if (it->first == options) {
+        e.disk_sets.splice(e.disk_sets.begin(), e.disk_sets, it);
+        return e.disk_sets.front().second;
+      }
+    }
+    auto set = std::make_shared<const SplatDiskSet>(splat_disks(*maps, options));
+    const std::size_t added = set->disks.size() * sizeof(SplatDisk);
+    e.disk_sets.emplace_front(options, set);
+    e.bytes += added;
+    bytes_ += added;
+    if (e.disk_sets.size() > kKept) {
+      const std::size_t dropped = e.disk_sets.back().second->disks.size() * sizeof(SplatDisk);
+      e.disk_sets.pop_back();
+      e.bytes -= dropped;
+      bytes_ -= dropped;
+    }
+    return set;
+  }
+  return std::make_shared<const SplatDiskSet>(splat_disks(*maps, options));
 }
 
 }  // namespace beamcast

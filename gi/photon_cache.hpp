@@ -10,8 +10,10 @@
 #include <list>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "gi/photon_gather.hpp"
+#include "gi/photon_clusters.hpp"
 #include "gi/photon_map.hpp"
 
 namespace beamcast {
@@ -30,6 +32,12 @@ class PhotonCache {
   // use and kept with the maps: one per skip_direct.
   std::shared_ptr<const PhotonGather> gather(const std::shared_ptr<const PhotonMaps>& maps,
                                              bool skip_direct);
+  // The splat pass's disks for `maps` (as for gather()), built on first use
+  // and kept with the maps for the 4 most recent options (the preview's
+  // photon knob moves the drawn share): a camera-only change clusters
+  // nothing again.
+  std::shared_ptr<const SplatDiskSet> disks(const std::shared_ptr<const PhotonMaps>& maps,
+                                            const SplatDiskOptions& options);
   std::size_t bytes() const { return bytes_; }
   std::size_t entries() const { return entries_.size(); }
 
@@ -39,6 +47,8 @@ class PhotonCache {
     std::shared_ptr<const PhotonMaps> maps;
     std::size_t bytes;
     std::shared_ptr<const PhotonGather> gather[2];  // by skip_direct
+    // Most recently used first.
+    std::list<std::pair<SplatDiskOptions, std::shared_ptr<const SplatDiskSet>>> disk_sets;
   };
   std::size_t max_bytes_;
   std::size_t bytes_ = 0;

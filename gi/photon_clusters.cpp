@@ -154,4 +154,28 @@ std::vector<SplatDisk> cluster_photons(const std::vector<Photon>& photons, std::
   return out;
 }
 
+SplatDiskSet splat_disks(const PhotonMaps& maps, const SplatDiskOptions& options) {
+  SplatDiskSet set;
+  Aabb box;
+  for (const auto* map : {&maps.global, &maps.caustic}) {
+    for (const Photon& p : *map) box.grow(Vec3{p.p[0], p.p[1], p.p[2]});
+  }
+  set.anchor = box.empty() ? Vec3{0.0, 0.0, 0.0} : box.centre();
+  for (const auto* map : {&maps.global, &maps.caustic}) {
+    const bool caustic = map == &maps.caustic;
+    if (caustic) set.caustic_first = set.disks.size();
+    const auto kept = static_cast<std::size_t>(std::count_if(map->begin(), map->end(), [&](const Photon& p) {
+      return !(options.skip_direct && p.bounces == 0);
+    }));
+    set.photons += static_cast<std::int64_t>(kept);
+    const auto drawn = static_cast<std::size_t>(std::llround(options.share * static_cast<double>(kept)));
+    const ClusterOptions cluster{caustic ? options.caustic_radius : options.radius, options.cluster,
+                                 1.0 / options.share};
+    const std::vector<SplatDisk> disks =
+        cluster_photons(*map, drawn, options.skip_direct, set.anchor, cluster);
+    set.disks.insert(set.disks.end(), disks.begin(), disks.end());
+  }
+  return set;
+}
+
 }  // namespace beamcast

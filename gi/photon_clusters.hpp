@@ -43,4 +43,25 @@ std::vector<SplatDisk> cluster_photons(const std::vector<Photon>& photons, std::
                                        bool skip_direct, const Vec3& anchor,
                                        const ClusterOptions& options);
 
+// What the splat pass uploads for a scene's maps: both maps' disks (the
+// global map's, then the caustic map's from caustic_first), relative to
+// the photons' centre `anchor`.
+struct SplatDiskSet {
+  Vec3 anchor{};
+  std::vector<SplatDisk> disks;
+  std::size_t caustic_first = 0;
+  std::int64_t photons = 0;  // the photons they hold (before the drawn share)
+};
+
+struct SplatDiskOptions {
+  bool skip_direct = false;     // leave out photons straight from the lights
+  double share = 1.0;           // the drawn share of each map (display_share)
+  double radius = 1.0;          // the global map's splat radius
+  double caustic_radius = 1.0;  // the caustic map's
+  double cluster = 0.0;         // GiSettings::cluster
+  bool operator==(const SplatDiskOptions&) const = default;
+};
+
+SplatDiskSet splat_disks(const PhotonMaps& maps, const SplatDiskOptions& options);
+
 }  // namespace beamcast

@@ -6,8 +6,6 @@
 #include <cmath>
 #include <limits>
 
-#include "gi/photon_clusters.hpp"
-
 namespace beamcast {
 
 std::shared_ptr<const LineIntegralTable> TableCache::get(const Density& density, int nd, int ns,
@@ -271,31 +269,19 @@ void SceneResources::upload_photons(PhotonCache& cache, bool skip_direct) {
   bool traced = false;
   maps_ = cache.get(scene_, &traced);
   photon_trace_ms_ = traced ? maps_->trace_ms : 0.0;
-  Aabb box;
-  for (const auto* map : {&maps_->global, &maps_->caustic}) {
-    for (const Photon& p : *map) box.grow(Vec3{p.p[0], p.p[1], p.p[2]});
-  }
-  photon_anchor_ = box.empty() ? Vec3{0.0, 0.0, 0.0} : box.centre();
   // A share of the maps drawn (gi.display_fraction, their first photons, power
-  // scaled up): the default radii at the drawn photon counts.
-  const double share = display_share(scene_.gi.display_fraction);
+  // scaled up): the default radii at the drawn photon counts. The disks
+  // (clustered by gi.cluster) are kept with the maps.
   const SplatRadii radii = splat_radii(scene_, scene_.gi.display_fraction);
   photon_radius_ = radii.global;
   caustic_radius_ = radii.caustic;
-  std::vector<SplatDisk> data;
-  for (const auto* map : {&maps_->global, &maps_->caustic}) {
-    const bool caustic = map == &maps_->caustic;
-    if (caustic) photon_caustic_first_ = static_cast<GLsizei>(data.size());
-    const auto kept = static_cast<std::size_t>(std::count_if(
-        map->begin(), map->end(), [&](const Photon& p) { return !(skip_direct && p.bounces == 0); }));
-    photons_kept_ += static_cast<std::int64_t>(kept);
-    const auto drawn = static_cast<std::size_t>(std::llround(share * static_cast<double>(kept)));
-    const ClusterOptions options{caustic ? caustic_radius_ : photon_radius_, scene_.gi.cluster,
-                                 1.0 / share};
-    const std::vector<SplatDisk> disks =
-        cluster_photons(*map, drawn, skip_direct, photon_anchor_, options);
-    data.insert(data.end(), disks.begin(), disks.end());
-  }
+  const std::shared_ptr<const SplatDiskSet> set =
+      cache.disks(maps_, {skip_direct, display_share(scene_.gi.display_fraction), photon_radius_,
+                          caustic_radius_, scene_.gi.cluster});
+  photon_anchor_ = set->anchor;
+  photon_caustic_first_ = static_cast<GLsizei>(set->caustic_first);
+  photons_kept_ = set->photons;
+  const std::vector<SplatDisk>& data = set->disks;
   photon_count_ = static_cast<GLsizei>(data.size());
   if (!data.empty()) {
     GLuint id = 0;

@@ -8,7 +8,9 @@
 #include <random>
 #include <vector>
 
+#include "gi/photon_cache.hpp"
 #include "gi/photon_clusters.hpp"
+#include "protocol/scene_json.hpp"
 
 namespace beamcast {
 namespace {
@@ -131,6 +133,34 @@ TEST(PhotonClusters, SurfacesTheSplatTellsApartStayApart) {
   }
   EXPECT_EQ(disks[1].normal[1], -1.0f);
   EXPECT_EQ(disks[3].position[3], 1.0f);  // marked straight from the light
+}
+
+// The disks are kept with the cached maps: the same options give the same
+// set (a camera-only change clusters nothing again), other options (the
+// preview's drawn share) their own; the bytes count them.
+TEST(PhotonClusters, TheCacheKeepsTheDisksWithTheMaps) {
+  const nlohmann::json j = {
+      {"occluders", {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1.0}}}},
+      {"lights", {{{"type", "point"}, {"position", {0, 0, 0}}, {"power", 1.0}}}},
+      {"gi", {{"photons", 5000}, {"caustic_photons", 0}}},
+      {"cameras", {{{"position", {0, 0, 0.5}}, {"target", {0, 0, 0}}}}}};
+  const Scene scene = parse_scene(j, {});
+  PhotonCache cache;
+  const auto maps = cache.get(scene);
+  const std::size_t before = cache.bytes();
+  const SplatDiskOptions all{false, 1.0, 0.3, 0.1, 0.35};
+  const auto a = cache.disks(maps, all);
+  EXPECT_EQ(a->photons, static_cast<std::int64_t>(maps->global.size()));
+  EXPECT_LT(a->disks.size(), maps->global.size());
+  EXPECT_EQ(cache.bytes(), before + a->disks.size() * sizeof(SplatDisk));
+  EXPECT_EQ(cache.disks(maps, all), a);
+  SplatDiskOptions quarter = all;
+  quarter.share = 0.25;
+  const auto b = cache.disks(maps, quarter);
+  EXPECT_NE(b, a);
+  EXPECT_LT(b->disks.size(), a->disks.size());
+  EXPECT_EQ(b->photons, a->photons);
+  EXPECT_EQ(cache.disks(maps, all), a);  // still kept
 }
 
 }  // namespace
