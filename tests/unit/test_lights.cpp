@@ -145,6 +145,10 @@ TEST(Lights, BadFieldsAreRefusedWithTheirPath) {
                   "out_of_range", "/gi/caustic_radius");
   EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"caustic_radius", "big"}}}}),
                   "wrong_type", "/gi/caustic_radius");
+  EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"cluster", 1.5}}}}),
+                  "out_of_range", "/gi/cluster");
+  EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"cluster", -0.1}}}}),
+                  "out_of_range", "/gi/cluster");
 }
 
 TEST(Lights, BadMaterialsAreRefusedWithTheirPath) {
