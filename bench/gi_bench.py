@@ -13,7 +13,11 @@ Runs `beamcast render` (this build) on the Cornell box (examples/cornell_box.jso
     and 2x its default at 1e5; at 1e5 also direct light from photons (the
     seed's way) in place of the direct pass, and the direct pass's knobs
     (points per quad light 4 and 64, shadow maps of 128 and 512 texels), the
-    splats' edge correction off, and splatting at 1/2 and 1/4 of the size.
+    splats' edge correction off, splatting at 1/2 and 1/8 of the size (the
+    default is 1/4), and photons merged into disks (gi.cluster) 0, 0.25 and
+    0.5 (the default is 0.35).
+Then the default frame as the preview gets it: one camera per request to a
+beamcast-server (next to the binary) holding the scene, maps cached.
 Per photon count also the CPU photon gather on the same photons
 (`beamcast render --gather radius`: the splat estimator in double, with the
 direct pass's term from the same points with exact visibility; and
