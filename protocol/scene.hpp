@@ -96,10 +96,9 @@ struct GiSettings {
   // and the light seen in them, as the reference's pixel average does).
   int specular_samples = 2;
   // Photons are splatted at 1/splat_scale of the render size per side, then
-  // brought back by a surface-aware upsampling (pass gi_resolve): near edges
-  // the upsampling pulls values from further inside a surface, which the
-  // edge correction (made per render pixel) then over-corrects a little;
-  // on the Cornell box 2 costs no error over 1 at 0.5x the frame time, and
+  // brought back by a surface-aware upsampling (pass gi_resolve) of values
+  // each corrected at its own splat pixel (the edge correction); on the
+  // Cornell box 2 costs no error over 1 at 0.5x the frame time, and
   // with the default radius (four times the area of its disks before
   // 2026-11-26) 4 costs 0.05% of the image's error at 0.4x the time of 2
   // (docs/gi.md).

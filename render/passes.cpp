@@ -478,9 +478,8 @@ class PhotonPass final : public Pass {
     const GLint radius_uniform = program.uniform(multi, "u_radius");
     // The buffer holds the drawn share of each map (gi.display_fraction),
     // its power already scaled, clustered (gi.cluster): all of it is drawn.
-    const GLsizei split_all = ctx.resources.photon_caustic_first();
-    const GLsizei split = split_all;
-    const GLsizei caustic = ctx.resources.photon_count() - split_all;
+    const GLsizei split = ctx.resources.photon_caustic_first();
+    const GLsizei caustic = ctx.resources.photon_count() - split;
     glUniform1f(program.uniform(multi, "u_power_scale"), 1.0f);
     const float caustic_radius = static_cast<float>(ctx.resources.caustic_radius());
     for_each_view_offset(ctx, self, program, "u_photon_offset", ctx.resources.photon_anchor(), [&] {
@@ -490,7 +489,7 @@ class PhotonPass final : public Pass {
         glDrawArraysInstanced(GL_TRIANGLES, 0, 6, split);
       }
       if (caustic > 0) {
-        glUniform1i(first_uniform, split_all);
+        glUniform1i(first_uniform, split);
         glUniform1f(radius_uniform, caustic_radius);
         glDrawArraysInstanced(GL_TRIANGLES, 0, 6, caustic);
       }

@@ -275,14 +275,9 @@ void SceneResources::upload_photons(PhotonCache& cache, bool skip_direct) {
   const SplatRadii radii = splat_radii(scene_, scene_.gi.display_fraction);
   photon_radius_ = radii.global;
   caustic_radius_ = radii.caustic;
-  const std::shared_ptr<const SplatDiskSet> set =
-      cache.disks(maps_, {skip_direct, display_share(scene_.gi.display_fraction), photon_radius_,
-                          caustic_radius_, scene_.gi.cluster});
-  photon_anchor_ = set->anchor;
-  photon_caustic_first_ = static_cast<GLsizei>(set->caustic_first);
-  photons_kept_ = set->photons;
-  const std::vector<SplatDisk>& data = set->disks;
-  photon_count_ = static_cast<GLsizei>(data.size());
+  disks_ = cache.disks(maps_, {skip_direct, display_share(scene_.gi.display_fraction),
+                               photon_radius_, caustic_radius_, scene_.gi.cluster});
+  const std::vector<SplatDisk>& data = disks_->disks;
   if (!data.empty()) {
     GLuint id = 0;
     glCreateBuffers(1, &id);

@@ -77,13 +77,17 @@ class SceneResources {
   // Disks in photon_buffer() (the drawn share of the maps, clustered by
   // gi.cluster), and the photons they hold (both maps, without those
   // straight from the lights when the direct pass carries direct light).
-  GLsizei photon_count() const { return photon_count_; }
-  std::int64_t photons_kept() const { return photons_kept_; }
-  const Vec3& photon_anchor() const { return photon_anchor_; }
+  GLsizei photon_count() const {
+    return disks_ ? static_cast<GLsizei>(disks_->disks.size()) : 0;
+  }
+  std::int64_t photons_kept() const { return disks_ ? disks_->photons : 0; }
+  const Vec3& photon_anchor() const { return disks_ ? disks_->anchor : kOrigin; }
   double photon_radius() const { return photon_radius_; }
   // The photon buffer holds the global map's photons, then from this index
   // the caustic map's, splatted with caustic_radius().
-  GLsizei photon_caustic_first() const { return photon_caustic_first_; }
+  GLsizei photon_caustic_first() const {
+    return disks_ ? static_cast<GLsizei>(disks_->caustic_first) : 0;
+  }
   double caustic_radius() const { return caustic_radius_; }
   // Volume photons (group "volume_photons": the medium's scattering events of
   // the global map), positions relative to volume_anchor(), the photon's
@@ -148,11 +152,9 @@ class SceneResources {
   std::string shadow_key_;
   std::shared_ptr<const PhotonMaps> maps_;
   GlBuffer photon_ssbo_;
-  GLsizei photon_count_ = 0;
-  std::int64_t photons_kept_ = 0;
-  Vec3 photon_anchor_{};
+  static constexpr Vec3 kOrigin{0.0, 0.0, 0.0};
+  std::shared_ptr<const SplatDiskSet> disks_;  // what photon_ssbo_ holds (cached with the maps)
   double photon_radius_ = 1.0;
-  GLsizei photon_caustic_first_ = 0;
   double caustic_radius_ = 1.0;
   double photon_trace_ms_ = 0.0;
   double photon_upload_ms_ = 0.0;
