@@ -99,6 +99,11 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
+std::string python_interpreter() {
+  const char* env = std::getenv("BEAMCAST_PYTHON");
+  return env != nullptr && *env != '\0' ? std::string(env) : std::string("/usr/bin/python3");
+}
+
 const char* csv_header() {
   return "scene,method,layout,filter,table_size,samples,rule,gpu_ms,beam_gpu_ms,wall_ms,repeats,"
          "max_abs,rms,rel_l1,psnr_db,nonfinite";
@@ -227,7 +232,7 @@ void write_summary(const std::filesystem::path& file, const std::vector<Accuracy
 
 std::string run_plot_script(const std::filesystem::path& csv,
                             const std::filesystem::path& out_dir) {
-  const std::filesystem::path python = "/usr/bin/python3";
+  const std::filesystem::path python = python_interpreter();
   const std::filesystem::path script =
       find_data_dir("bench") / "plot_accuracy.py";
   if (!std::filesystem::exists(python)) return "no " + python.string();

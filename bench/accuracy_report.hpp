@@ -41,10 +41,14 @@ const char* csv_header();
 void write_csv(const std::filesystem::path& file, const std::vector<AccuracyRow>& rows);
 void write_summary(const std::filesystem::path& file, const std::vector<AccuracyRow>& rows,
                    const std::vector<BenchScene>& scenes, const RunInfo& info);
-// Runs /usr/bin/python3 bench/plot_accuracy.py CSV OUT_DIR. Returns an empty
+// Runs bench/plot_accuracy.py CSV OUT_DIR with python_interpreter(). Returns an empty
 // string on success, else one line saying why there are no plots.
 std::string run_plot_script(const std::filesystem::path& csv, const std::filesystem::path& out_dir);
 // `s` as one POSIX shell word (single quotes).
 std::string shell_quote(const std::string& s);
+// The Python that runs the bench scripts and plots: $BEAMCAST_PYTHON where
+// set (a machine whose numpy and matplotlib live in another interpreter, e.g.
+// a virtual environment), else /usr/bin/python3 (Debian's, as README installs).
+std::string python_interpreter();
 
 }  // namespace beamcast::bench

@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench/accuracy_report.hpp"
 #include "client/client.hpp"
 #include "protocol/data_dir.hpp"
 #include "protocol/rigs.hpp"
@@ -183,9 +184,9 @@ Row renderer_run(Renderer& renderer, const Scene& scene, const std::vector<Camer
 
 std::string run_plot(const fs::path& out) {
   const fs::path script = find_data_dir("bench") / "plot_views.py";
-  const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" +
-                          (out / "views.csv").string() + "' '" + (out / "views.png").string() +
-                          "'";
+  const std::string cmd = shell_quote(python_interpreter()) + " " + shell_quote(script.string()) +
+                          " " + shell_quote((out / "views.csv").string()) + " " +
+                          shell_quote((out / "views.png").string());
   const int status = std::system(cmd.c_str());
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return "plot_views.py failed";
   return "";

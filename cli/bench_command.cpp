@@ -27,13 +27,14 @@ namespace beamcast::cli {
 
 namespace {
 
-// Runs bench/SCRIPT with /usr/bin/python3, this binary and --out OUT, plus
+// Runs bench/SCRIPT with bench::python_interpreter(), this binary and --out OUT, plus
 // `extra` (already quoted); a failing script fails the command.
 void run_python_bench(const std::string& script_name, const std::string& out,
                       const std::string& extra) {
   const std::filesystem::path script = find_data_dir("bench") / script_name;
   const std::string cmd =
-      "/usr/bin/python3 " + bench::shell_quote(script.string()) + " --binary " +
+      bench::shell_quote(bench::python_interpreter()) + " " + bench::shell_quote(script.string()) +
+      " --binary " +
       bench::shell_quote(std::filesystem::read_symlink("/proc/self/exe").string()) + " --out " +
       bench::shell_quote(out) + extra;
   const int status = std::system(cmd.c_str());

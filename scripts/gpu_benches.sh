@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# The benchmarks to run on a machine with a GPU (docs/performance.md, "On a
+# GPU"), in order of what matters most, each under its own time limit so a
+# short lease still brings back the first ones:
+#
+#   scripts/gpu_benches.sh OUT [DATA]
+#
+# OUT   results: one folder per step, log.txt (each step's command, seconds,
+#       exit status), info.txt (the EGL device path's renderer string)
+# DATA  optional folder with bunny00.bslm, bunny00.off, fandisk.bslm,
+#       fandisk.off (scripts/fetch_cgal_models.sh, then `beamcast slim fit`)
+#       and skull_2.9.inr (scripts/fetch_cgal_volumes.sh); steps that need a
+#       missing file leave it out
+#
+# Environment: BIN (folder of beamcast and beamcast-server; default
+# build/bin), DEADLINE (seconds for the whole run; default 3600),
+# BEAMCAST_PYTHON (the Python with numpy and matplotlib; default
+# /usr/bin/python3). A step over its limit is stopped (exit 124 in log.txt)
+# and the next one runs; `tar` of OUT after each step keeps OUT.tgz current.
+set -uo pipefail
+
+if [ $# -lt 1 ] || [ $# -gt 2 ]; then
+  echo "usage: $0 OUT [DATA]" >&2
+  exit 1
+fi
+out=$1
+data=${2:+$(cd "$2" && pwd)}
+root=$(cd "$(dirname "$0")/.." && pwd)
+bin=${BIN:-$root/build/bin}
+deadline=$((SECONDS + ${DEADLINE:-3600}))
+py=${BEAMCAST_PYTHON:-/usr/bin/python3}
+mkdir -p "$out"
+log=$out/log.txt
+
+# step NAME LIMIT_S COMMAND...: runs COMMAND with its output in OUT/NAME.log,
+# stopped after LIMIT_S or at the deadline, whichever comes first.
+step() {
+  local name=$1 limit=$2
+  shift 2
+  local left=$((deadline - SECONDS - 5))
+  if [ "$left" -lt 15 ]; then
+    echo "$name: skipped (deadline)" >>"$log"
+    return
+  fi
+  [ "$limit" -gt "$left" ] && limit=$left
+  local t0=$SECONDS
+  timeout --kill-after=5 "$limit" "$@" >"$out/$name.log" 2>&1
+  local rc=$?
+  echo "$name: rc $rc, $((SECONDS - t0)) s (limit $limit): $*" >>"$log"
+  tar czf "$out.tgz" -C "$(dirname "$out")" "$(basename "$out")" 2>/dev/null
+}
+
+have() { [ -n "$data" ] && [ -f "$data/$1" ]; }
+
+{
+  date -u
+  nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader 2>/dev/null
+  "$bin/beamcast" info --platform device 2>&1
+} >"$out/info.txt"
+renderer=$("$bin/beamcast" info --platform device 2>/dev/null | head -1)
+echo "renderer: $renderer" >>"$log"
+
+slim_pairs=()
+slim_args=()
+for m in bunny00 fandisk; do
+  if have "$m.bslm" && have "$m.off"; then
+    slim_pairs+=("$m.bslm:$m.off")
+    slim_args+=(--model "$data/$m.bslm" --mesh "$data/$m.off")
+  fi
+done
+frame_args=()
+[ ${#slim_pairs[@]} -gt 0 ] && frame_args=(--assets "$data" --slim "${slim_pairs[@]}")
+skull_args=()
+have skull_2.9.inr && skull_args=(--skull "$data/skull_2.9.inr")
+
+step frames 150 "$py" "$root/bench/frame_times.py" --out "$out/frames" --server "$bin/beamcast-server" \
+  --sizes 512 2048 --info "$renderer" "${frame_args[@]}"
+step accuracy_512 150 "$bin/beamcast" bench accuracy --size 512 --out "$out/accuracy_512"
+step views_512 90 "$bin/beamcast" bench views --size 512 --out "$out/views_512"
+step slim_512 90 "$bin/beamcast" bench slim --size 512 --out "$out/slim_512" "${slim_args[@]}"
+step volumes_512 90 "$bin/beamcast" bench volumes --size 512 --out "$out/volumes_512" \
+  "${skull_args[@]}"
+step gi_512 120 "$bin/beamcast" bench gi --size 512 --spp 256 --out "$out/gi_512"
+step views_2048 90 "$bin/beamcast" bench views --size 2048 -k 1 -k 4 -k 16 --rounds 2 --out "$out/views_2048"
+step accuracy_2048 120 "$bin/beamcast" bench accuracy --size 2048 --out "$out/accuracy_2048" \
+  --scene paper_10sets --scene grazing_capsule --scene beams_1000 --scene density_gaussian
+step slim_2048 90 "$bin/beamcast" bench slim --size 2048 --zoom-only --zoom 1 --zoom 4 \
+  --out "$out/slim_2048" "${slim_args[@]}"
+step volumes_2048 90 "$bin/beamcast" bench volumes --size 2048 --reference-spv 2 \
+  --out "$out/volumes_2048" "${skull_args[@]}"
+step medium_512 60 "$bin/beamcast" bench medium --size 512 --out "$out/medium_512"
+echo "done: $((SECONDS)) s" >>"$log"
+tar czf "$out.tgz" -C "$(dirname "$out")" "$(basename "$out")" 2>/dev/null
+exit 0
