@@ -236,10 +236,17 @@ def main():
                  for k in (4, 64)]
     settings += [("direct", mid, "epanechnikov", 1.0, {"shadow_size": k}, f"shadow {k}")
                  for k in (128, 512)]
-    # The splats' edge correction off, and splatting at 1/2 and 1/4 size.
+    # Every point at every pixel (the default shares a quad's points out
+    # over a 2 x 2 pattern, gi.direct_interleave 4).
+    settings += [("direct", mid, "epanechnikov", 1.0, {"direct_interleave": 1}, "not interleaved")]
+    # The splats' edge correction off, and splatting at 1/2, 1/4 and 1/8 size
+    # (the default, 0, is 1/8 from 512 pixels a side up, else 1/4).
     settings += [("splat", mid, "epanechnikov", 1.0, {"edge_correction": False}, "no edge corr.")]
     settings += [("splat", mid, "epanechnikov", 1.0, {"splat_scale": k}, f"splat 1/{k}")
-                 for k in (2, 8)]
+                 for k in (2, 4, 8)]
+    # The defaults before 2026-11-26 (third session): no interleave, splat 1/4.
+    settings += [("direct", mid, "epanechnikov", 1.0, {"direct_interleave": 1, "splat_scale": 4},
+                  "earlier default")]
     # Photons merged into disks (gi.cluster; default 0.35): none, finer, coarser.
     settings += [("cluster", mid, "epanechnikov", 1.0, {"cluster": c}, f"cluster {c}")
                  for c in (0.0, 0.25, 0.5)]
@@ -292,9 +299,18 @@ def main():
 
     # The default frame as the preview gets it, one camera per request.
     server = os.path.join(os.path.dirname(a.binary), "beamcast-server")
-    rate = frame_rate(server, dict(base, cameras=[dict(cam, name="v")])) if os.path.exists(server) else None
-    if rate:
-        print("camera-only change, one camera per request: " + json.dumps(rate), flush=True)
+    # And against the defaults before 2026-11-26's third session (every direct
+    # point at every pixel, splat 1/4), alternately in 3 rounds: new/old per round.
+    rate, old_ratio = None, []
+    if os.path.exists(server):
+        one = dict(base, cameras=[dict(cam, name="v")])
+        old = dict(one, gi=dict(base.get("gi", {}), direct_interleave=1, splat_scale=4))
+        for _ in range(3):
+            r_new, r_old = frame_rate(server, one), frame_rate(server, old)
+            old_ratio.append(round(r_new["render_ms"] / r_old["render_ms"], 3))
+            rate = r_new if rate is None or r_new["render_ms"] < rate["render_ms"] else rate
+        print("camera-only change, one camera per request: " + json.dumps(rate) +
+              f"; new/old per round {old_ratio}", flush=True)
 
     # The path tracer itself at a few sample counts (another seed than the
     # reference's): its time to reach a given error, against the photons'.
@@ -331,7 +347,9 @@ def main():
                     f"beamcast-server (maps cached; median of 12): render {rate['render_ms']} ms "
                     f"(**{rate['frames_per_s']} frames/s**; photon upload {rate['upload_ms']} ms, "
                     f"GPU {rate['gpu_ms']} ms: " +
-                    ", ".join(f"{k} {v}" for k, v in rate["passes"].items()) + " ms).\n\n")
+                    ", ".join(f"{k} {v}" for k, v in rate["passes"].items()) + " ms; the fastest "
+                    "of 3 rounds). Its render time over the earlier defaults' (gi.direct_interleave "
+                    f"1, splat_scale 4), round by round, alternately: {old_ratio}.\n\n")
         cols = list(rows[0].keys())
         f.write("| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n")
         for r in rows:

@@ -83,6 +83,12 @@ struct GiSettings {
   int max_depth = 16;  // bounces a photon may take
   DirectLightMethod direct = DirectLightMethod::kShadowMaps;
   int direct_samples = 16;  // points per area light in the direct pass
+  // 4: the points of each light with a multiple of 4 of them are shared out
+  // over a 2 x 2 pixel pattern (each pixel a quarter of them, at 4 times
+  // the weight) and a 3 x 3 surface-aware filter gives every pixel all four
+  // quarters (passes direct and direct_filter; interleaved sampling): the
+  // direct pass's point loop costs a quarter. 1: every pixel every point.
+  int direct_interleave = 4;
   int shadow_size = 256;    // texels per cube-map face of a direct point's shadow map
   // Divide each pixel's photon estimate by the share of its disk on its own
   // surface (the splats' edge bias at corners and edges; pass gi_resolve).
@@ -101,8 +107,10 @@ struct GiSettings {
   // Cornell box 2 costs no error over 1 at 0.5x the frame time, and
   // with the default radius (four times the area of its disks before
   // 2026-11-26) 4 costs 0.05% of the image's error at 0.4x the time of 2
-  // (docs/gi.md).
-  int splat_scale = 4;
+  // (docs/gi.md). 0 (the default): 8 from 512 render pixels a side up, else
+  // 4 (render/passes.hpp, auto_splat_scale; at 512^2 8 costs 0.03% of the
+  // image's error at 0.8x the frame time of 4).
+  int splat_scale = 0;
   // Photons merged before splatting (gi/photon_clusters.hpp): per cell of
   // side cluster x the radius, normal bin and plane, one disk at their
   // centroid carrying their power; 0: one disk per photon. The splats' fill

@@ -300,7 +300,8 @@ void check_shadow_budget(const Scene& scene, const SceneLimits& limits, const st
 GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "gi settings");
   o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth", "direct",
-                "direct_samples", "shadow_size", "edge_correction", "splat_scale", "cluster",
+                "direct_samples", "direct_interleave", "shadow_size", "edge_correction",
+                "splat_scale", "cluster",
                 "light_antialias", "caustic_radius", "specular_samples", "lod"});
   GiSettings g;
   std::int64_t total = 0;
@@ -358,10 +359,19 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
         *v, {{"shadow_maps", DirectLightMethod::kShadowMaps}, {"photons", DirectLightMethod::kPhotons}});
   }
   if (auto v = o.optional("direct_samples")) g.direct_samples = read_int_in(*v, 1, 256);
+  if (auto v = o.optional("direct_interleave")) {
+    const std::int64_t k = read_integer(*v);
+    if (k != 1 && k != 4) {
+      fail("out_of_range", v->path,
+           "direct_interleave must be 1 (every point at every pixel) or 4 (a 2 x 2 pattern), got " +
+               std::to_string(k));
+    }
+    g.direct_interleave = static_cast<int>(k);
+  }
   if (auto v = o.optional("shadow_size")) g.shadow_size = read_int_in(*v, 16, 2048);
   if (auto v = o.optional("edge_correction")) g.edge_correction = read_bool(*v);
   if (auto v = o.optional("light_antialias")) g.light_antialias = read_bool(*v);
-  if (auto v = o.optional("splat_scale")) g.splat_scale = read_int_in(*v, 1, 8);
+  if (auto v = o.optional("splat_scale")) g.splat_scale = read_int_in(*v, 0, 8);
   if (auto v = o.optional("cluster")) g.cluster = check_closed(*v, read_number(*v), 0.0, 1.0);
   if (auto v = o.optional("specular_samples")) g.specular_samples = read_int_in(*v, 1, 8);
   if (auto v = o.optional("lod")) {

@@ -16,6 +16,19 @@ bool contains(const std::vector<T>& v, std::string_view s) {
 
 }  // namespace
 
+bool interleaves_direct_points(const GiSettings& gi, std::size_t points) {
+  return gi.direct_interleave == 4 && points > 0 && points % 4 == 0;
+}
+
+bool interleaves_direct(const Scene& scene) {
+  return std::any_of(scene.lights.begin(), scene.lights.end(), [&](const Light& l) {
+    const std::size_t n = std::visit(
+        [&](const auto& kind) { return kind.direct_points(scene.gi.direct_samples).size(); },
+        l.shape);
+    return interleaves_direct_points(scene.gi, n);
+  });
+}
+
 const std::vector<TargetDecl>& target_catalog() {
   static const std::vector<TargetDecl> kTargets = {
       {"hdr", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kBackground},
@@ -55,6 +68,10 @@ const std::vector<TargetDecl>& target_catalog() {
       // over the volumes, so cleared to one.
       {"volume_t0", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kOne},
       {"volume_t1", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kOne},
+      // The interleaved direct points' irradiance, each pixel's quarter at 4
+      // times the weight (w: 1 where a diffuse surface was lit), before the
+      // direct_filter pass brings the four quarters together.
+      {"direct_split", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       // What mirror and glass pixels show, found on the CPU (render/specular_pass.hpp).
       {"specular", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
   };
@@ -107,9 +124,26 @@ const std::vector<PassDecl>& pass_catalog() {
       {PassId::kDirect, "direct",
        [](const PlanInput& in) {
          return !in.scene.occluders.empty() && in.scene.has_gi() &&
-                in.scene.gi.direct == DirectLightMethod::kShadowMaps;
+                in.scene.gi.direct == DirectLightMethod::kShadowMaps && !interleaves_direct(in.scene);
        },
        {"hdr", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {"shadows"}},
+      // The same with gi.direct_interleave 4 (interleaved sampling): each
+      // pixel sums a quarter of each interleaved light's points (by its
+      // place in a 2 x 2 pattern) into direct_split, the other lights' points
+      // into hdr as above; direct_filter then averages the four quarters
+      // over each pixel's 3 x 3 neighbours on its own surface.
+      {PassId::kDirectSplit, "direct",
+       [](const PlanInput& in) {
+         return !in.scene.occluders.empty() && in.scene.has_gi() &&
+                in.scene.gi.direct == DirectLightMethod::kShadowMaps && interleaves_direct(in.scene);
+       },
+       {"hdr", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr", "direct_split"}, {"shadows"}},
+      {PassId::kDirectFilter, "direct_filter",
+       [](const PlanInput& in) {
+         return !in.scene.occluders.empty() && in.scene.has_gi() &&
+                in.scene.gi.direct == DirectLightMethod::kShadowMaps && interleaves_direct(in.scene);
+       },
+       {"hdr", "direct_split", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {}},
       // Photon splatting (seed 001, section 4.2): one camera-facing disk per
       // photon adds its reflected radiance to the G-buffer's pixels within
       // the radius (without the photons straight from a light when the

@@ -16,6 +16,13 @@
 
 namespace beamcast {
 
+// True if a light with `points` direct points has them shared out over the
+// 2 x 2 pixel pattern (gi.direct_interleave 4 and a nonzero multiple of 4).
+bool interleaves_direct_points(const GiSettings& gi, std::size_t points);
+// True if any light of the scene does (passes direct with the split target,
+// and direct_filter).
+bool interleaves_direct(const Scene& scene);
+
 // Every pass the renderer can execute. The executor of each is made by
 // make_pass (render/passes.cpp), whose switch over this enum has no default:
 // a new id without an executor does not compile (-Wswitch) and fails the
@@ -28,6 +35,8 @@ enum class PassId {
   kSlimResolve,
   kSlimGbuffer,
   kDirect,
+  kDirectSplit,
+  kDirectFilter,
   kPhotons,
   kGiResolve,
   kSpecular,
@@ -39,7 +48,7 @@ enum class PassId {
   kTonemap,
   kUpscale
 };
-inline constexpr std::size_t kPassCount = 17;
+inline constexpr std::size_t kPassCount = 19;
 
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {
@@ -101,7 +110,7 @@ struct FramePlan {
   std::vector<const TargetDecl*> targets;  // read or written by a planned pass, allocated
   std::vector<std::string> uploads;        // union of the planned passes' uploads
   std::string final_target;                // the last pass's first write: what is read back
-  int splat_scale = 1;  // kSplat targets' divisor: the scene's gi.splat_scale
+  int splat_scale = 1;  // kSplat targets' divisor: the scene's gi.splat_scale (0: auto_splat_scale)
 
   // True if a planned pass (not just the frame-start clear) writes `target`.
   bool written(std::string_view target) const;

@@ -37,9 +37,11 @@ GLenum internal_format(TargetFormat f, int bits) {
 
 void FrameTargets::ensure(const FramePlan& plan, int render_w, int render_h, int camera_w,
                           int camera_h, int bits, int layer_count) {
+  const int splat_scale =
+      plan.splat_scale > 0 ? plan.splat_scale : auto_splat_scale(render_w, render_h);
   if (render_w != render_w_ || render_h != render_h_ || camera_w != camera_w_ ||
       camera_h != camera_h_ || bits != bits_ || layer_count != layers_ ||
-      plan.splat_scale != splat_scale_) {
+      splat_scale != splat_scale_) {
     targets_.clear();
     for (PassFbos& f : fbos_) f = PassFbos{};
     render_w_ = render_w;
@@ -48,7 +50,7 @@ void FrameTargets::ensure(const FramePlan& plan, int render_w, int render_h, int
     camera_h_ = camera_h;
     bits_ = bits;
     layers_ = layer_count;
-    splat_scale_ = plan.splat_scale;
+    splat_scale_ = splat_scale;
   }
   for (const TargetDecl* decl : plan.targets) {
     if (find(decl->name)) continue;
@@ -56,8 +58,8 @@ void FrameTargets::ensure(const FramePlan& plan, int render_w, int render_h, int
     int w = camera_size ? camera_w : render_w;
     int h = camera_size ? camera_h : render_h;
     if (decl->size == TargetSize::kSplat) {
-      w = splat_size(render_w, plan.splat_scale);
-      h = splat_size(render_h, plan.splat_scale);
+      w = splat_size(render_w, splat_scale);
+      h = splat_size(render_h, splat_scale);
     }
     const GLenum format = internal_format(decl->format, bits);
     Target t{decl, {}};
@@ -254,6 +256,9 @@ class DirectPass final : public Pass {
     ProgramPair& program = lean ? lean_ : programs_.get(ctx.scene);
     glUseProgram(program.get(multi));
     glUniform1i(program.uniform(multi, "u_point_count"), count);
+    // With the split target (kDirectSplit) the interleaved points go there.
+    const bool split = self.id == PassId::kDirectSplit;
+    glUniform1i(program.uniform(multi, "u_interleaved"), split ? res.direct_interleaved() : 0);
     glUniform1f(program.uniform(multi, "u_far"), far_);
     glUniform1f(program.uniform(multi, "u_texel"), 2.0f / static_cast<float>(size_));
     const GLint region_eye = set_medium_uniforms(program, multi, ctx);
@@ -268,6 +273,7 @@ class DirectPass final : public Pass {
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
     glBlendEquation(GL_FUNC_ADD);
+    if (split) glDisablei(GL_BLEND, 1);  // direct_split is written, not added to
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glBindVertexArray(ctx.empty_vao);
@@ -355,6 +361,36 @@ class DirectPass final : public Pass {
   float far_ = 1.0f;
 };
 
+// The interleaved direct points' four quarters brought together
+// (shaders/direct_filter.frag): at each lit diffuse pixel, the mean over the
+// pattern's four classes of each class's tent-weighted (1 2 1) mean over the
+// 3 x 3 neighbours on the pixel's own surface, times albedo / pi, into hdr.
+class DirectFilterPass final : public Pass {
+ public:
+  DirectFilterPass() : program_("direct_filter") {}
+  void execute(FrameContext& ctx, const PassDecl& self) override {
+    if (ctx.resources.direct_interleaved() == 0) return;
+    const bool multi = ctx.views > 0;
+    glUseProgram(program_.get(multi));
+    glBindTextureUnit(0, ctx.targets.texture("view_depth"));
+    glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
+    glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
+    glBindTextureUnit(3, ctx.targets.texture("direct_split"));
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glBindVertexArray(ctx.empty_vao);
+    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    glDisable(GL_BLEND);
+    gl_check("direct_filter pass");
+  }
+
+ private:
+  ProgramPair program_;
+};
+
 // The photon splats' tests (shaders/photon_splat.frag, gi_resolve.frag; the
 // CPU's SplatTests): a photon lights a surface point whose normal is within
 // 25 degrees of its own (curved surfaces turn within a radius; a thin wall's
@@ -382,7 +418,7 @@ class GiResolvePass final : public Pass {
     glUniform1f(program.uniform(multi, "u_max_plane"), kSplatMaxPlane);
     set_photon_lod(program, multi, ctx.scene.gi);
     glUniform1i(program.uniform(multi, "u_correct"), ctx.scene.gi.edge_correction ? 1 : 0);
-    glUniform1i(program.uniform(multi, "u_splat_scale"), ctx.plan.splat_scale);
+    glUniform1i(program.uniform(multi, "u_splat_scale"), ctx.targets.splat_scale());
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
     glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
@@ -454,7 +490,7 @@ class PhotonPass final : public Pass {
     glDisable(GL_CULL_FACE);
     glBindVertexArray(ctx.empty_vao);
     // Splatted at the kSplat size: the viewport shrinks for this pass.
-    const int scale = ctx.plan.splat_scale;
+    const int scale = ctx.targets.splat_scale();
     glUniform1i(program.uniform(multi, "u_splat_scale"), scale);
     GLint viewport[4];
     glGetIntegerv(GL_VIEWPORT, viewport);
@@ -701,7 +737,10 @@ std::unique_ptr<Pass> make_pass(PassId id) {
     case PassId::kSlimGbuffer:
       return make_slim_pass(id);
     case PassId::kDirect:
+    case PassId::kDirectSplit:
       return std::make_unique<DirectPass>();
+    case PassId::kDirectFilter:
+      return std::make_unique<DirectFilterPass>();
     case PassId::kPhotons:
       return std::make_unique<PhotonPass>();
     case PassId::kGiResolve:

@@ -345,13 +345,18 @@ void SceneResources::upload_volume_photons(PhotonCache& cache) {
 
 void SceneResources::upload_direct() {
   Aabb box;
-  for (const Light& l : scene_.lights) {
-    std::vector<DirectPoint> points = std::visit(
-        [&](const auto& kind) { return kind.direct_points(scene_.gi.direct_samples); }, l.shape);
-    for (DirectPoint& p : points) {
-      box.grow(p.position);
-      direct_points_.push_back(p);
-      direct_flux_.push_back(l.flux);
+  // Interleaved lights' points first (direct_interleaved()), then the others.
+  for (const bool first : {true, false}) {
+    for (const Light& l : scene_.lights) {
+      std::vector<DirectPoint> points = std::visit(
+          [&](const auto& kind) { return kind.direct_points(scene_.gi.direct_samples); }, l.shape);
+      if (interleaves_direct_points(scene_.gi, points.size()) != first) continue;
+      for (DirectPoint& p : points) {
+        box.grow(p.position);
+        direct_points_.push_back(p);
+        direct_flux_.push_back(l.flux);
+      }
+      if (first) direct_interleaved_ += static_cast<int>(points.size());
     }
   }
   direct_anchor_ = box.empty() ? Vec3{0.0, 0.0, 0.0} : box.centre();
@@ -382,8 +387,10 @@ void SceneResources::upload_direct() {
     glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(PointData)), data.data(),
                          0);
   }
+  // The interleave orders the points, and each point has its shadow map.
   shadow_key_ = photon_key(scene_) + "|" + std::to_string(scene_.gi.direct_samples) + "|" +
-                std::to_string(scene_.gi.shadow_size);
+                std::to_string(scene_.gi.shadow_size) + "|" +
+                std::to_string(scene_.gi.direct_interleave);
   gl_check("upload direct points");
 }
 

@@ -102,6 +102,10 @@ class SceneResources {
   GLuint direct_buffer() const { return direct_ssbo_.get(); }
   const std::vector<DirectPoint>& direct_points() const { return direct_points_; }
   const Vec3& direct_anchor() const { return direct_anchor_; }
+  // The first direct_interleaved() points (a multiple of 4: the lights with a
+  // multiple of 4 points, with gi.direct_interleave 4) are shared out over
+  // the 2 x 2 pixel pattern; the rest are summed at every pixel.
+  int direct_interleaved() const { return direct_interleaved_; }
   const std::string& shadow_key() const { return shadow_key_; }
   // The triangle vertices' anchor (positions in triangle_vao() are relative to it).
   const Vec3& mesh_anchor() const { return mesh_anchor_; }
@@ -148,6 +152,7 @@ class SceneResources {
   void upload_medium_meshes();
   std::vector<DirectPoint> direct_points_;
   std::vector<Color> direct_flux_;  // each point's light's flux
+  int direct_interleaved_ = 0;
   Vec3 direct_anchor_{};
   std::string shadow_key_;
   std::shared_ptr<const PhotonMaps> maps_;

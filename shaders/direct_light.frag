@@ -1,5 +1,7 @@
 // Direct light of a lit scene (pass "direct", gi.direct "shadow_maps"): each
-// light is a few point emitters (DirectPoint in protocol/lights/light_base.hpp);
+// light is a few point emitters (DirectPoint in protocol/lights/light_base.hpp;
+// with gi.direct_interleave 4, each pixel a quarter of an interleaved light's
+// points, the rest in pass direct_filter);
 // a diffuse G-buffer point x with normal n (facing the camera) reflects
 //   L = albedo / pi * sum_i flux_i * angular_i(c) * max(0, n.l) * V_i / d^2,
 // V_i from point i's cube shadow map of the triangles (distance compared,
@@ -21,11 +23,13 @@ layout(binding = 2) uniform VIEW_SAMPLER u_gb_albedo;
 layout(binding = 3) uniform samplerCubeArrayShadow u_shadows;
 uniform vec3 u_point_offset;  // direct anchor minus eye
 uniform int u_point_count;
+uniform int u_interleaved;  // points [0, u_interleaved) are split over the 2 x 2 pattern (0: none)
 uniform float u_far;    // shadow-map distances are stored over this
 uniform float u_texel;  // a texel's angular size at a face centre (2 / size)
 uniform float u_sigma_t;  // a medium's extinction: the light is attenuated on its way (0: none)
 
 layout(location = 0) out vec4 out_color;
+layout(location = 1) out vec4 out_split;  // direct_split (pass direct with the split target)
 
 const float kPi = 3.14159265358979;
 
@@ -53,6 +57,46 @@ bool analytic_blocked(vec3 o, vec3 d, float len) {
   return false;
 }
 
+// What point i gives x (normal n): flux x angular x cos / d^2 x visibility
+// (x transmittance), or zero.
+vec3 point_light(int i, vec3 x, vec3 n) {
+  DirectPoint p = points[i];
+  vec3 to = p.position.xyz + u_point_offset - x;
+  float d2 = dot(to, to);
+  float dist = sqrt(d2);
+  vec3 l = to / dist;
+  float cos_x = dot(n, l);
+  if (cos_x <= 0.0) return vec3(0.0);
+  float c = -dot(p.axis.xyz, l);
+  int mode = int(p.position.w + 0.5);
+  float angular = 1.0;
+  if (mode == 1) {
+    angular = max(c, 0.0);
+  } else if (mode == 2) {
+    angular = c >= p.flux.w ? 1.0 : (c <= p.axis.w ? 0.0 : smoothstep(p.axis.w, p.flux.w, c));
+  }
+  if (angular <= 0.0) return vec3(0.0);
+  // Normal-offset lookup: x moved off its surface by about a texel's
+  // footprint (more where the light grazes it), compared half a texel
+  // short, so a lit surface does not shadow itself (acne).
+  float foot = dist * u_texel;
+  float sin_x = sqrt(max(0.0, 1.0 - cos_x * cos_x));
+  vec3 v = x + (foot * (0.5 + 1.5 * sin_x)) * n - (p.position.xyz + u_point_offset);
+  float visible = texture(u_shadows, vec4(v, float(i)), (length(v) - 0.5 * foot) / u_far);
+  if (visible <= 0.0) return vec3(0.0);
+#ifdef BEAMCAST_DIRECT_LEAN
+  return p.flux.rgb * (angular * cos_x * visible / d2);
+#else
+  if (u_count > 0 && analytic_blocked(x + (1e-4 * dist) * n, l, dist)) return vec3(0.0);
+#ifdef BEAMCAST_MEDIUM_REGIONS
+  float transmitted = exp(-(u_sigma_t * dist + region_depth(x, l, 0.0, dist)));
+#else
+  float transmitted = u_sigma_t > 0.0 ? exp(-u_sigma_t * dist) : 1.0;
+#endif
+  return p.flux.rgb * (angular * cos_x * visible * transmitted / d2);
+#endif
+}
+
 void main() {
   select_view(view_index());
   ivec2 px = ivec2(gl_FragCoord.xy);
@@ -63,43 +107,14 @@ void main() {
   vec3 n = VIEW_TEXEL(u_gb_normal, px).xyz;
   ViewRay ray = view_ray(gl_FragCoord.xy);
   vec3 x = ray.origin + (z / ray.cos_axis) * ray.dir;
-  vec3 e = vec3(0.0);
-  for (int i = 0; i < u_point_count; ++i) {
-    DirectPoint p = points[i];
-    vec3 to = p.position.xyz + u_point_offset - x;
-    float d2 = dot(to, to);
-    float dist = sqrt(d2);
-    vec3 l = to / dist;
-    float cos_x = dot(n, l);
-    if (cos_x <= 0.0) continue;
-    float c = -dot(p.axis.xyz, l);
-    int mode = int(p.position.w + 0.5);
-    float angular = 1.0;
-    if (mode == 1) {
-      angular = max(c, 0.0);
-    } else if (mode == 2) {
-      angular = c >= p.flux.w ? 1.0 : (c <= p.axis.w ? 0.0 : smoothstep(p.axis.w, p.flux.w, c));
-    }
-    if (angular <= 0.0) continue;
-    // Normal-offset lookup: x moved off its surface by about a texel's
-    // footprint (more where the light grazes it), compared half a texel
-    // short, so a lit surface does not shadow itself (acne).
-    float foot = dist * u_texel;
-    float sin_x = sqrt(max(0.0, 1.0 - cos_x * cos_x));
-    vec3 v = x + (foot * (0.5 + 1.5 * sin_x)) * n - (p.position.xyz + u_point_offset);
-    float visible = texture(u_shadows, vec4(v, float(i)), (length(v) - 0.5 * foot) / u_far);
-    if (visible <= 0.0) continue;
-#ifdef BEAMCAST_DIRECT_LEAN
-    e += p.flux.rgb * (angular * cos_x * visible / d2);
-#else
-    if (u_count > 0 && analytic_blocked(x + (1e-4 * dist) * n, l, dist)) continue;
-#ifdef BEAMCAST_MEDIUM_REGIONS
-    float transmitted = exp(-(u_sigma_t * dist + region_depth(x, l, 0.0, dist)));
-#else
-    float transmitted = u_sigma_t > 0.0 ? exp(-u_sigma_t * dist) : 1.0;
-#endif
-    e += p.flux.rgb * (angular * cos_x * visible * transmitted / d2);
-#endif
+  // Interleaved points: this pixel's quarter (its place in the 2 x 2
+  // pattern) at 4 times the weight, into direct_split for direct_filter.
+  vec3 split = vec3(0.0);
+  for (int i = (px.x & 1) | ((px.y & 1) << 1); i < u_interleaved; i += 4) {
+    split += point_light(i, x, n);
   }
+  vec3 e = vec3(0.0);
+  for (int i = u_interleaved; i < u_point_count; ++i) e += point_light(i, x, n);
   out_color = vec4(albedo.rgb / kPi * e, 0.0);
+  out_split = vec4(4.0 * split, 1.0);
 }

@@ -25,6 +25,9 @@ struct QuadLight {
   Emission emit(const LightRandom& u) const;
   LightSample sample(const Vec3& x, const LightRandom& u) const;
   std::optional<double> hit(const Vec3& o, const Vec3& v, double t_max) const;
+  // A k_u x k_v grid of cell centres (direct_points), listed 2 x 2 cell by
+  // 2 x 2 cell, so that with both even every fourth point (the direct pass's
+  // interleaved quarters, gi.direct_interleave) spans the whole light.
   std::vector<DirectPoint> direct_points(int samples) const;
   double radiance_scale() const;
 };

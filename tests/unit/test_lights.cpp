@@ -149,6 +149,19 @@ TEST(Lights, BadFieldsAreRefusedWithTheirPath) {
                   "out_of_range", "/gi/cluster");
   EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"cluster", -0.1}}}}),
                   "out_of_range", "/gi/cluster");
+  // The interleave is 1 or 4 (a 2 x 2 pattern), nothing between; 2^32 + 4
+  // must not wrap to 4.
+  for (const json bad : {json(2), json(0), json(4294967300LL)}) {
+    EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"direct_interleave", bad}}}}),
+                    "out_of_range", "/gi/direct_interleave");
+  }
+  EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"direct_interleave", true}}}}),
+                  "wrong_type", "/gi/direct_interleave");
+  EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"splat_scale", 9}}}}),
+                  "out_of_range", "/gi/splat_scale");
+  // 0 is the default, auto (8 from 512 pixels a side, else 4).
+  EXPECT_EQ(parse_scene(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}), {}).gi.splat_scale, 0);
+  EXPECT_EQ(parse_scene(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}), {}).gi.direct_interleave, 4);
 }
 
 TEST(Lights, BadMaterialsAreRefusedWithTheirPath) {

@@ -103,6 +103,10 @@ TEST(PassPlan, EveryCatalogPassIsReachable) {
       }
     }
   }
+  // A quad light's 16 points are interleaved (direct_filter).
+  Scene quad = scene_with(false, true, true);
+  quad.lights[0].shape = QuadLight{};
+  for (const auto& n : make_plan(PlanInput{quad}).names()) seen.push_back(n);
   for (const PassDecl& p : pass_catalog()) {
     EXPECT_NE(std::find(seen.begin(), seen.end(), p.name), seen.end()) << p.name;
     EXPECT_FALSE(p.writes.empty()) << p.name;
@@ -134,6 +138,34 @@ TEST(PassPlan, ReadingATargetNobodyWritesFailsAtPlanTime) {
   const FramePlan plan = make_plan(PlanInput{scene}, catalog, targets);
   EXPECT_EQ(plan.names(), (std::vector<std::string>{"gbuffer", "lighting"}));
   EXPECT_TRUE(plan.uses("gbuffer.normal"));
+}
+
+// gi.direct_interleave 4 (the default) shares out the points of each light
+// with a multiple of 4 of them over the 2 x 2 pixel pattern: a quad light's
+// 16 add the direct_split target and the direct_filter pass after direct; a
+// point light's one point, or direct_interleave 1, does not.
+TEST(PassPlan, QuadLightsInterleaveTheirDirectPoints) {
+  Scene quad = scene_with(false, true, true);
+  quad.lights[0].shape = QuadLight{};
+  EXPECT_TRUE(interleaves_direct(quad));
+  const FramePlan plan = make_plan(PlanInput{quad});
+  EXPECT_EQ(plan.names(), (std::vector<std::string>{"gbuffer", "direct", "direct_filter", "photons",
+                                                    "gi_resolve", "tonemap"}));
+  EXPECT_TRUE(plan.uses("direct_split"));
+  // The quad's points, 2 x 2 cells at a time: every fourth spans the light.
+  const auto points = std::get<QuadLight>(quad.lights[0].shape).direct_points(16);
+  ASSERT_EQ(points.size(), 16u);
+  for (int c = 0; c < 4; ++c) {
+    Aabb box;
+    for (std::size_t i = static_cast<std::size_t>(c); i < points.size(); i += 4) box.grow(points[i].position);
+    EXPECT_NEAR(box.hi[0] - box.lo[0], 0.5, 1e-12) << c;  // cells 1/4 wide: centres 2 cells apart
+    EXPECT_NEAR(box.hi[2] - box.lo[2], 0.5, 1e-12) << c;
+  }
+  quad.gi.direct_interleave = 1;
+  EXPECT_FALSE(interleaves_direct(quad));
+  EXPECT_EQ(make_plan(PlanInput{quad}).names(),
+            (std::vector<std::string>{"gbuffer", "direct", "photons", "gi_resolve", "tonemap"}));
+  EXPECT_FALSE(interleaves_direct(scene_with(false, true, true)));  // a point light
 }
 
 // A lit scene (lights) runs the G-buffer, direct light and photon splatting
