@@ -108,8 +108,8 @@ struct GiSettings {
   // with the default radius (four times the area of its disks before
   // 2026-11-26) 4 costs 0.05% of the image's error at 0.4x the time of 2
   // (docs/gi.md). 0 (the default): 8 from 512 render pixels a side up, else
-  // 4 (render/passes.hpp, auto_splat_scale; at 512^2 8 costs 0.03% of the
-  // image's error at 0.8x the frame time of 4).
+  // 4 (render/passes.hpp, auto_splat_scale; at 512^2 8 costs 0.02% of the
+  // image's error at 0.85x the GPU time of 4).
   int splat_scale = 0;
   // Photons merged before splatting (gi/photon_clusters.hpp): per cell of
   // side cluster x the radius, normal bin and plane, one disk at their

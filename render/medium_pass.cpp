@@ -73,12 +73,7 @@ class VolumePhotonPass final : public Pass {
     set_photon_lod(program, multi, ctx.scene.gi);
     glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, ctx.resources.volume_buffer());
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    glBlendEquation(GL_FUNC_ADD);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_CULL_FACE);
-    glBindVertexArray(ctx.empty_vao);
+    begin_additive(ctx);
     int view = 0;
     for_each_view_offset(ctx, self, program, "u_photon_offset", ctx.resources.volume_anchor(),
                          [&] {

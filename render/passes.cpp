@@ -263,20 +263,13 @@ class DirectPass final : public Pass {
     glUniform1f(program.uniform(multi, "u_texel"), 2.0f / static_cast<float>(size_));
     const GLint region_eye = set_medium_uniforms(program, multi, ctx);
     glUniform1i(program.uniform(multi, "u_count"), res.analytic_count());
-    glBindTextureUnit(0, ctx.targets.texture("view_depth"));
-    glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
-    glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
+    bind_gbuffer(ctx);
     glBindTextureUnit(3, cubes_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, res.direct_buffer());
     if (res.analytic_count() > 0)
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, res.analytic_buffer());
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    glBlendEquation(GL_FUNC_ADD);
+    begin_additive(ctx);
     if (split) glDisablei(GL_BLEND, 1);  // direct_split is written, not added to
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_CULL_FACE);
-    glBindVertexArray(ctx.empty_vao);
     int view = 0;
     for_each_view_offset(ctx, self, program, "u_point_offset", res.direct_anchor(), [&] {
       set_region_eye(ctx, region_eye, view++);
@@ -372,16 +365,9 @@ class DirectFilterPass final : public Pass {
     if (ctx.resources.direct_interleaved() == 0) return;
     const bool multi = ctx.views > 0;
     glUseProgram(program_.get(multi));
-    glBindTextureUnit(0, ctx.targets.texture("view_depth"));
-    glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
-    glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
+    bind_gbuffer(ctx);
     glBindTextureUnit(3, ctx.targets.texture("direct_split"));
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    glBlendEquation(GL_FUNC_ADD);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_CULL_FACE);
-    glBindVertexArray(ctx.empty_vao);
+    begin_additive(ctx);
     for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
     glDisable(GL_BLEND);
     gl_check("direct_filter pass");
@@ -419,15 +405,9 @@ class GiResolvePass final : public Pass {
     set_photon_lod(program, multi, ctx.scene.gi);
     glUniform1i(program.uniform(multi, "u_correct"), ctx.scene.gi.edge_correction ? 1 : 0);
     glUniform1i(program.uniform(multi, "u_splat_scale"), ctx.targets.splat_scale());
-    glBindTextureUnit(0, ctx.targets.texture("view_depth"));
-    glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
-    glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
+    bind_gbuffer(ctx);
     glBindTextureUnit(3, ctx.targets.texture("gi_indirect"));
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    glBlendEquation(GL_FUNC_ADD);
-    glDisable(GL_DEPTH_TEST);
-    glBindVertexArray(ctx.empty_vao);
+    begin_additive(ctx);
     // Quad lights whose outlines are antialiased: corners relative to the
     // first one's (in double, then float).
     std::vector<const Light*> quads;
@@ -479,16 +459,9 @@ class PhotonPass final : public Pass {
     glUniform1f(program.uniform(multi, "u_min_cos"), kSplatMinCos);
     glUniform1f(program.uniform(multi, "u_max_plane"), kSplatMaxPlane);
     set_photon_lod(program, multi, ctx.scene.gi);
-    glBindTextureUnit(0, ctx.targets.texture("view_depth"));
-    glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
-    glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
+    bind_gbuffer(ctx);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, ctx.resources.photon_buffer());
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    glBlendEquation(GL_FUNC_ADD);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_CULL_FACE);
-    glBindVertexArray(ctx.empty_vao);
+    begin_additive(ctx);
     // Splatted at the kSplat size: the viewport shrinks for this pass.
     const int scale = ctx.targets.splat_scale();
     glUniform1i(program.uniform(multi, "u_splat_scale"), scale);
@@ -718,6 +691,21 @@ void set_region_eye(const FrameContext& ctx, GLint location, int view) {
       ctx.views > 0 && view >= 0 ? ctx.view_eyes[static_cast<std::size_t>(view)] : ctx.basis.eye;
   glUniform3f(location, static_cast<float>(eye[0]), static_cast<float>(eye[1]),
               static_cast<float>(eye[2]));
+}
+
+void begin_additive(const FrameContext& ctx) {
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_ONE, GL_ONE);
+  glBlendEquation(GL_FUNC_ADD);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  glBindVertexArray(ctx.empty_vao);
+}
+
+void bind_gbuffer(const FrameContext& ctx) {
+  glBindTextureUnit(0, ctx.targets.texture("view_depth"));
+  glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
+  glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
 }
 
 void set_photon_lod(ProgramPair& program, bool multiview, const GiSettings& gi) {

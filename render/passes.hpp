@@ -97,8 +97,8 @@ inline constexpr int kMaxBatchViews = 64;
 inline int splat_size(int render_size, int scale) { return (render_size + scale - 1) / scale; }
 // gi.splat_scale 0 (the default): 8 from 512 render pixels a side (the
 // smaller side) up, else 4. On the Cornell box at 512^2 8 has 4's error
-// within 0.1% per wall and its frame is about 20% shorter on llvmpipe
-// (docs/gi.md); below 512 the splat grid would fall under 64 texels a side.
+// within 0.1% per wall at 0.85x its GPU time on llvmpipe (docs/gi.md);
+// below 512 the splat grid would fall under 64 texels a side.
 inline int auto_splat_scale(int render_w, int render_h) {
   return std::min(render_w, render_h) >= 512 ? 8 : 4;
 }
@@ -218,6 +218,13 @@ void for_each_view_offset(FrameContext& ctx, const PassDecl& self, ProgramPair& 
 GLint set_medium_uniforms(ProgramPair& program, bool multiview, const FrameContext& ctx);
 // The eye of view `view` (-1 or the only view: ctx.basis.eye) into u_region_eye.
 void set_region_eye(const FrameContext& ctx, GLint location, int view);
+
+// Additive draws into hdr: blending ONE + ONE, no depth test, no culling,
+// and the empty vertex array of full-screen and generated draws bound.
+void begin_additive(const FrameContext& ctx);
+// The G-buffer of lit scenes on texture units 0-2: view_depth, gb_normal,
+// gb_albedo (the binding order of the lighting passes' shaders).
+void bind_gbuffer(const FrameContext& ctx);
 
 // The photon LOD uniforms of shaders/photon_splat.vert (GiSettings::lod_*),
 // for the passes that draw photons with it.

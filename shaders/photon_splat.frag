@@ -35,15 +35,16 @@ void main() {
                  ivec2(cam.viewport.xy) - 1);
   float z = VIEW_TEXEL(u_view_depth, px).r;
   if (z >= 1e29) discard;  // no surface on this pixel
-  vec4 albedo = VIEW_TEXEL(u_gb_albedo, px);
-  if (albedo.w > 0.5) discard;  // mirrors and glass store no photons
-  vec3 n = VIEW_TEXEL(u_gb_normal, px).xyz;
   ViewRay ray = view_ray(vec2(px) + 0.5);
   vec3 x = ray.origin + (z / ray.cos_axis) * ray.dir;
   vec3 d = x - v_center;
   float r2 = u_radius * u_radius;
   float d2 = dot(d, d);
+  // The distance first: most of the quad's fragments end here, before the
+  // normal and material fetches.
   if (d2 >= r2) discard;
+  if (VIEW_TEXEL(u_gb_albedo, px).w > 0.5) discard;  // mirrors and glass store no photons
+  vec3 n = VIEW_TEXEL(u_gb_normal, px).xyz;
   if (dot(n, v_normal) < u_min_cos) discard;
   if (abs(dot(d, n)) > u_max_plane * u_radius) discard;
 #if GI_KERNEL == 0
