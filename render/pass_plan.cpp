@@ -20,6 +20,16 @@ bool interleaves_direct_points(const GiSettings& gi, std::size_t points) {
   return gi.direct_interleave == 4 && points > 0 && points % 4 == 0;
 }
 
+namespace {
+
+// The direct pass runs: occluders to light, lights, gi.direct "shadow_maps".
+bool shadow_mapped_direct(const Scene& scene) {
+  return !scene.occluders.empty() && scene.has_gi() &&
+         scene.gi.direct == DirectLightMethod::kShadowMaps;
+}
+
+}  // namespace
+
 bool interleaves_direct(const Scene& scene) {
   return std::any_of(scene.lights.begin(), scene.lights.end(), [&](const Light& l) {
     const std::size_t n = std::visit(
@@ -123,8 +133,7 @@ const std::vector<PassDecl>& pass_catalog() {
       // the analytic occluders; adds what diffuse surfaces reflect to hdr.
       {PassId::kDirect, "direct",
        [](const PlanInput& in) {
-         return !in.scene.occluders.empty() && in.scene.has_gi() &&
-                in.scene.gi.direct == DirectLightMethod::kShadowMaps && !interleaves_direct(in.scene);
+         return shadow_mapped_direct(in.scene) && !interleaves_direct(in.scene);
        },
        {"hdr", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {"shadows"}},
       // The same with gi.direct_interleave 4 (interleaved sampling): each
@@ -134,14 +143,12 @@ const std::vector<PassDecl>& pass_catalog() {
       // over each pixel's 3 x 3 neighbours on its own surface.
       {PassId::kDirectSplit, "direct",
        [](const PlanInput& in) {
-         return !in.scene.occluders.empty() && in.scene.has_gi() &&
-                in.scene.gi.direct == DirectLightMethod::kShadowMaps && interleaves_direct(in.scene);
+         return shadow_mapped_direct(in.scene) && interleaves_direct(in.scene);
        },
        {"hdr", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr", "direct_split"}, {"shadows"}},
       {PassId::kDirectFilter, "direct_filter",
        [](const PlanInput& in) {
-         return !in.scene.occluders.empty() && in.scene.has_gi() &&
-                in.scene.gi.direct == DirectLightMethod::kShadowMaps && interleaves_direct(in.scene);
+         return shadow_mapped_direct(in.scene) && interleaves_direct(in.scene);
        },
        {"hdr", "direct_split", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {}},
       // Photon splatting (seed 001, section 4.2): one camera-facing disk per
