@@ -8,8 +8,9 @@ scene's first camera is set to SIZE x SIZE and rendered --frames times after
 one warm-up request (which traces photons and uploads volumes; later requests
 reuse them, as a preview does). Reported per row: the medians of the
 server's render_ms (GPU passes, photon upload and read-back; not the PNG
-encode), gpu_ms, read-back and each pass's GPU ms, the warm-up request's
-render_ms, and the passes that ran.
+encode), gpu_ms, readback_ms (the read-back call's wall time, which
+includes waiting for the GPU to finish the frame) and each pass's GPU ms,
+the warm-up request's render_ms, and the passes that ran.
 
   /usr/bin/python3 bench/frame_times.py --out DIR [--sizes 512 2048]
       [--assets DIR --slim bunny00.bslm:bunny00.off ...]
@@ -130,7 +131,8 @@ def write_tables(out, rows, info, frames):
         f.write(f"# Frame time per effect ({info or 'renderer: see beamcast info'})\n\n")
         f.write(f"Medians of {frames} requests after a warm-up request (its render_ms is `first`), "
                 "one camera each, through beamcast-server; render = GPU passes + photon upload + read-back "
-                "(not the PNG encode). Per pass: GPU ms.\n\n")
+                "(not the PNG encode); read-back: the read-back call's wall time, waiting for the GPU "
+                "included. Per pass: GPU ms.\n\n")
         f.write("| scene | size | render ms | GPU ms | read-back ms | first ms | passes (GPU ms) |\n")
         f.write("|---|---|---|---|---|---|---|\n")
         for r in rows:
