@@ -70,6 +70,17 @@ ViewRay view_ray(vec2 frag) {
   return r;
 }
 
+// The camera-relative point at view depth z on the ray through window
+// position `frag`: view_ray's origin + (z / cos_axis) dir without its
+// normalization (perspective: z times the unnormalized direction, whose
+// component along forward is 1). For passes that place many G-buffer points.
+vec3 view_point(vec2 frag, float z) {
+  vec2 ndc = 2.0 * frag / cam.viewport.xy - 1.0;
+  vec3 across = ndc.x * cam.cam_up.w * cam.cam_right.xyz + ndc.y * cam.cam_up.xyz;
+  if (is_orthographic()) return cam.cam_right.w * across + z * cam.cam_forward.xyz;
+  return z * (cam.cam_forward.xyz + cam.cam_right.w * across);
+}
+
 // Reversed-Z window depth of a point at view depth z (z > 0 along forward).
 float window_depth(float z) {
   float n = cam.viewport.z, f = cam.viewport.w;

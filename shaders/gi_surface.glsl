@@ -16,10 +16,7 @@ const float kTwoPi = 6.28318530717959;
 const int kRings = 4;     // the disk's sample points: kRings rings
 const int kPerRing = 12;  // of kPerRing points
 
-vec3 surface_point(ivec2 px, float z) {
-  ViewRay ray = view_ray(vec2(px) + 0.5);
-  return ray.origin + (z / ray.cos_axis) * ray.dir;
-}
+vec3 surface_point(ivec2 px, float z) { return view_point(vec2(px) + 0.5, z); }
 
 // The kernel's profile at distance fraction s = d / r (unnormalized).
 float profile(float s) {

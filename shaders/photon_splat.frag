@@ -35,9 +35,7 @@ void main() {
                  ivec2(cam.viewport.xy) - 1);
   float z = VIEW_TEXEL(u_view_depth, px).r;
   if (z >= 1e29) discard;  // no surface on this pixel
-  ViewRay ray = view_ray(vec2(px) + 0.5);
-  vec3 x = ray.origin + (z / ray.cos_axis) * ray.dir;
-  vec3 d = x - v_center;
+  vec3 d = view_point(vec2(px) + 0.5, z) - v_center;
   float r2 = u_radius * u_radius;
   float d2 = dot(d, d);
   // The distance first: most of the quad's fragments end here, before the
