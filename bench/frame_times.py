@@ -15,7 +15,8 @@ the warm-up request's render_ms, and the passes that ran.
   /usr/bin/python3 bench/frame_times.py --out DIR [--sizes 512 2048]
       [--assets DIR --slim bunny00.bslm:bunny00.off ...]
 
-Writes frame_times.csv and frame_times.md to DIR. The CLI's renderer string
+Writes frame_times.csv and frame_times.md to DIR (and, for each --slim
+mesh, MESH.obj beside it in --assets: mesh occluders read OBJ). The CLI's renderer string
 (`beamcast info`) names the GPU; pass --info to record it in the table.
 """
 
