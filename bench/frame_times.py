@@ -103,12 +103,15 @@ def slim_scenes(pairs, assets):
     return out
 
 
-def time_scene(client, name, scene, size, frames):
+def time_scene(client, name, scene, size, frames, camera=None):
+    """Puts `scene` as `name` and renders it `frames` + 1 times, one camera a
+    request: the first camera at size x size, or camera(i) for request i
+    (a preview's moving camera). Medians over the requests after the first."""
     cam = dict(scene["cameras"][0], width=size, height=size)
     client.scene_put(name, dict(scene, cameras=[cam]))
     rows = []
     for i in range(frames + 1):
-        got, result = client.render(scene_id=name, cameras=[cam])
+        got, result = client.render(scene_id=name, cameras=[camera(i) if camera else cam])
         rows.append((result["timings"]["render_ms"], got[0]))
     first = rows[0][0]
     rows = rows[1:]
@@ -117,6 +120,7 @@ def time_scene(client, name, scene, size, frames):
     return {"render_ms": round(med(r for r, _ in rows), 2),
             "gpu_ms": round(med(f["gpu_ms"] for _, f in rows), 2),
             "readback_ms": round(med(f.get("readback_ms", 0.0) for _, f in rows), 2),
+            "upload_ms": round(med(f.get("photons", {}).get("upload_ms", 0.0) for _, f in rows), 2),
             "first_render_ms": round(first, 1),
             "passes": {n: round(med(f["pass_ms"][n] for _, f in rows), 2) for n in f0["pass_ms"]},
             "png": rows[-1][1]["png"]}
@@ -192,7 +196,7 @@ def main():
                         with open(os.path.join(a.out, f"{name}_{size}.png"), "wb") as f:
                             f.write(t["png"])
                     row = {"scene": name, "size": size, "what": what,
-                           **{k: v for k, v in t.items() if k not in ("passes", "png")},
+                           **{k: v for k, v in t.items() if k not in ("passes", "png", "upload_ms")},
                            "passes": " ".join(f"{n} {ms}" for n, ms in t["passes"].items())}
                     rows.append(row)
                     print(json.dumps(row), flush=True)

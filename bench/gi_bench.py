@@ -68,30 +68,25 @@ def frame_rate(server_binary, scene, frames=12):
     to a beamcast-server holding the scene (maps traced by the first
     request, cached after), the camera nudged each time. Medians over
     `frames` requests after the first: the server's render_ms (photon
-    upload, GPU, readback; not the PNG encoding), gpu_ms and each pass."""
+    upload, GPU, readback; not the PNG encoding), gpu_ms and each pass
+    (bench/frame_times.py's time_scene)."""
     sys.path.insert(0, os.path.join(ROOT, "client", "python"))
     from beamcast_client import BeamcastClient
+    from frame_times import time_scene
     proc = subprocess.Popen([server_binary, "--port", "0", "--http-port", "-1"],
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     try:
         port = int(proc.stdout.readline().rsplit(":", 1)[-1].split()[0])
         cam0 = scene["cameras"][0]
-        rows = []
         with BeamcastClient("127.0.0.1", port, timeout=300) as c:
-            c.scene_put("gi", scene)
-            for i in range(frames + 1):
-                cam = dict(cam0, position=[cam0["position"][0] + 3.0 * (i % 5)] + cam0["position"][1:])
-                got, result = c.render(scene_id="gi", cameras=[cam])
-                if i:
-                    rows.append((result["timings"]["render_ms"], got[0]))
+            t = time_scene(c, "gi", scene, cam0["width"], frames, camera=lambda i: dict(
+                cam0, position=[cam0["position"][0] + 3.0 * (i % 5)] + cam0["position"][1:]))
     finally:
         proc.terminate()
         proc.wait()
-    med = statistics.median
-    out = {"render_ms": round(med(r for r, _ in rows), 1),
-           "gpu_ms": round(med(f["gpu_ms"] for _, f in rows), 1),
-           "upload_ms": round(med(f["photons"]["upload_ms"] for _, f in rows), 1),
-           "passes": {n: round(med(f["pass_ms"][n] for _, f in rows), 1) for n in rows[0][1]["pass_ms"]}}
+    out = {"render_ms": round(t["render_ms"], 1), "gpu_ms": round(t["gpu_ms"], 1),
+           "upload_ms": round(t["upload_ms"], 1),
+           "passes": {n: round(ms, 1) for n, ms in t["passes"].items()}}
     out["frames_per_s"] = round(1000.0 / out["render_ms"], 2)
     return out
 

@@ -345,16 +345,20 @@ void SceneResources::upload_volume_photons(PhotonCache& cache) {
 
 void SceneResources::upload_direct() {
   Aabb box;
+  std::vector<std::vector<DirectPoint>> per_light;
+  for (const Light& l : scene_.lights) {
+    per_light.push_back(std::visit(
+        [&](const auto& kind) { return kind.direct_points(scene_.gi.direct_samples); }, l.shape));
+  }
   // Interleaved lights' points first (direct_interleaved()), then the others.
   for (const bool first : {true, false}) {
-    for (const Light& l : scene_.lights) {
-      std::vector<DirectPoint> points = std::visit(
-          [&](const auto& kind) { return kind.direct_points(scene_.gi.direct_samples); }, l.shape);
+    for (std::size_t k = 0; k < per_light.size(); ++k) {
+      const std::vector<DirectPoint>& points = per_light[k];
       if (interleaves_direct_points(scene_.gi, points.size()) != first) continue;
-      for (DirectPoint& p : points) {
+      for (const DirectPoint& p : points) {
         box.grow(p.position);
         direct_points_.push_back(p);
-        direct_flux_.push_back(l.flux);
+        direct_flux_.push_back(scene_.lights[k].flux);
       }
       if (first) direct_interleaved_ += static_cast<int>(points.size());
     }

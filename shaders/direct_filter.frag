@@ -20,9 +20,8 @@ layout(location = 0) out vec4 out_color;
 
 const float kPi = 3.14159265358979;
 
-// The point at view depth z of pixel px + (dx, dy) is o + z w, with o and w
-// linear in the pixel (view_ray's origin, and its direction over cos_axis).
-vec3 g_o, g_w, g_odx, g_wdx, g_ody, g_wdy, g_x, g_n;
+// This pixel, its surface point and normal, and the image's size.
+vec3 g_x, g_n;
 ivec2 g_px, g_size;
 
 // The neighbour's tent weight if it counts, else 0 (and its irradiance in e).
@@ -33,8 +32,7 @@ float neighbour(int dx, int dy, float w, out vec3 e) {
   vec4 s = VIEW_TEXEL(u_split, q);
   if (s.w < 0.5) return 0.0;
   float zq = VIEW_TEXEL(u_view_depth, q).r;
-  vec3 d = g_o + float(dx) * g_odx + float(dy) * g_ody +
-           zq * (g_w + float(dx) * g_wdx + float(dy) * g_wdy) - g_x;
+  vec3 d = view_point(vec2(q) + 0.5, zq) - g_x;
   if (abs(dot(d, g_n)) > 0.1 * length(d)) return 0.0;
   e = w * s.rgb;
   return w;
@@ -46,16 +44,7 @@ void main() {
   vec4 own = VIEW_TEXEL(u_split, g_px);
   if (own.w < 0.5) discard;  // not a lit diffuse pixel
   g_size = ivec2(cam.viewport.xy);
-  ViewRay r = view_ray(gl_FragCoord.xy);
-  ViewRay rx = view_ray(gl_FragCoord.xy + vec2(1.0, 0.0));
-  ViewRay ry = view_ray(gl_FragCoord.xy + vec2(0.0, 1.0));
-  g_o = r.origin;
-  g_w = r.dir / r.cos_axis;
-  g_odx = rx.origin - g_o;
-  g_wdx = rx.dir / rx.cos_axis - g_w;
-  g_ody = ry.origin - g_o;
-  g_wdy = ry.dir / ry.cos_axis - g_w;
-  g_x = g_o + VIEW_TEXEL(u_view_depth, g_px).r * g_w;
+  g_x = view_point(gl_FragCoord.xy, VIEW_TEXEL(u_view_depth, g_px).r);
   g_n = VIEW_TEXEL(u_gb_normal, g_px).xyz;
   vec3 e1, e2;
   // Left and right; top and bottom; the four diagonals.

@@ -105,8 +105,7 @@ void main() {
   vec4 albedo = VIEW_TEXEL(u_gb_albedo, px);
   if (albedo.w > 0.5) discard;  // mirrors, glass and emitters
   vec3 n = VIEW_TEXEL(u_gb_normal, px).xyz;
-  ViewRay ray = view_ray(gl_FragCoord.xy);
-  vec3 x = ray.origin + (z / ray.cos_axis) * ray.dir;
+  vec3 x = view_point(gl_FragCoord.xy, z);
   // Interleaved points: this pixel's quarter (its place in the 2 x 2
   // pattern) at 4 times the weight, into direct_split for direct_filter.
   vec3 split = vec3(0.0);
