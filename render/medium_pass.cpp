@@ -78,7 +78,7 @@ class VolumePhotonPass final : public Pass {
     for_each_view_offset(ctx, self, program, "u_photon_offset", ctx.resources.volume_anchor(),
                          [&] {
                            set_region_eye(ctx, region_eye, view++);
-                           glDrawArraysInstanced(GL_TRIANGLES, 0, 6, count);
+                           glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, count);
                          });
     glDisable(GL_BLEND);
     gl_check("volume photon pass");

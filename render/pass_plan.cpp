@@ -79,8 +79,8 @@ const std::vector<TargetDecl>& target_catalog() {
       {"volume_t0", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kOne},
       {"volume_t1", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kOne},
       // The interleaved direct points' irradiance, each pixel's quarter at 4
-      // times the weight (w: 1 where a diffuse surface was lit), before the
-      // direct_filter pass brings the four quarters together.
+      // times the weight (w: the view depth where a diffuse surface was lit, else 0), before the
+      // gi_resolve pass brings the four quarters together.
       {"direct_split", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       // What mirror and glass pixels show, found on the CPU (render/specular_pass.hpp).
       {"specular", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
@@ -139,18 +139,13 @@ const std::vector<PassDecl>& pass_catalog() {
       // The same with gi.direct_interleave 4 (interleaved sampling): each
       // pixel sums a quarter of each interleaved light's points (by its
       // place in a 2 x 2 pattern) into direct_split, the other lights' points
-      // into hdr as above; direct_filter then averages the four quarters
+      // into hdr as above; gi_resolve then averages the four quarters
       // over each pixel's 3 x 3 neighbours on its own surface.
       {PassId::kDirectSplit, "direct",
        [](const PlanInput& in) {
          return shadow_mapped_direct(in.scene) && interleaves_direct(in.scene);
        },
        {"hdr", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr", "direct_split"}, {"shadows"}},
-      {PassId::kDirectFilter, "direct_filter",
-       [](const PlanInput& in) {
-         return shadow_mapped_direct(in.scene) && interleaves_direct(in.scene);
-       },
-       {"hdr", "direct_split", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {}},
       // Photon splatting (seed 001, section 4.2): one camera-facing disk per
       // photon adds its reflected radiance to the G-buffer's pixels within
       // the radius (without the photons straight from a light when the
@@ -161,10 +156,13 @@ const std::vector<PassDecl>& pass_catalog() {
       // The splats' sum to hdr, divided by the share of each pixel's disk
       // that its surface covers (found in the G-buffer), so a surface's
       // edges and the room's corners are not darkened by the disk hanging
-      // over them (gi.edge_correction; shaders/gi_resolve.frag).
+      // over them (gi.edge_correction; shaders/gi_resolve.frag). With the
+      // interleaved direct light (direct_split written) the same pass
+      // brings its four quarters together (shaders/direct_filter.glsl).
       {PassId::kGiResolve, "gi_resolve",
        [](const PlanInput& in) { return !in.scene.occluders.empty() && in.scene.has_gi(); },
-       {"hdr", "gi_indirect", "view_depth", "gb_normal", "gb_albedo"}, {}, {"hdr"}, {}},
+       {"hdr", "gi_indirect", "view_depth", "gb_normal", "gb_albedo"}, {"direct_split"}, {"hdr"},
+       {}},
       // Mirror and glass pixels of a lit scene: the CPU follows their centre
       // rays to what they reach and the radiance there is added to hdr
       // (render/specular_pass.hpp).

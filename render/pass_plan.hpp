@@ -6,6 +6,7 @@
 // what the plan lists (render/passes.cpp makes one executor per PassId).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -19,8 +20,8 @@ namespace beamcast {
 // True if a light with `points` direct points has them shared out over the
 // 2 x 2 pixel pattern (gi.direct_interleave 4 and a nonzero multiple of 4).
 bool interleaves_direct_points(const GiSettings& gi, std::size_t points);
-// True if any light of the scene does (passes direct with the split target,
-// and direct_filter).
+// True if any light of the scene does (pass direct with the split target,
+// which gi_resolve filters).
 bool interleaves_direct(const Scene& scene);
 
 // Every pass the renderer can execute. The executor of each is made by
@@ -36,7 +37,6 @@ enum class PassId {
   kSlimGbuffer,
   kDirect,
   kDirectSplit,
-  kDirectFilter,
   kPhotons,
   kGiResolve,
   kSpecular,
@@ -48,7 +48,40 @@ enum class PassId {
   kTonemap,
   kUpscale
 };
-inline constexpr std::size_t kPassCount = 19;
+inline constexpr std::size_t kPassCount = static_cast<std::size_t>(PassId::kUpscale) + 1;
+
+// The texel layout of a kSplat target. llvmpipe rasterizes a framebuffer in
+// 64 x 64 tiles, one thread a tile: a splat grid of one tile (64 x 64 at
+// 512^2 and splat_scale 8) would be splatted by one thread however many
+// the machine has (the photon pass ran as fast with LP_NUM_THREADS=1). So
+// a grid of fewer than kSplatTiles tiles is stored as `bands` horizontal
+// bands of `band_h` rows side by side, each starting on a tile column
+// (`stride` texels apart): grid texel (x, y) is stored at
+// (x + (y / band_h) * stride, y % band_h). The passes that draw into it draw
+// once per band (viewport shifted, scissor on the band); the readers map
+// with the same formula (shaders/gi_surface.glsl's splat_texel). One band is
+// the plain layout; a GPU gains nothing from bands and loses nothing.
+struct SplatBands {
+  int w = 0, h = 0;  // the grid, in splat pixels
+  int bands = 1;
+  int band_h = 0;
+  int stride = 0;
+  int texture_w() const { return (bands - 1) * stride + w; }
+};
+inline constexpr int kLlvmpipeTile = 64;
+inline constexpr int kSplatTiles = 4;
+inline SplatBands splat_bands(int w, int h) {
+  auto tiles = [](int n) { return (n + kLlvmpipeTile - 1) / kLlvmpipeTile; };
+  SplatBands b{w, h, 1, h, 0};
+  const int have = tiles(w) * tiles(h);
+  if (have >= kSplatTiles) return b;
+  // Bands of at least 8 rows (the binning's cost per draw).
+  b.bands = std::max(1, std::min((kSplatTiles + have - 1) / have, h / 8));
+  b.band_h = (h + b.bands - 1) / b.bands;
+  b.bands = (h + b.band_h - 1) / b.band_h;
+  b.stride = tiles(w) * kLlvmpipeTile;
+  return b;
+}
 
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {

@@ -51,6 +51,7 @@ void FrameTargets::ensure(const FramePlan& plan, int render_w, int render_h, int
     bits_ = bits;
     layers_ = layer_count;
     splat_scale_ = splat_scale;
+    splat_bands_ = beamcast::splat_bands(splat_size(render_w, splat_scale), splat_size(render_h, splat_scale));
   }
   for (const TargetDecl* decl : plan.targets) {
     if (find(decl->name)) continue;
@@ -58,8 +59,8 @@ void FrameTargets::ensure(const FramePlan& plan, int render_w, int render_h, int
     int w = camera_size ? camera_w : render_w;
     int h = camera_size ? camera_h : render_h;
     if (decl->size == TargetSize::kSplat) {
-      w = splat_size(render_w, splat_scale);
-      h = splat_size(render_h, splat_scale);
+      w = splat_bands_.texture_w();
+      h = splat_bands_.band_h;
     }
     const GLenum format = internal_format(decl->format, bits);
     Target t{decl, {}};
@@ -354,29 +355,6 @@ class DirectPass final : public Pass {
   float far_ = 1.0f;
 };
 
-// The interleaved direct points' four quarters brought together
-// (shaders/direct_filter.frag): at each lit diffuse pixel, the mean over the
-// pattern's four classes of each class's tent-weighted (1 2 1) mean over the
-// 3 x 3 neighbours on the pixel's own surface, times albedo / pi, into hdr.
-class DirectFilterPass final : public Pass {
- public:
-  DirectFilterPass() : program_("direct_filter") {}
-  void execute(FrameContext& ctx, const PassDecl& self) override {
-    if (ctx.resources.direct_interleaved() == 0) return;
-    const bool multi = ctx.views > 0;
-    glUseProgram(program_.get(multi));
-    bind_gbuffer(ctx);
-    glBindTextureUnit(3, ctx.targets.texture("direct_split"));
-    begin_additive(ctx);
-    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
-    glDisable(GL_BLEND);
-    gl_check("direct_filter pass");
-  }
-
- private:
-  ProgramPair program_;
-};
-
 // The photon splats' tests (shaders/photon_splat.frag, gi_resolve.frag; the
 // CPU's SplatTests): a photon lights a surface point whose normal is within
 // 25 degrees of its own (curved surfaces turn within a radius; a thin wall's
@@ -405,8 +383,14 @@ class GiResolvePass final : public Pass {
     set_photon_lod(program, multi, ctx.scene.gi);
     glUniform1i(program.uniform(multi, "u_correct"), ctx.scene.gi.edge_correction ? 1 : 0);
     glUniform1i(program.uniform(multi, "u_splat_scale"), ctx.targets.splat_scale());
+    const SplatBands& bands = ctx.targets.splat_bands();
+    glUniform2i(program.uniform(multi, "u_band_layout"), bands.band_h, bands.stride);
     bind_gbuffer(ctx);
     glBindTextureUnit(3, ctx.targets.texture("gi_indirect"));
+    // The interleaved direct light's quarters, filtered here (direct_filter.glsl).
+    const bool split = ctx.plan.written("direct_split") && ctx.resources.direct_interleaved() > 0;
+    glUniform1i(program.uniform(multi, "u_direct_split"), split ? 1 : 0);
+    if (split) glBindTextureUnit(4, ctx.targets.texture("direct_split"));
     begin_additive(ctx);
     // Quad lights whose outlines are antialiased: corners relative to the
     // first one's (in double, then float).
@@ -462,12 +446,27 @@ class PhotonPass final : public Pass {
     bind_gbuffer(ctx);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, ctx.resources.photon_buffer());
     begin_additive(ctx);
-    // Splatted at the kSplat size: the viewport shrinks for this pass.
+    // Splatted at the kSplat size, band by band (SplatBands): the viewport
+    // shrinks and shifts for this pass, the scissor keeps each band's draw
+    // to its own rows.
     const int scale = ctx.targets.splat_scale();
+    const SplatBands& bands = ctx.targets.splat_bands();
     glUniform1i(program.uniform(multi, "u_splat_scale"), scale);
     GLint viewport[4];
     glGetIntegerv(GL_VIEWPORT, viewport);
-    glViewport(0, 0, splat_size(viewport[2], scale), splat_size(viewport[3], scale));
+    const bool banded = bands.bands > 1;
+    if (banded) glEnable(GL_SCISSOR_TEST);
+    // Runs `draw` once per band with `prog`'s u_band_shift (a band's texel
+    // plus it is its grid texel) set.
+    auto per_band = [&](ProgramPair& prog, auto&& draw) {
+      const GLint shift = prog.uniform(multi, "u_band_shift");
+      for (int b = 0; b < bands.bands; ++b) {
+        glViewport(b * bands.stride, -b * bands.band_h, bands.w, bands.h);
+        if (banded) glScissor(b * bands.stride, 0, bands.w, bands.band_h);
+        glUniform2i(shift, -b * bands.stride, b * bands.band_h);
+        draw();
+      }
+    };
     // gi.edge_correction: each splat pixel's share of its disk on its own
     // surface into the target's alpha (shaders/gi_share.frag), for gi_resolve.
     if (ctx.scene.gi.edge_correction) {
@@ -478,7 +477,8 @@ class PhotonPass final : public Pass {
       glUniform1f(share.uniform(multi, "u_min_cos"), kSplatMinCos);
       glUniform1f(share.uniform(multi, "u_max_plane"), kSplatMaxPlane);
       glUniform1i(share.uniform(multi, "u_splat_scale"), scale);
-      for_each_view(ctx, self, share, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+      for_each_view(ctx, self, share,
+                    [&] { per_band(share, [] { glDrawArrays(GL_TRIANGLES, 0, 3); }); });
       glUseProgram(program.get(multi));
     }
     // Two draws: the global map's photons, then the caustic map's with their
@@ -492,17 +492,20 @@ class PhotonPass final : public Pass {
     glUniform1f(program.uniform(multi, "u_power_scale"), 1.0f);
     const float caustic_radius = static_cast<float>(ctx.resources.caustic_radius());
     for_each_view_offset(ctx, self, program, "u_photon_offset", ctx.resources.photon_anchor(), [&] {
-      if (split > 0) {
-        glUniform1i(first_uniform, 0);
-        glUniform1f(radius_uniform, radius);
-        glDrawArraysInstanced(GL_TRIANGLES, 0, 6, split);
-      }
-      if (caustic > 0) {
-        glUniform1i(first_uniform, split);
-        glUniform1f(radius_uniform, caustic_radius);
-        glDrawArraysInstanced(GL_TRIANGLES, 0, 6, caustic);
-      }
+      per_band(program, [&] {
+        if (split > 0) {
+          glUniform1i(first_uniform, 0);
+          glUniform1f(radius_uniform, radius);
+          glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, split);
+        }
+        if (caustic > 0) {
+          glUniform1i(first_uniform, split);
+          glUniform1f(radius_uniform, caustic_radius);
+          glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, caustic);
+        }
+      });
     });
+    if (banded) glDisable(GL_SCISSOR_TEST);
     glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
     glDisable(GL_BLEND);
     gl_check("photons pass");
@@ -727,8 +730,6 @@ std::unique_ptr<Pass> make_pass(PassId id) {
     case PassId::kDirect:
     case PassId::kDirectSplit:
       return std::make_unique<DirectPass>();
-    case PassId::kDirectFilter:
-      return std::make_unique<DirectFilterPass>();
     case PassId::kPhotons:
       return std::make_unique<PhotonPass>();
     case PassId::kGiResolve:

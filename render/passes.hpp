@@ -45,6 +45,8 @@ class FrameTargets {
   // The divisor of the kSplat targets as allocated: the plan's, or with the
   // plan's 0 (gi.splat_scale "auto") auto_splat_scale of the render size.
   int splat_scale() const { return splat_scale_; }
+  // How the kSplat targets' texels are laid out (SplatBands).
+  const SplatBands& splat_bands() const { return splat_bands_; }
 
  private:
   struct Target {
@@ -57,6 +59,7 @@ class FrameTargets {
   };
   int render_w_ = 0, render_h_ = 0, camera_w_ = 0, camera_h_ = 0, bits_ = 0, layers_ = 0;
   int splat_scale_ = 1;
+  SplatBands splat_bands_;
   std::vector<Target> targets_;
   std::array<PassFbos, kPassCount> fbos_;
   const Target* find(std::string_view name) const;

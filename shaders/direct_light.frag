@@ -107,7 +107,7 @@ void main() {
   vec3 n = VIEW_TEXEL(u_gb_normal, px).xyz;
   vec3 x = view_point(gl_FragCoord.xy, z);
   // Interleaved points: this pixel's quarter (its place in the 2 x 2
-  // pattern) at 4 times the weight, into direct_split for direct_filter.
+  // pattern) at 4 times the weight, into direct_split for gi_resolve.
   vec3 split = vec3(0.0);
   for (int i = (px.x & 1) | ((px.y & 1) << 1); i < u_interleaved; i += 4) {
     split += point_light(i, x, n);
@@ -115,5 +115,5 @@ void main() {
   vec3 e = vec3(0.0);
   for (int i = u_interleaved; i < u_point_count; ++i) e += point_light(i, x, n);
   out_color = vec4(albedo.rgb / kPi * e, 0.0);
-  out_split = vec4(4.0 * split, 1.0);
+  out_split = vec4(4.0 * split, z);  // w: the view depth, > 0 (direct_filter.glsl)
 }

@@ -20,7 +20,11 @@
 layout(binding = 2) uniform VIEW_SAMPLER u_gb_albedo;
 layout(binding = 3) uniform VIEW_SAMPLER u_indirect;  // rgb: the splats' sum; a: the share
 uniform int u_correct;      // 0: no share correction (gi.edge_correction off)
+uniform int u_direct_split;  // 1: the interleaved direct light to filter (direct_filter.glsl)
 uniform int u_splat_scale;  // u_indirect has 1/u_splat_scale of the pixels per side
+// u_indirect's bands (render/pass_plan.hpp, SplatBands): rows a band, texels
+// from one band's start to the next's.
+uniform ivec2 u_band_layout;
 
 const int kMaxAaLights = 8;
 uniform int u_aa_lights;        // quad lights to antialias (the first kMaxAaLights)
@@ -32,9 +36,12 @@ uniform vec3 u_light_radiance[kMaxAaLights];
 
 layout(location = 0) out vec4 out_color;
 
+const float kPi = 3.14159265358979;
+
 // A splat pixel's sum, divided by its share with the edge correction on.
 vec3 corrected(ivec2 q) {
-  vec4 v = VIEW_TEXEL(u_indirect, q);
+  vec4 v = VIEW_TEXEL(u_indirect, ivec2(q.x + (q.y / u_band_layout.x) * u_band_layout.y,
+                                         q.y % u_band_layout.x));
   return u_correct != 0 ? v.rgb / max(v.a, 0.25) : v.rgb;
 }
 
@@ -151,6 +158,8 @@ void main() {
   }
   vec3 n = VIEW_TEXEL(u_gb_normal, px).xyz;
   vec3 x = surface_point(px, z);
-  vec3 sum = albedo.rgb * upsample(px, x, n);
+  vec3 e = upsample(px, x, n);
+  if (u_direct_split != 0) e += filtered_direct(px, x, n) * (1.0 / kPi);
+  vec3 sum = albedo.rgb * e;
   out_color = vec4(sum + lights, 0.0);
 }

@@ -21,6 +21,9 @@
 //     in front hides the rest of x's surface);
 //   - off the image: unknown, covered.
 layout(binding = 2) uniform VIEW_SAMPLER u_gb_albedo;
+// A band's texel plus u_band_shift is its splat-grid texel (render/pass_plan.hpp,
+// SplatBands; the pass draws once per band).
+uniform ivec2 u_band_shift;
 uniform int u_splat_scale;  // this target has 1/u_splat_scale of the G-buffer's pixels per side
 
 layout(location = 0) out vec4 out_color;
@@ -28,7 +31,7 @@ layout(location = 0) out vec4 out_color;
 void main() {
   select_view(view_index());
   // The G-buffer pixel this splat pixel stands for (as photon_splat.frag).
-  ivec2 px = min(ivec2(gl_FragCoord.xy) * u_splat_scale + u_splat_scale / 2,
+  ivec2 px = min((ivec2(gl_FragCoord.xy) + u_band_shift) * u_splat_scale + u_splat_scale / 2,
                  ivec2(cam.viewport.xy) - 1);
   float z = VIEW_TEXEL(u_view_depth, px).r;
   if (z >= 1e29 || VIEW_TEXEL(u_gb_albedo, px).w > 0.5) discard;  // no photons there

@@ -17,6 +17,9 @@ uniform float u_radius;
 #endif
 uniform float u_min_cos;   // normal test: cos of the largest angle between the normals
 uniform float u_max_plane; // plane test: largest distance off the surface's plane, x radius
+// A band's texel plus u_band_shift is its splat-grid texel (render/pass_plan.hpp,
+// SplatBands; the pass draws once per band).
+uniform ivec2 u_band_shift;
 uniform int u_splat_scale; // this target has 1/u_splat_scale of the G-buffer's pixels per side
 
 flat in vec3 v_center;
@@ -31,7 +34,7 @@ void main() {
   select_view(view_index());
   // The G-buffer pixel this (splat-size) pixel stands for (gi_resolve.frag
   // uses the same one).
-  ivec2 px = min(ivec2(gl_FragCoord.xy) * u_splat_scale + u_splat_scale / 2,
+  ivec2 px = min((ivec2(gl_FragCoord.xy) + u_band_shift) * u_splat_scale + u_splat_scale / 2,
                  ivec2(cam.viewport.xy) - 1);
   float z = VIEW_TEXEL(u_view_depth, px).r;
   if (z >= 1e29) discard;  // no surface on this pixel

@@ -64,10 +64,9 @@ void main() {
   }
   v_power = p.power.rgb * (u_power_scale * lod);
   v_normal = p.normal.xyz;
-  // Corner of two triangles: (-1,-1) (1,-1) (1,1) / (-1,-1) (1,1) (-1,1).
-  const vec2 corners[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1), vec2(1, 1),
-                                  vec2(-1, 1));
-  vec2 k = corners[gl_VertexID];
+  // Corner of a triangle strip of 4 vertices: (-1,-1) (1,-1) (-1,1) (1,1)
+  // (llvmpipe shades the vertices on one thread: 4 a quad, not 6).
+  vec2 k = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0);
   // Perspective: a sphere of radius r at distance D subtends asin(r / D); a
   // quad in its centre's plane facing the camera covers that cone with half
   // size r D / sqrt(D^2 - r^2) (here along the view axis, the worst case

@@ -16,6 +16,7 @@
 #include "gi/photon_map.hpp"
 #include "protocol/camera.hpp"
 #include "protocol/scene_json.hpp"
+#include "render/pass_plan.hpp"
 #include "render/renderer.hpp"
 
 namespace beamcast {
@@ -118,37 +119,82 @@ TEST(Gi, PhotonsDoNotBleedThroughAThinWall) {
 // while a wrong kernel normalization, a missed n.l rule or a dropped map
 // would be off by 10% or more.
 TEST(Gi, SplattingEqualsTheCpuEstimatorOnTheSamePhotons) {
-  std::ifstream in(std::string(BEAMCAST_SOURCE_DIR) + "/examples/cornell_caustic.json");
-  json j = json::parse(in);
-  j["cameras"][0]["width"] = 96;
-  j["cameras"][0]["height"] = 96;
-  // Every bounce from photons (the CPU estimator has no shadow maps).
-  // At the full render size, without the edge correction, with the
-  // light's outline aliased and the mirror and glass pixels followed along
-  // their centre rays only, as the CPU estimator does them. (The
-  // outline's antialiasing alone is a 20% L1 difference: the light is
-  // ~100x brighter than the walls.)
-  // Every photon its own disk (gi.cluster 0), as the CPU estimator sums them.
-  j["gi"] = {{"photons", 20000}, {"caustic_photons", 20000}, {"kernel", "epanechnikov"},
-             {"direct", "photons"}, {"edge_correction", false}, {"splat_scale", 1},
-             {"light_antialias", false}, {"specular_samples", 1}, {"cluster", 0}};
-  const Scene scene = parse_scene(j, {});
-  const auto frames = renderer().render(scene, FrameOptions{.read_hdr = true});
-  const GiScene surfaces(scene);
-  const PhotonMaps maps = trace_photons(scene, surfaces);
-  ASSERT_FALSE(maps.caustic.empty());
-  EXPECT_EQ(frames[0].photons, static_cast<std::int64_t>(maps.global.size() + maps.caustic.size()));
-  const PhotonGather gather(maps);
-  const HdrImage cpu = gather_image(scene, surfaces, gather, scene.cameras[0]);
-  const HdrImage& gpu = frames[0].hdr;
-  ASSERT_EQ(cpu.rgb.size(), gpu.rgb.size());
-  double diff = 0.0, total = 0.0;
-  for (std::size_t i = 0; i < cpu.rgb.size(); ++i) {
-    diff += std::abs(static_cast<double>(gpu.rgb[i]) - cpu.rgb[i]);
-    total += cpu.rgb[i];
+  // 96^2: the splat grid is 2 x 2 of llvmpipe's tiles, stored plain; 64^2:
+  // one tile, stored as 4 bands of 16 rows (SplatBands): a band's rows or
+  // shift off by one would move whole rows of splats, far over the bound.
+  ASSERT_EQ(splat_bands(96, 96).bands, 1);
+  ASSERT_EQ(splat_bands(64, 64).bands, 4);
+  for (const int size : {96, 64}) {
+    SCOPED_TRACE(size);
+    std::ifstream in(std::string(BEAMCAST_SOURCE_DIR) + "/examples/cornell_caustic.json");
+    json j = json::parse(in);
+    j["cameras"][0]["width"] = size;
+    j["cameras"][0]["height"] = size;
+    // Every bounce from photons (the CPU estimator has no shadow maps).
+    // At the full render size, without the edge correction, with the
+    // light's outline aliased and the mirror and glass pixels followed along
+    // their centre rays only, as the CPU estimator does them. (The
+    // outline's antialiasing alone is a 20% L1 difference: the light is
+    // ~100x brighter than the walls.)
+    // Every photon its own disk (gi.cluster 0), as the CPU estimator sums them.
+    j["gi"] = {{"photons", 20000}, {"caustic_photons", 20000}, {"kernel", "epanechnikov"},
+               {"direct", "photons"}, {"edge_correction", false}, {"splat_scale", 1},
+               {"light_antialias", false}, {"specular_samples", 1}, {"cluster", 0}};
+    const Scene scene = parse_scene(j, {});
+    const auto frames = renderer().render(scene, FrameOptions{.read_hdr = true});
+    const GiScene surfaces(scene);
+    const PhotonMaps maps = trace_photons(scene, surfaces);
+    ASSERT_FALSE(maps.caustic.empty());
+    EXPECT_EQ(frames[0].photons,
+              static_cast<std::int64_t>(maps.global.size() + maps.caustic.size()));
+    const PhotonGather gather(maps);
+    const HdrImage cpu = gather_image(scene, surfaces, gather, scene.cameras[0]);
+    const HdrImage& gpu = frames[0].hdr;
+    ASSERT_EQ(cpu.rgb.size(), gpu.rgb.size());
+    double diff = 0.0, total = 0.0;
+    for (std::size_t i = 0; i < cpu.rgb.size(); ++i) {
+      diff += std::abs(static_cast<double>(gpu.rgb[i]) - cpu.rgb[i]);
+      total += cpu.rgb[i];
+    }
+    ASSERT_GT(total, 0.0);
+    std::printf("%d^2: splats against the CPU estimator, relative L1 %.5f\n", size, diff / total);
+    EXPECT_LT(diff / total, 2e-3);
   }
-  ASSERT_GT(total, 0.0);
-  EXPECT_LT(diff / total, 2e-3);
+}
+
+// The splat grid's band layout (render/passes.hpp): every grid texel has
+// its own texel of the texture, and each band starts on a tile column of its
+// own, so grids of fewer than kSplatTiles tiles reach that many tiles (or
+// one band per 8 rows).
+TEST(Gi, SplatBandsMapEveryGridTexelToItsOwnTexel) {
+  for (int w = 1; w <= 200; w += 7) {
+    for (int h = 1; h <= 200; h += 5) {
+      const SplatBands b = splat_bands(w, h);
+      SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+      ASSERT_GE(b.bands, 1);
+      ASSERT_GE(b.band_h * b.bands, h);
+      ASSERT_LT(b.band_h * (b.bands - 1), h);  // no empty band
+      if (b.bands > 1) {
+        EXPECT_EQ(b.stride % kLlvmpipeTile, 0);
+        EXPECT_GE(b.stride, w);
+      }
+      const int tiles_x = (w + kLlvmpipeTile - 1) / kLlvmpipeTile;
+      const int tiles_y = (h + kLlvmpipeTile - 1) / kLlvmpipeTile;
+      if (tiles_x * tiles_y >= kSplatTiles) EXPECT_EQ(b.bands, 1);
+      else EXPECT_EQ(b.bands, std::max(1, std::min((kSplatTiles + tiles_x * tiles_y - 1) /
+                                                       (tiles_x * tiles_y), h / 8)));
+      std::vector<char> used(static_cast<std::size_t>(b.texture_w()) * b.band_h, 0);
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          const int tx = x + (y / b.band_h) * b.stride, ty = y % b.band_h;
+          ASSERT_LT(tx, b.texture_w());
+          char& u = used[static_cast<std::size_t>(ty) * b.texture_w() + tx];
+          ASSERT_EQ(u, 0);
+          u = 1;
+        }
+      }
+    }
+  }
 }
 
 // gi.cluster (the default 0.25) against one disk per photon on the Cornell
@@ -340,7 +386,7 @@ TEST(Gi, DirectLightOfAQuadLightMatchesItsIntegral) {
   EXPECT_LT(c.max_rel, 1e-3);
   EXPECT_LT(rule_error, 4e-3);
   // Interleaved (gi.direct_interleave 4): each pixel sums a quarter of the
-  // points and direct_filter takes the other quarters from its neighbours,
+  // points and gi_resolve takes the other quarters from its neighbours,
   // up to a pixel away. The irradiance changes by up to 18% from one pixel
   // to the next on this 64^2 view (computed offline); the tent's symmetric
   // weights cancel that first-order change and leave its curvature: measured
@@ -367,7 +413,7 @@ TEST(Gi, DirectLightOfAQuadLightMatchesItsIntegral) {
 TEST(Gi, TheEdgeCorrectionRemovesTheSplatsBiasAtASurfacesEdge) {
   constexpr double kRho = 0.5, kPhi = 10.0, kHalf = 1.0, kRadius = 0.1;
   const Vec3 light{0.0, 0.5, 0.0};
-  auto scene_json = [&](bool correct) {
+  auto scene_json = [&](bool correct, int size) {
     return json{
         {"occluders",
          {{{"type", "quad"}, {"corner", {-kHalf, 0, kHalf}}, {"edge_u", {2 * kHalf, 0, 0}},
@@ -378,11 +424,11 @@ TEST(Gi, TheEdgeCorrectionRemovesTheSplatsBiasAtASurfacesEdge) {
         {"gi", {{"photons", 200000}, {"caustic_photons", 0}, {"radius", kRadius},
                 {"direct", "photons"}, {"edge_correction", correct}, {"splat_scale", 1}}},
         {"cameras", {{{"position", {0, 3, 0.001}}, {"target", {0, 0, 0}}, {"fov_y", 45},
-                      {"width", 128}, {"height", 128}}}}};
+                      {"width", size}, {"height", size}}}}};
   };
   // Mean of gpu / closed form over floor pixels within kRadius / 2 of an edge.
-  auto band_ratio = [&](bool correct) {
-    const Scene scene = parse_scene(scene_json(correct), {});
+  auto band_ratio = [&](bool correct, int size) {
+    const Scene scene = parse_scene(scene_json(correct, size), {});
     const auto frames = renderer().render(scene, FrameOptions{.read_hdr = true});
     const Camera& cam = scene.cameras[0];
     const CameraBasis basis = camera_basis(cam);
@@ -404,11 +450,21 @@ TEST(Gi, TheEdgeCorrectionRemovesTheSplatsBiasAtASurfacesEdge) {
         ++n;
       }
     }
-    EXPECT_GT(n, 500);
+    std::printf("%d^2: %d edge-band pixels, mean gpu / closed form %.4f (%s)\n", size, n, sum / n,
+                correct ? "corrected" : "uncorrected");
+    EXPECT_GT(n, size * size / 40);
     return sum / n;
   };
-  EXPECT_LT(band_ratio(false), 0.85);
-  EXPECT_NEAR(band_ratio(true), 1.0, 0.04);
+  EXPECT_LT(band_ratio(false, 128), 0.85);
+  EXPECT_NEAR(band_ratio(true, 128), 1.0, 0.04);
+  // At 64^2 the grid is one llvmpipe tile, stored as 4 bands (SplatBands):
+  // the share draw runs once per band with its shift. Its share comes from a
+  // G-buffer of twice the pixel size here, so less exact: 0.9548, the same
+  // to the fourth digit with the bands as without them (kSplatTiles 1,
+  // measured 2026-11-26), hence 6%; a band's rows shifted would give the
+  // edge pixels the interior's share (1), the uncorrected ~0.7.
+  EXPECT_NEAR(band_ratio(true, 64), 1.0, 0.06);
+  EXPECT_EQ(splat_bands(64, 64).bands, 4);
 }
 
 TEST(Gi, ACameraOnlyChangeTracesNoPhotons) {

@@ -122,7 +122,7 @@ TEST(Server, LitScenesReportPhotonsAndRefuseBadLightsWithPaths) {
   Reply r = c.call(render_req(1, scene));
   ASSERT_TRUE(r.json["ok"]) << r.json;
   EXPECT_EQ(r.json["result"]["passes"],
-            json({"gbuffer", "direct", "direct_filter", "photons", "gi_resolve", "tonemap"}));
+            json({"gbuffer", "direct", "photons", "gi_resolve", "tonemap"}));
   const RenderResponse first = test::render_result(r);
   ASSERT_TRUE(first.frames[0].photons);
   EXPECT_GT(first.frames[0].photons->count, 0);

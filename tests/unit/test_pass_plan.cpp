@@ -103,7 +103,7 @@ TEST(PassPlan, EveryCatalogPassIsReachable) {
       }
     }
   }
-  // A quad light's 16 points are interleaved (direct_filter).
+  // A quad light's 16 points are interleaved (direct with direct_split).
   Scene quad = scene_with(false, true, true);
   quad.lights[0].shape = QuadLight{};
   for (const auto& n : make_plan(PlanInput{quad}).names()) seen.push_back(n);
@@ -142,16 +142,20 @@ TEST(PassPlan, ReadingATargetNobodyWritesFailsAtPlanTime) {
 
 // gi.direct_interleave 4 (the default) shares out the points of each light
 // with a multiple of 4 of them over the 2 x 2 pixel pattern: a quad light's
-// 16 add the direct_split target and the direct_filter pass after direct; a
-// point light's one point, or direct_interleave 1, does not.
+// 16 add the direct_split target, which gi_resolve reads (it filters the
+// quarters); a point light's one point, or direct_interleave 1, does not.
 TEST(PassPlan, QuadLightsInterleaveTheirDirectPoints) {
   Scene quad = scene_with(false, true, true);
   quad.lights[0].shape = QuadLight{};
   EXPECT_TRUE(interleaves_direct(quad));
   const FramePlan plan = make_plan(PlanInput{quad});
-  EXPECT_EQ(plan.names(), (std::vector<std::string>{"gbuffer", "direct", "direct_filter", "photons",
-                                                    "gi_resolve", "tonemap"}));
+  EXPECT_EQ(plan.names(),
+            (std::vector<std::string>{"gbuffer", "direct", "photons", "gi_resolve", "tonemap"}));
   EXPECT_TRUE(plan.uses("direct_split"));
+  const auto resolve = std::find_if(plan.passes.begin(), plan.passes.end(),
+                                    [](const PassDecl* p) { return p->id == PassId::kGiResolve; });
+  ASSERT_NE(resolve, plan.passes.end());
+  EXPECT_EQ((*resolve)->optional_reads, std::vector<std::string>{"direct_split"});
   // The quad's points, 2 x 2 cells at a time: every fourth spans the light.
   const auto points = std::get<QuadLight>(quad.lights[0].shape).direct_points(16);
   ASSERT_EQ(points.size(), 16u);
@@ -165,6 +169,7 @@ TEST(PassPlan, QuadLightsInterleaveTheirDirectPoints) {
   EXPECT_FALSE(interleaves_direct(quad));
   EXPECT_EQ(make_plan(PlanInput{quad}).names(),
             (std::vector<std::string>{"gbuffer", "direct", "photons", "gi_resolve", "tonemap"}));
+  EXPECT_FALSE(make_plan(PlanInput{quad}).uses("direct_split"));
   EXPECT_FALSE(interleaves_direct(scene_with(false, true, true)));  // a point light
 }
 
