@@ -86,7 +86,7 @@ struct GiSettings {
   // 4: the points of each light with a multiple of 4 of them are shared out
   // over a 2 x 2 pixel pattern (each pixel a quarter of them, at 4 times
   // the weight) and a 3 x 3 surface-aware filter gives every pixel all four
-  // quarters (passes direct and direct_filter; interleaved sampling): the
+  // quarters (pass direct, filtered in gi_resolve; interleaved sampling): the
   // direct pass's point loop costs a quarter. 1: every pixel every point.
   int direct_interleave = 4;
   int shadow_size = 256;    // texels per cube-map face of a direct point's shadow map

@@ -1,7 +1,7 @@
 // Direct light of a lit scene (pass "direct", gi.direct "shadow_maps"): each
 // light is a few point emitters (DirectPoint in protocol/lights/light_base.hpp;
 // with gi.direct_interleave 4, each pixel a quarter of an interleaved light's
-// points, the rest in pass direct_filter);
+// points, the rest from its neighbours in pass gi_resolve, direct_filter.glsl);
 // a diffuse G-buffer point x with normal n (facing the camera) reflects
 //   L = albedo / pi * sum_i flux_i * angular_i(c) * max(0, n.l) * V_i / d^2,
 // V_i from point i's cube shadow map of the triangles (distance compared,
