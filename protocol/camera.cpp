@@ -65,4 +65,18 @@ Ray camera_ray(const Camera& cam, const CameraBasis& b, int px, int py) {
   return camera_ray_ndc(cam, b, nx, ny);
 }
 
+std::optional<std::array<double, 2>> window_position(const Camera& cam, const CameraBasis& b,
+                                                     const Vec3& p) {
+  const Vec3 v = p - b.eye;
+  double half_h = b.half_height;
+  if (cam.projection == Projection::kPerspective) {
+    const double z = dot(v, b.forward);
+    if (!(z > cam.near_plane)) return std::nullopt;
+    half_h = z * b.tan_half_fov;
+  }
+  const double nx = dot(v, b.right) / (half_h * b.aspect);
+  const double ny = dot(v, b.up) / half_h;
+  return std::array<double, 2>{(nx + 1.0) * 0.5 * cam.width, (ny + 1.0) * 0.5 * cam.height};
+}
+
 }  // namespace beamcast

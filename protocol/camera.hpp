@@ -2,6 +2,9 @@
 // camera-relative float matrices) and the CPU reference (which traces rays).
 #pragma once
 
+#include <array>
+#include <optional>
+
 #include "protocol/scene.hpp"
 
 namespace beamcast {
@@ -36,5 +39,12 @@ Ray camera_ray(const Camera& cam, const CameraBasis& basis, int px, int py);
 
 // Same, for a point in normalized device coordinates [-1, 1]^2.
 Ray camera_ray_ndc(const Camera& cam, const CameraBasis& basis, double ndc_x, double ndc_y);
+
+// Where point p lands in the window, in pixels (x right, y up from the
+// bottom edge; pixel (px, py) spans [px, px + 1) x [py, py + 1)): the
+// inverse of camera_ray. Perspective: nothing for a point at or behind the
+// near plane's depth (it has no place in the image).
+std::optional<std::array<double, 2>> window_position(const Camera& cam, const CameraBasis& basis,
+                                                     const Vec3& p);
 
 }  // namespace beamcast

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -363,6 +364,34 @@ class DirectPass final : public Pass {
 constexpr float kSplatMinCos = 0.906f;
 constexpr float kSplatMaxPlane = 0.1f;
 
+// A rectangle of pixels, lower-left and upper-right inclusive, in window
+// coordinates (y up): gi_resolve tests a quad light's outline only there.
+constexpr std::array<int, 4> kEveryPixel = {-(1 << 30), -(1 << 30), 1 << 30, 1 << 30};
+
+// The pixels a quad light's projection can touch, 2 pixels wider on each
+// side (a pixel meets the light only if its square meets the light's
+// projection; the outline test's rays are within the pixel); every pixel if
+// a corner has no place in the image (at or behind the near plane).
+std::array<int, 4> light_pixel_rect(const QuadLight& q, const Camera& cam, const CameraBasis& b) {
+  const Vec3 corners[4] = {q.corner, q.corner + q.edge_u, q.corner + q.edge_v,
+                           q.corner + q.edge_u + q.edge_v};
+  std::array<double, 2> lo{std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::infinity()};
+  std::array<double, 2> hi{-lo[0], -lo[1]};
+  for (const Vec3& c : corners) {
+    const auto w = window_position(cam, b, c);
+    if (!w) return kEveryPixel;
+    for (int a = 0; a < 2; ++a) {
+      lo[a] = std::min(lo[a], (*w)[a]);
+      hi[a] = std::max(hi[a], (*w)[a]);
+    }
+  }
+  auto pixel = [](double x, int margin) {
+    return static_cast<int>(std::clamp(std::floor(x) + margin, -1e9, 1e9));
+  };
+  return {pixel(lo[0], -2), pixel(lo[1], -2), pixel(hi[0], 2), pixel(hi[1], 2)};
+}
+
 // The splats' sum (gi_indirect) into hdr, upsampled, each splat pixel
 // divided by the kernel-weighted share of its disk that lies on its own
 // surface (its alpha, from the photon pass's share draw), or passed through
@@ -416,6 +445,13 @@ class GiResolvePass final : public Pass {
       set("u_light_u", q.edge_u);
       set("u_light_v", q.edge_v);
       set("u_light_radiance", Vec3{radiance[0], radiance[1], radiance[2]});
+      // The pixels whose outline test can find the light (one camera; a
+      // multi-view batch tests every pixel).
+      const std::array<int, 4> rect =
+          multi ? kEveryPixel
+                : light_pixel_rect(q, ctx.camera, ctx.basis);
+      glUniform4i(program.uniform(multi, ("u_light_rect" + i).c_str()), rect[0], rect[1], rect[2],
+                  rect[3]);
     }
     for_each_view_offset(ctx, self, program, "u_light_offset", anchor,
                          [] { glDrawArrays(GL_TRIANGLES, 0, 3); });

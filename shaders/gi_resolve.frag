@@ -33,6 +33,11 @@ uniform vec3 u_light_corner[kMaxAaLights];  // relative to the anchor
 uniform vec3 u_light_u[kMaxAaLights];
 uniform vec3 u_light_v[kMaxAaLights];
 uniform vec3 u_light_radiance[kMaxAaLights];
+// The pixels (x0, y0, x1, y1, inclusive) where light k's outline can lie:
+// its projection's bounds and 2 pixels, from the CPU; elsewhere the pixel
+// neither sees nor touches the light, and its test is skipped (~2.5 ms of a
+// 512^2 Cornell frame on llvmpipe).
+uniform ivec4 u_light_rect[kMaxAaLights];
 
 layout(location = 0) out vec4 out_color;
 
@@ -147,6 +152,8 @@ void main() {
   if (u_aa_lights > 0) {
     float zlim = z >= 1e29 ? 3.0e38 : 1.01 * z;
     for (int k = 0; k < u_aa_lights; ++k) {
+      ivec4 r = u_light_rect[k];
+      if (any(lessThan(px, r.xy)) || any(greaterThan(px, r.zw))) continue;
       lights += light_coverage(px, k, zlim) * u_light_radiance[k];
     }
     if (albedo.w > 2.5) lights -= albedo.rgb;  // the centre's light, drawn by the G-buffer

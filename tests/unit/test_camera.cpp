@@ -157,6 +157,37 @@ TEST(Camera, PixelRowsCountUpward) {
   EXPECT_LT(camera_ray(c, b, 0, 5).dir[0], 0.0);  // px = 0 is the left column
 }
 
+// window_position inverts camera_ray: a point anywhere along a pixel
+// centre's ray lands on that centre (1e-9 px: double rounding of a few
+// dot products), for both projections and a turned, non-square camera;
+// a point behind the near plane has no position.
+TEST(Camera, WindowPositionInvertsCameraRay) {
+  for (const Projection proj : {Projection::kPerspective, Projection::kOrthographic}) {
+    Camera c = look_at({1, 2, 3}, {-2, 0.5, -4});
+    c.projection = proj;
+    c.width = 37;
+    c.height = 23;
+    c.fov_y_deg = 70;
+    c.ortho_height = 3;
+    const CameraBasis b = camera_basis(c);
+    for (int py = 0; py < c.height; py += 5) {
+      for (int px = 0; px < c.width; px += 4) {
+        const Ray r = camera_ray(c, b, px, py);
+        for (const double t : {r.t_min * 2.0, 1.0, 50.0}) {
+          const auto w = window_position(c, b, r.origin + t * r.dir);
+          ASSERT_TRUE(w.has_value());
+          EXPECT_NEAR((*w)[0], px + 0.5, 1e-9);
+          EXPECT_NEAR((*w)[1], py + 0.5, 1e-9);
+        }
+      }
+    }
+    if (proj == Projection::kPerspective) {
+      EXPECT_FALSE(window_position(c, b, b.eye - b.forward).has_value());
+      EXPECT_FALSE(window_position(c, b, b.eye + 0.5 * c.near_plane * b.forward).has_value());
+    }
+  }
+}
+
 TEST(Camera, RotateMatchesAxisAngle) {
   const double a = 0.8;
   const std::array<double, 4> q{std::cos(a / 2), 0, 0, std::sin(a / 2)};  // about +Z
