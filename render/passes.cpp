@@ -493,13 +493,20 @@ class PhotonPass final : public Pass {
     const bool banded = bands.bands > 1;
     if (banded) glEnable(GL_SCISSOR_TEST);
     // Runs `draw` once per band with `prog`'s u_band_shift (a band's texel
-    // plus it is its grid texel) set.
+    // plus it is its grid texel) set, and the disks' cull uniforms
+    // (u_band_ndc: the band's rows in NDC y, a pixel wider each side; the
+    // share draw has none).
     auto per_band = [&](ProgramPair& prog, auto&& draw) {
       const GLint shift = prog.uniform(multi, "u_band_shift");
+      const GLint ndc = prog.uniform(multi, "u_band_ndc");
+      glUniform1i(prog.uniform(multi, "u_band_cull"), banded ? 1 : 0);
+      const float row = 2.0f / static_cast<float>(bands.h);
       for (int b = 0; b < bands.bands; ++b) {
         glViewport(b * bands.stride, -b * bands.band_h, bands.w, bands.h);
         if (banded) glScissor(b * bands.stride, 0, bands.w, bands.band_h);
         glUniform2i(shift, -b * bands.stride, b * bands.band_h);
+        glUniform2f(ndc, static_cast<float>(b * bands.band_h - 1) * row - 1.0f,
+                    static_cast<float>((b + 1) * bands.band_h + 1) * row - 1.0f);
         draw();
       }
     };

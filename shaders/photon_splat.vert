@@ -11,6 +11,14 @@ uniform vec3 u_photon_offset;  // photon anchor minus eye
 uniform float u_radius;
 uniform int u_first;  // the draw's first photon (the caustic map's follow the global map's)
 uniform float u_power_scale;  // 1 / the share of the maps drawn (gi.display_fraction)
+// The splat grid's bands (render/pass_plan.hpp, SplatBands): with
+// u_band_cull 1 a disk whose quad lies wholly above or below the rows of
+// this draw's band, u_band_ndc (NDC y, a pixel wider each side), is dropped
+// before setup: llvmpipe pays ~1 us a disk a band in triangle setup and
+// binning, the scissor rejecting it only after that. 0 (volume photons):
+// no bands.
+uniform int u_band_cull;
+uniform vec2 u_band_ndc;
 
 // Level of detail (seed 001, section 6; GiSettings::lod_*): 0 groups: off.
 uniform int u_lod_groups;
@@ -86,6 +94,19 @@ void main() {
     float d2 = dot(c, c);
     s = radius * sqrt(d2 / max(d2 - radius * radius, 0.01 * d2));
   }
-  vec3 corner = c + s * (k.x * cam.cam_right.xyz + k.y * cam.cam_up.xyz);
-  gl_Position = cam.view_proj * vec4(corner, 1.0);
+  vec4 centre = cam.view_proj * vec4(c, 1.0);
+  vec4 across = cam.view_proj * vec4(s * cam.cam_right.xyz, 0.0);
+  vec4 up = cam.view_proj * vec4(s * cam.cam_up.xyz, 0.0);
+  if (u_band_cull != 0 && centre.w > 0.0) {
+    // The quad lies in the plane through c parallel to the image (right
+    // and up are across the view axis): its corners share centre.w.
+    float half_y = (abs(across.y) + abs(up.y)) / centre.w;
+    float y = centre.y / centre.w;
+    if (y + half_y < u_band_ndc.x || y - half_y > u_band_ndc.y) {
+      gl_Position = vec4(2.0, 2.0, 2.0, 1.0);  // outside the clip volume
+      v_power = vec3(0.0);
+      return;
+    }
+  }
+  gl_Position = centre + k.x * across + k.y * up;
 }
