@@ -58,8 +58,10 @@ class ServerProcess {
       dup2(fds[1], STDOUT_FILENO);
       close(fds[0]);
       close(fds[1]);
-      // K pipelined requests must all be admitted; 64 covers K = 36.
-      execl(binary.c_str(), binary.c_str(), "--port", "0", "--no-demo",
+      // K pipelined requests must all be admitted; 64 covers K = 36. No
+      // HTTP listener: the default port (7879) is another server's in a
+      // parallel test run (ctest -j: "bind: Address already in use").
+      execl(binary.c_str(), binary.c_str(), "--port", "0", "--http-port", "-1", "--no-demo",
             "--max-inflight-per-connection", "64", "--max-inflight-total", "128",
             static_cast<char*>(nullptr));
       std::perror("exec beamcast-server");

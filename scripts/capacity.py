@@ -19,7 +19,7 @@ import time
 
 
 def start_server(binary, extra):
-    p = subprocess.Popen([binary, "--port", "0", "--quiet-requests", *extra],
+    p = subprocess.Popen([binary, "--port", "0", "--http-port", "-1", "--quiet-requests", *extra],
                          stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     line = p.stdout.readline()
     if "listening on" not in line:

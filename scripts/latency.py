@@ -29,7 +29,7 @@ def main():
     if args.server:
         host, port = args.server.rsplit(":", 1)
     else:
-        proc = subprocess.Popen([args.binary, "--port", "0"], stdout=subprocess.PIPE,
+        proc = subprocess.Popen([args.binary, "--port", "0", "--http-port", "-1"], stdout=subprocess.PIPE,
                                 stderr=subprocess.DEVNULL, text=True)
         host, port = proc.stdout.readline().strip().rsplit(" ", 1)[1].rsplit(":", 1)
     client = beamcast_client.BeamcastClient(host, int(port))
