@@ -58,8 +58,8 @@ inline constexpr std::size_t kPassCount = static_cast<std::size_t>(PassId::kUpsc
 // bands of `band_h` rows side by side, each starting on a tile column
 // (`stride` texels apart): grid texel (x, y) is stored at
 // (x + (y / band_h) * stride, y % band_h). The passes that draw into it draw
-// once per band (viewport shifted, scissor on the band); the readers map
-// with the same formula (shaders/gi_surface.glsl's splat_texel). One band is
+// once per band (viewport shifted, scissor on the band); the reader,
+// gi_resolve.frag's corrected(), maps with the same formula. One band is
 // the plain layout; a GPU gains nothing from bands and loses nothing.
 struct SplatBands {
   int w = 0, h = 0;  // the grid, in splat pixels
@@ -70,16 +70,18 @@ struct SplatBands {
 };
 inline constexpr int kLlvmpipeTile = 64;
 inline constexpr int kSplatTiles = 4;
+// The fewest bands whose tiles (tile columns a band x bands x tile rows a
+// band) reach kSplatTiles, bands of at least 8 rows (each band costs a
+// draw's vertices and binning).
 inline SplatBands splat_bands(int w, int h) {
   auto tiles = [](int n) { return (n + kLlvmpipeTile - 1) / kLlvmpipeTile; };
   SplatBands b{w, h, 1, h, 0};
-  const int have = tiles(w) * tiles(h);
-  if (have >= kSplatTiles) return b;
-  // Bands of at least 8 rows (the binning's cost per draw).
-  b.bands = std::max(1, std::min((kSplatTiles + have - 1) / have, h / 8));
-  b.band_h = (h + b.bands - 1) / b.bands;
-  b.bands = (h + b.band_h - 1) / b.band_h;
-  b.stride = tiles(w) * kLlvmpipeTile;
+  for (int n = 1; n <= std::max(1, h / 8); ++n) {
+    b.band_h = (h + n - 1) / n;
+    b.bands = (h + b.band_h - 1) / b.band_h;
+    if (tiles(w) * b.bands * tiles(b.band_h) >= kSplatTiles) break;
+  }
+  if (b.bands > 1) b.stride = tiles(w) * kLlvmpipeTile;
   return b;
 }
 

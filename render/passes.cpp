@@ -52,7 +52,8 @@ void FrameTargets::ensure(const FramePlan& plan, int render_w, int render_h, int
     bits_ = bits;
     layers_ = layer_count;
     splat_scale_ = splat_scale;
-    splat_bands_ = beamcast::splat_bands(splat_size(render_w, splat_scale), splat_size(render_h, splat_scale));
+    splat_bands_ = beamcast::splat_bands(splat_size(render_w, splat_scale),
+                                         splat_size(render_h, splat_scale));
   }
   for (const TargetDecl* decl : plan.targets) {
     if (find(decl->name)) continue;

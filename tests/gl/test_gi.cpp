@@ -162,11 +162,23 @@ TEST(Gi, SplattingEqualsTheCpuEstimatorOnTheSamePhotons) {
   }
 }
 
-// The splat grid's band layout (render/passes.hpp): every grid texel has
-// its own texel of the texture, and each band starts on a tile column of its
-// own, so grids of fewer than kSplatTiles tiles reach that many tiles (or
-// one band per 8 rows).
+// The splat grid's band layout (render/pass_plan.hpp, SplatBands): every
+// grid texel has its own texel of the texture, each band starts on a tile
+// column of its own, and a grid of fewer than kSplatTiles llvmpipe tiles
+// reaches kSplatTiles tiles (or as many as bands of 8 rows or more allow).
 TEST(Gi, SplatBandsMapEveryGridTexelToItsOwnTexel) {
+  // Known layouts: 512^2 at splat_scale 8, 128^2 at 4, 512^2 at 4, a
+  // non-square grid, and one too short for bands.
+  struct Known {
+    int w, h, bands, band_h;
+  };
+  for (const Known k : {Known{64, 64, 4, 16}, Known{32, 32, 4, 8}, Known{128, 128, 1, 128},
+                        Known{100, 30, 2, 15}, Known{16, 12, 1, 12}}) {
+    const SplatBands b = splat_bands(k.w, k.h);
+    EXPECT_EQ(b.bands, k.bands) << k.w << "x" << k.h;
+    EXPECT_EQ(b.band_h, k.band_h) << k.w << "x" << k.h;
+  }
+  auto tiles = [](int n) { return (n + kLlvmpipeTile - 1) / kLlvmpipeTile; };
   for (int w = 1; w <= 200; w += 7) {
     for (int h = 1; h <= 200; h += 5) {
       const SplatBands b = splat_bands(w, h);
@@ -177,13 +189,10 @@ TEST(Gi, SplatBandsMapEveryGridTexelToItsOwnTexel) {
       if (b.bands > 1) {
         EXPECT_EQ(b.stride % kLlvmpipeTile, 0);
         EXPECT_GE(b.stride, w);
+        EXPECT_GE(b.band_h, 8);
       }
-      const int tiles_x = (w + kLlvmpipeTile - 1) / kLlvmpipeTile;
-      const int tiles_y = (h + kLlvmpipeTile - 1) / kLlvmpipeTile;
-      if (tiles_x * tiles_y >= kSplatTiles) EXPECT_EQ(b.bands, 1);
-      else EXPECT_EQ(b.bands, std::max(1, std::min((kSplatTiles + tiles_x * tiles_y - 1) /
-                                                       (tiles_x * tiles_y), h / 8)));
       std::vector<char> used(static_cast<std::size_t>(b.texture_w()) * b.band_h, 0);
+      std::vector<std::pair<int, int>> touched;  // llvmpipe tiles the texels fall in
       for (int y = 0; y < h; ++y) {
         for (int x = 0; x < w; ++x) {
           const int tx = x + (y / b.band_h) * b.stride, ty = y % b.band_h;
@@ -191,8 +200,15 @@ TEST(Gi, SplatBandsMapEveryGridTexelToItsOwnTexel) {
           char& u = used[static_cast<std::size_t>(ty) * b.texture_w() + tx];
           ASSERT_EQ(u, 0);
           u = 1;
+          const std::pair<int, int> tile{tx / kLlvmpipeTile, ty / kLlvmpipeTile};
+          if (std::find(touched.begin(), touched.end(), tile) == touched.end()) {
+            touched.push_back(tile);
+          }
         }
       }
+      // At most h / 8 bands of one tile row each: tiles(w) x (h / 8) tiles.
+      EXPECT_GE(static_cast<int>(touched.size()),
+                std::min(kSplatTiles, tiles(w) * std::max(1, h / 8)));
     }
   }
 }
