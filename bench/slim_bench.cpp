@@ -76,6 +76,10 @@ Image coverage_image(const SlimPixels& gpu, const SlimPixels& ref) {
   return img;
 }
 
+const char* evaluation_name(SlimEvaluation e) {
+  return e == SlimEvaluation::kField ? "field" : e == SlimEvaluation::kPatch ? "patch" : "blend";
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
@@ -117,6 +121,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
                                                         : std::vector<double>{0.25, 1.0, 4.0, 16.0};
   for (double z : zooms) {
     settings.push_back({"zoom", with(2.0, 0.25, true), z});
+    settings.push_back({"zoom, patch", with(2.0, 0.25, true, SlimEvaluation::kPatch), z});
     settings.push_back({"zoom, no 2nd stage", with(2.0, 0.25, false), z});
     settings.push_back({"zoom, seed's blend", with(2.0, 0.25, true, SlimEvaluation::kBlend), z});
     settings.push_back(
@@ -174,6 +179,11 @@ int run_slim_bench(const SlimBenchOptions& opts) {
     const double model_size = length(box.hi - box.lo);
     std::map<double, SlimPixels> references;
     for (const Setting& st : settings) {
+      if (!opts.evaluations.empty() &&
+          std::find(opts.evaluations.begin(), opts.evaluations.end(),
+                    evaluation_name(st.slim.evaluation)) == opts.evaluations.end()) {
+        continue;
+      }
       Scene scene = base;
       scene.slim = st.slim;
       scene.cameras = {camera_for(box, st.zoom, size)};
@@ -205,7 +215,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
       }
       const SlimPixels pts = slim_from_surface(last.targets["slim_surface"], size, size);
       const SlimErrors e = compare_slim(pts, ref->second, model_size);
-      const char* eval_name = st.slim.evaluation == SlimEvaluation::kField ? "field" : "blend";
+      const char* eval_name = evaluation_name(st.slim.evaluation);
       if (opts.images && st.knob.rfind("zoom", 0) == 0) {
         char name[256];
         std::snprintf(name, sizeof name, "%s_zoom%g_%s_%s.png", model.name.c_str(), st.zoom,

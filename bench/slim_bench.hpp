@@ -27,6 +27,8 @@ struct SlimBenchOptions {
   std::vector<double> zooms;  // empty: 0.25, 1, 4, 16 (quick: 0.25, 1, 4)
   bool zoom_only = false;     // skip the S and t rows
   bool no_generated = false;  // skip the generated sphere and torus
+  // Only the rows of these evaluations ("field", "patch", "blend"); empty: all.
+  std::vector<std::string> evaluations;
   // SLIM model files (JSON or binary, e.g. from `beamcast slim fit`) besides
   // the generated sphere and torus.
   std::vector<std::filesystem::path> models;

@@ -142,6 +142,9 @@ void add_bench_command(CLI::App& app) {
   slim->add_flag("--zoom-only", sopts->zoom_only, "Only the zoom rows (not the S and t rows)");
   slim->add_flag("--no-generated", sopts->no_generated,
                  "Only the --model files (not the generated sphere and torus)");
+  slim->add_option("--evaluation", sopts->evaluations,
+                   "Only the rows of this slim.evaluation (repeatable: field, patch, blend)")
+      ->check(CLI::IsMember({"field", "patch", "blend"}));
   slim->add_flag("--images", sopts->images,
                  "Coverage pictures of the zoom rows (grey: both, red: holes, blue: spurious)");
   slim->add_option("--model", sopts->models,

@@ -148,6 +148,11 @@ enum class SlimEvaluation : std::uint8_t {
   // The seed's: the points' weighted mean depth and normal (each point's own
   // height-field normal).
   kBlend,
+  // F evaluated as kField, without sampling: each sphere is drawn as one
+  // quad over its projection and each of its fragments solves where the
+  // centre ray meets the sphere's height field (a quadratic in closed
+  // form). S and the second stage do not apply.
+  kPatch,
 };
 
 struct SlimSettings {

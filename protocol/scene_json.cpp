@@ -833,7 +833,9 @@ SlimSettings parse_slim_settings(const Node& n) {
   if (auto v = o.optional("cull_backfaces")) s.cull_backfaces = read_bool(*v);
   if (auto v = o.optional("evaluation")) {
     s.evaluation = read_enum<SlimEvaluation>(
-        *v, {{"field", SlimEvaluation::kField}, {"blend", SlimEvaluation::kBlend}});
+        *v, {{"field", SlimEvaluation::kField},
+            {"blend", SlimEvaluation::kBlend},
+            {"patch", SlimEvaluation::kPatch}});
   }
   return s;
 }

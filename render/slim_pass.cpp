@@ -166,6 +166,8 @@ SlimResources::SlimResources(const Scene& scene) {
     d.p2[0] = static_cast<float>(s.poly.c[4]);
     d.p2[1] = static_cast<float>(s.poly.c[5]);
     d.p2[2] = static_cast<float>(s.crease);
+    // The patch's normal cone (slim_patch.vert's backface cull).
+    d.p2[3] = static_cast<float>(std::atan(max_slope(s)));
     d.q2[0] = static_cast<float>(s.poly2.c[4]);
     d.q2[1] = static_cast<float>(s.poly2.c[5]);
     put(d.albedo, occ.albedo, static_cast<double>(occ.material.type));
@@ -187,6 +189,10 @@ SlimResources::SlimResources(const Scene& scene) {
   glVertexArrayAttribBinding(id, 0, 0);
   glVertexArrayBindingDivisor(id, 0, 1);  // one sphere per instance: the command's base instance
   gl_check("SlimResources");
+}
+
+void SlimResources::plan_patches(std::size_t views) {
+  slots_.assign(views, static_cast<std::int64_t>(spheres_.size()));
 }
 
 void SlimResources::plan_views(const std::vector<Camera>& cams, const std::vector<CameraBasis>& bases,
@@ -236,25 +242,28 @@ constexpr float kSlimFieldStep = 2.0f;
 // Passes 1 and 2: every sphere's points, one indirect command each, per view.
 class SlimPointsPass final : public Pass {
  public:
-  explicit SlimPointsPass(bool depth)
-      : depth_(depth), program_(depth ? "slim_depth" : "slim_accumulate") {}
+  explicit SlimPointsPass(bool depth) : depth_(depth) {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     SlimResources* slim = ctx.resources.slim();
     if (!slim || slim->sphere_count() == 0) return;
     const bool multi = ctx.views > 0;
-    if (depth_) {  // the first of the slim passes plans the frame's samples
+    const bool patch = ctx.scene.slim.evaluation == SlimEvaluation::kPatch;
+    const std::string name = depth_ ? "slim_depth" : "slim_accumulate";
+    ProgramPair& program = programs_.get(patch ? name + "_patch" : name);
+    if (depth_ && patch) slim->plan_patches(multi ? ctx.views : 1);
+    if (depth_ && !patch) {  // the first of the slim passes plans the frame's samples
       if (multi) {
         slim->plan_views(*ctx.view_cameras, *ctx.view_bases, ctx.scene.slim);
       } else {
         slim->plan_views({ctx.camera}, {ctx.basis}, ctx.scene.slim);
       }
     }
-    glUseProgram(program_.get(multi));
+    glUseProgram(program.get(multi));
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     if (!depth_) {
       glBindTextureUnit(1, ctx.targets.texture("slim_near"));
       glBindTextureUnit(2, ctx.targets.texture("slim_radius"));
-      glUniform1f(program_.uniform(multi, "u_threshold"),
+      glUniform1f(program.uniform(multi, "u_threshold"),
                   static_cast<float>(ctx.scene.slim.depth_threshold));
     }
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, slim->sphere_buffer());
@@ -265,11 +274,12 @@ class SlimPointsPass final : public Pass {
     glDisable(GL_CULL_FACE);
     // Field evaluation: points cover the pixels their sample can stand for
     // (slim_points.vert sets the size); the seed's blend: single pixels.
-    const bool field = ctx.scene.slim.evaluation == SlimEvaluation::kField;
-    glUniform1i(program_.uniform(multi, "u_field"), field ? 1 : 0);
-    glUniform1f(program_.uniform(multi, "u_cell_diag"),
+    const bool field = ctx.scene.slim.evaluation != SlimEvaluation::kBlend;
+    glUniform1i(program.uniform(multi, "u_field"), field ? 1 : 0);
+    glUniform1f(program.uniform(multi, "u_cell_diag"),
                 static_cast<float>(slim_cell_diagonal(ctx.scene.slim)));
-    if (!depth_) glUniform1f(program_.uniform(multi, "u_step"), kSlimFieldStep);
+    if (!depth_) glUniform1f(program.uniform(multi, "u_step"), kSlimFieldStep);
+    glUniform1i(program.uniform(multi, "u_cull_backfaces"), ctx.scene.slim.cull_backfaces ? 1 : 0);
     if (field) {
       glEnable(GL_PROGRAM_POINT_SIZE);
     } else {
@@ -280,9 +290,14 @@ class SlimPointsPass final : public Pass {
     glBlendFunc(GL_ONE, GL_ONE);
     glBlendEquation(depth_ ? GL_MIN : GL_FUNC_ADD);
     const auto n = static_cast<GLsizei>(slim->sphere_count());
-    const GLint grid_base = program_.uniform(multi, "u_grid_base");
+    const GLint grid_base = program.uniform(multi, "u_grid_base");
     int view = 0;
-    for_each_view_offset(ctx, self, program_, "u_offset", slim->anchor(), [&] {
+    if (patch) glBindVertexArray(ctx.empty_vao);
+    for_each_view_offset(ctx, self, program, "u_offset", slim->anchor(), [&] {
+      if (patch) {  // one quad per sphere (slim_patch.vert)
+        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, n);
+        return;
+      }
       glUniform1i(grid_base, view * n);
       const auto offset = static_cast<std::intptr_t>(view) * n * 16;
       glMultiDrawArraysIndirect(GL_POINTS, reinterpret_cast<const void*>(offset), n, 0);
@@ -297,7 +312,7 @@ class SlimPointsPass final : public Pass {
 
  private:
   bool depth_;
-  ProgramPair program_;
+  LazyPrograms programs_;
 };
 
 // Pass 3: normalization into the surfaces' targets.
@@ -310,7 +325,7 @@ class SlimResolvePass final : public Pass {
     glUseProgram(program_.get(multi));
     glUniform1i(program_.uniform(multi, "u_gi"), self.id == PassId::kSlimGbuffer ? 1 : 0);
     glUniform1i(program_.uniform(multi, "u_field"),
-                ctx.scene.slim.evaluation == SlimEvaluation::kField ? 1 : 0);
+                ctx.scene.slim.evaluation != SlimEvaluation::kBlend ? 1 : 0);
     glBindTextureUnit(0, ctx.targets.texture("slim_sum_normal"));
     glBindTextureUnit(1, ctx.targets.texture("slim_sum_albedo"));
     glBindTextureUnit(2, ctx.targets.texture("slim_sum_field"));

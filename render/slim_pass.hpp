@@ -70,6 +70,9 @@ class SlimResources {
   // of each view (what the draws process; culled slots included).
   void plan_views(const std::vector<Camera>& cams, const std::vector<CameraBasis>& bases,
                   const SlimSettings& settings);
+  // slim.evaluation "patch" draws one quad per sphere and view, planned on
+  // the GPU (slim_patch.vert): only the slots are recorded (one a sphere).
+  void plan_patches(std::size_t views);
   GLuint command_buffer() const { return command_buffer_.get(); }
   GLuint grid_buffer() const { return grid_ssbo_.get(); }
   // Sample slots drawn per frame in the last plan_views (each view's sum).

@@ -84,3 +84,68 @@ float slim_field_step(float near, float radius) {
   float footprint = 2.0 * cam.cam_right.w / cam.viewport.y * (is_orthographic() ? 1.0 : near);
   return min(u_step * footprint, 0.05 * radius);
 }
+
+// slim.evaluation "patch": where the centre ray `ray` first meets sphere
+// s's height field (centre c, camera-relative) inside the sphere, in closed
+// form. Along the ray from its closest point m to the centre, l(x) = m + x d
+// (local frame, x within the half chord), w - f(u, v) is the quadratic
+// -(a x^2 + b x + q) with a = f's second-order part along d, b = grad f(m) . d
+// - d_w, q = f(m) - m_w; its roots are taken from the cancellation-free
+// pair. On a crease a root of one polynomial counts where the min/max rule
+// takes that polynomial there. t: the ray distance of the point.
+float slim_first_root(vec4 p, vec4 e, vec3 m, vec3 d, float half_chord, float lo, vec4 p_other,
+                      vec4 e_other, float crease) {
+  vec2 g;
+  float fm = poly(p, e, m.xy, g);
+  float a = p.x * d.x * d.x + p.y * d.x * d.y + p.z * d.y * d.y;
+  float b = dot(g, d.xy) - d.z;
+  float q = fm - m.z;
+  float x1 = 1e30, x2 = 1e30;
+  float disc = b * b - 4.0 * a * q;
+  if (abs(a) * half_chord <= 1e-6 * abs(b)) {
+    x1 = -q / b;  // linear along the ray
+  } else if (disc >= 0.0) {
+    float k = -0.5 * (b + (b < 0.0 ? -sqrt(disc) : sqrt(disc)));
+    x1 = k / a;
+    x2 = k != 0.0 ? q / k : 1e30;
+  }
+  float lo_x = min(x1, x2), hi_x = max(x1, x2);
+  float best = 1e30;
+  for (int i = 0; i < 2; ++i) {
+    float x = i == 0 ? lo_x : hi_x;
+    if (!(x > max(-half_chord, lo) && x < half_chord)) continue;
+    if (crease > 0.5) {  // the other polynomial must not take over there
+      vec3 l = m + x * d;
+      vec2 go;
+      float fo = poly(p_other, e_other, l.xy, go);
+      float fs = l.z;  // on this polynomial's surface
+      if (crease < 1.5 ? fo < fs : fo > fs) continue;
+    }
+    best = x;
+    break;
+  }
+  return best;
+}
+
+bool slim_crossing(SlimGpu s, vec3 c, ViewRay ray, out float t) {
+  t = 0.0;
+  float r = s.center.w;
+  vec3 o = ray.origin - c;
+  float tc = -dot(o, ray.dir);
+  vec3 mw = o + tc * ray.dir;
+  float d2 = dot(mw, mw);
+  if (d2 >= r * r) return false;
+  float half_chord = sqrt(r * r - d2);
+  vec3 m = vec3(dot(mw, s.axis_u.xyz), dot(mw, s.axis_v.xyz), dot(mw, s.axis_w.xyz));
+  vec3 d = vec3(dot(ray.dir, s.axis_u.xyz), dot(ray.dir, s.axis_v.xyz), dot(ray.dir, s.axis_w.xyz));
+  float lo = ray.t_min - tc;  // before the near plane
+  float crease = s.p2.z;
+  float x = slim_first_root(s.p1, s.p2, m, d, half_chord, lo, s.q1, s.q2, crease);
+  if (crease > 0.5) {
+    float x2 = slim_first_root(s.q1, s.q2, m, d, half_chord, lo, s.p1, s.p2, crease);
+    x = min(x, x2);
+  }
+  if (x >= 1e29) return false;
+  t = tc + x;
+  return true;
+}
