@@ -63,6 +63,9 @@ const std::vector<TargetDecl>& target_catalog() {
       // where none.
       {"slim_near", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
       {"slim_radius", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
+      // slim.evaluation "patch": slim_near as a depth buffer, which culls
+      // the accumulate pass's hidden patches before their fragments run.
+      {"slim_zbuf", TargetFormat::kDepth32f, TargetSize::kRender, TargetClear::kFarDepth},
       {"slim_sum_normal", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       {"slim_sum_albedo", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       {"slim_sum_field", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
@@ -113,7 +116,7 @@ const std::vector<PassDecl>& pass_catalog() {
        [](const PlanInput& in) { return has_slim(in.scene); },
        {"view_depth", "slim_near", "slim_radius"}, {},
        {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight",
-        "slim_sum_field2", "slim_sum_weight2"},
+        "slim_sum_field2", "slim_sum_weight2", "slim_zbuf"},
        {"slim"}},
       {PassId::kSlimResolve, "slim_resolve",
        [](const PlanInput& in) { return has_slim(in.scene) && !in.scene.has_gi(); },

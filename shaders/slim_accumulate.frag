@@ -13,11 +13,7 @@ layout(binding = 0) uniform VIEW_SAMPLER u_scene_depth;
 layout(binding = 1) uniform VIEW_SAMPLER u_near;
 layout(binding = 2) uniform VIEW_SAMPLER u_radius;
 uniform float u_threshold;  // slim.depth_threshold, in units of the point's sphere radius
-#ifdef SLIM_PATCH
-const int u_field = 1;  // the patch variant evaluates the field
-#else
 uniform int u_field;
-#endif
 uniform vec3 u_offset;  // slim anchor minus eye
 
 in float v_weight;
@@ -79,11 +75,7 @@ void main() {
   vec3 c = s.center.xyz + u_offset;
   ViewRay ray = view_ray(gl_FragCoord.xy);
   float t;
-#ifdef SLIM_PATCH
-  if (!slim_crossing(s, c, ray, t)) discard;
-#else
   if (!slim_owner(s, c, ray, v_point, v_normal, v_cell, t)) discard;
-#endif
   float depth = t * ray.cos_axis;
   if (depth >= VIEW_TEXEL(u_scene_depth, px).r) discard;
   if (depth > near + u_threshold * v_radius) discard;  // a hidden layer

@@ -7,11 +7,7 @@
 // and the smallest radius of those spheres (slim_radius): the scale over
 // which F bends, which bounds the accumulate pass's step along the ray.
 layout(binding = 0) uniform VIEW_SAMPLER u_scene_depth;
-#ifdef SLIM_PATCH
-const int u_field = 1;  // the patch variant evaluates the field
-#else
 uniform int u_field;
-#endif
 uniform vec3 u_offset;  // slim anchor minus eye
 
 in float v_depth;
@@ -31,11 +27,7 @@ void main() {
     SlimGpu s = spheres[v_sphere];
     ViewRay ray = view_ray(gl_FragCoord.xy);
     float t;
-#ifdef SLIM_PATCH
-    if (!slim_crossing(s, s.center.xyz + u_offset, ray, t)) discard;
-#else
     if (!slim_owner(s, s.center.xyz + u_offset, ray, v_point, v_normal, v_cell, t)) discard;
-#endif
     depth = t * ray.cos_axis;
     if (depth < cam.viewport.z) discard;  // before the near plane
   }

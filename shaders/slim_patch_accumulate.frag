@@ -1,0 +1,40 @@
+// SLIM pass 2, slim.evaluation "patch": each sphere whose patch the centre
+// ray meets within the depth threshold behind the nearest depth adds its
+// terms of F at x1 (the nearest depth) and x2 (a step behind), as
+// slim_accumulate.frag's field evaluation.
+// The patch's box is culled by the depth test against slim_near (slim_zbuf,
+// slim_near_depth.frag) before this runs.
+layout(early_fragment_tests) in;
+layout(binding = 0) uniform VIEW_SAMPLER u_scene_depth;
+layout(binding = 1) uniform VIEW_SAMPLER u_near;
+layout(binding = 2) uniform VIEW_SAMPLER u_radius;
+uniform float u_threshold;  // slim.depth_threshold, in units of the sphere's radius
+
+layout(location = 0) out vec4 out_normal;  // unused by the field evaluation
+layout(location = 1) out vec4 out_albedo;  // (w(x1) albedo, 0)
+layout(location = 2) out vec4 out_field;   // (w grad h + h grad w, w h) at x1
+layout(location = 3) out vec4 out_weight;  // (grad w, w) at x1
+layout(location = 4) out vec4 out_field2;  // the same at x2
+layout(location = 5) out vec4 out_weight2;
+
+void main() {
+  select_view(view_index());
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  float near = VIEW_TEXEL(u_near, px).r;
+  if (near >= 1e29) discard;  // no patch reaches this pixel
+  float z;
+  if (!patch_crossing(z)) discard;
+  if (z >= VIEW_TEXEL(u_scene_depth, px).r) discard;
+  if (z > near + u_threshold * v_p2.w) discard;  // a hidden layer
+  float step = slim_field_step(near, VIEW_TEXEL(u_radius, px).r);
+  vec4 t1, t2, t3, t4;
+  bool any = patch_terms(ray_org + near * ray_dir, t1, t2);
+  any = patch_terms(ray_org + (near + step) * ray_dir, t3, t4) || any;
+  if (!any) discard;
+  out_normal = vec4(0.0);
+  out_albedo = vec4(t2.w * v_albedo, 0.0);
+  out_field = t1;
+  out_weight = t2;
+  out_field2 = t3;
+  out_weight2 = t4;
+}
