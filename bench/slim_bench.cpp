@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <numbers>
@@ -212,10 +211,6 @@ int run_slim_bench(const SlimBenchOptions& opts) {
           if (p.name.rfind("slim", 0) == 0) s += p.gpu_ms;
         }
         slim_ms.push_back(s);
-        if (std::getenv("BEAMCAST_SLIM_PASSES")) {
-          for (const PassTiming& p : frames[0].passes) std::fprintf(stderr, "%s %.1f  ", p.name.c_str(), p.gpu_ms);
-          std::fprintf(stderr, "\n");
-        }
         last = std::move(frames[0]);
       }
       const SlimPixels pts = slim_from_surface(last.targets["slim_surface"], size, size);

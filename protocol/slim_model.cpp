@@ -76,6 +76,44 @@ Vec3 SlimSphere::surface_normal(double u, double v) const {
   return normalize(rotate(rotation, {-g[0], -g[1], 1.0}));
 }
 
+double slim_max_slope(const SlimSphere& s) {
+  auto bound = [&](const SlimPoly& p) {
+    const auto& c = p.c;
+    const double du = (2.0 * std::abs(c[0]) + std::abs(c[1])) * s.radius + std::abs(c[3]);
+    const double dv = (std::abs(c[1]) + 2.0 * std::abs(c[2])) * s.radius + std::abs(c[4]);
+    return std::hypot(du, dv);
+  };
+  const double a = bound(s.poly);
+  return s.crease == SlimCrease::kNone ? a : std::max(a, bound(s.poly2));
+}
+
+std::array<double, 2> slim_height_range(const SlimSphere& s) {
+  // The patch's points on a G x G grid of (u, v) cell centres, h apart,
+  // kept if within (1 + slope) h of the sphere: every point of the patch
+  // inside the sphere has a grid point within h / 2 in u and in v, whose
+  // point lies within (1 + slope) h of it and whose height differs by at
+  // most slope x h; hence the pad.
+  constexpr int kGrid = 32;
+  const double r = s.radius;
+  const double h = 2.0 * r / kGrid;
+  const double slope = slim_max_slope(s);
+  const double reach = r + (1.0 + slope) * h;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int i = 0; i < kGrid; ++i) {
+    const double u = -r + (i + 0.5) * h;
+    for (int j = 0; j < kGrid; ++j) {
+      const double v = -r + (j + 0.5) * h;
+      const double w = s.height(u, v);
+      if (u * u + v * v + w * w > reach * reach) continue;
+      lo = std::min(lo, w);
+      hi = std::max(hi, w);
+    }
+  }
+  if (!(lo <= hi)) return {-r, r};  // no grid point near: the whole sphere
+  const double pad = slope * h + 1e-3 * r;
+  return {std::clamp(lo - pad, -r, r), std::clamp(hi + pad, -r, r)};
+}
+
 Aabb slim_bounds(const std::vector<SlimSphere>& spheres) {
   Aabb b;
   for (const SlimSphere& s : spheres) {

@@ -71,6 +71,16 @@ inline double slim_weight(double q) {
   return s * s * s;
 }
 
+// A bound on the slope |grad f| of either polynomial over |u|, |v| <= r.
+double slim_max_slope(const SlimSphere& s);
+
+// [lo, hi] holding the local height w of every point of the sphere's patch
+// that lies inside the sphere (from a 32 x 32 grid of the height field,
+// padded by the slope bound times the grid step), within [-r, r]. The GPU
+// bounds each patch by the sphere within this slab (slim.evaluation
+// "patch").
+std::array<double, 2> slim_height_range(const SlimSphere& s);
+
 // The spheres' bounds (each sphere's box), empty for no spheres.
 Aabb slim_bounds(const std::vector<SlimSphere>& spheres);
 

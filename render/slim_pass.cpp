@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <numbers>
 #include <variant>
@@ -34,18 +32,6 @@ struct DrawCommand {  // DrawArraysIndirectCommand
   std::uint32_t count, instance_count, first, base_instance;
 };
 
-// The largest slope |grad f| of either polynomial over |u|, |v| <= r.
-double max_slope(const SlimSphere& s) {
-  auto bound = [&](const SlimPoly& p) {
-    const auto& c = p.c;
-    const double du = (2.0 * std::abs(c[0]) + std::abs(c[1])) * s.radius + std::abs(c[3]);
-    const double dv = (std::abs(c[1]) + 2.0 * std::abs(c[2])) * s.radius + std::abs(c[4]);
-    return std::hypot(du, dv);
-  };
-  const double a = bound(s.poly);
-  return s.crease == SlimCrease::kNone ? a : std::max(a, bound(s.poly2));
-}
-
 // True if every point of the sphere's patch faces away from the eye: its
 // normals lie within atan(max slope) of the local w axis, the directions
 // from the eye to its points within the sphere's angular radius of the
@@ -55,51 +41,10 @@ bool faces_away(const SlimSphere& sphere, const Vec3& to_centre, double distance
   if (!ortho && distance <= sphere.radius) return false;  // the eye is inside it
   const Vec3 w = sphere.to_world({0.0, 0.0, 1.0}) - sphere.center;
   const Vec3 view = ortho ? forward : (1.0 / distance) * to_centre;
-  const double alpha = std::atan(max_slope(sphere));
+  const double alpha = std::atan(slim_max_slope(sphere));
   const double beta = ortho ? 0.0 : std::asin(sphere.radius / distance);
   const double margin = 0.5 * std::numbers::pi - alpha - beta - 1e-3;
   return margin > 0.0 && dot(w, view) > std::cos(margin);
-}
-
-// [lo, hi] bounding the patch's local height w where it lies in the
-// sphere: each polynomial's range over the disc u^2 + v^2 <= r^2 (its
-// interior critical point and 720 points of the rim, padded by the rim
-// samples' worst miss, f'' along the rim times (step)^2 / 8), both
-// polynomials' on a crease, within [-r, r].
-std::array<double, 2> height_range(const SlimSphere& s) {
-  const double r = s.radius;
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  auto add = [&](const SlimPoly& p) {
-    const auto& c = p.c;
-    auto f = [&](double u, double v) {
-      return c[0] * u * u + c[1] * u * v + c[2] * v * v + c[3] * u + c[4] * v + c[5];
-    };
-    // Interior critical point: [2A B; B 2C] x = -[D E].
-    const double det = 4.0 * c[0] * c[2] - c[1] * c[1];
-    if (det != 0.0) {
-      const double u = (-2.0 * c[2] * c[3] + c[1] * c[4]) / det;
-      const double v = (c[1] * c[3] - 2.0 * c[0] * c[4]) / det;
-      if (u * u + v * v <= r * r) {
-        lo = std::min(lo, f(u, v));
-        hi = std::max(hi, f(u, v));
-      }
-    }
-    constexpr int kRim = 720;
-    const double step = 2.0 * std::numbers::pi / kRim;
-    const double curvature =
-        4.0 * (std::abs(c[0]) + std::abs(c[1]) + std::abs(c[2])) * r * r +
-        (std::abs(c[3]) + std::abs(c[4])) * r;
-    const double pad = curvature * step * step / 8.0;
-    for (int k = 0; k < kRim; ++k) {
-      const double w = f(r * std::cos(k * step), r * std::sin(k * step));
-      lo = std::min(lo, w - pad);
-      hi = std::max(hi, w + pad);
-    }
-  };
-  add(s.poly);
-  if (s.crease != SlimCrease::kNone) add(s.poly2);
-  const double margin = 1e-3 * r;
-  return {std::clamp(lo - margin, -r, r), std::clamp(hi + margin, -r, r)};
 }
 
 }  // namespace
@@ -178,11 +123,13 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
 SlimResources::SlimResources(const Scene& scene) {
   Aabb box;
   std::vector<const Occluder*> occluder_of;  // each sphere's occluder (its albedo)
+  std::vector<std::array<double, 2>> ranges;  // each sphere's height range
   for (const Occluder& occ : scene.occluders) {
     if (const auto* slim = std::get_if<SlimOccluder>(&occ.shape)) {
       for (const SlimSphere& s : slim->spheres()) {
         spheres_.push_back(&s);
         occluder_of.push_back(&occ);
+        ranges.push_back(slim->surface->height_ranges[&s - slim->spheres().data()]);
       }
       box.grow(slim->bounds());
     }
@@ -210,11 +157,11 @@ SlimResources::SlimResources(const Scene& scene) {
     d.p2[1] = static_cast<float>(s.poly.c[5]);
     d.p2[2] = static_cast<float>(s.crease);
     // The patch's normal cone (slim_patch.vert's backface cull).
-    d.p2[3] = static_cast<float>(std::atan(max_slope(s)));
+    d.p2[3] = static_cast<float>(std::atan(slim_max_slope(s)));
     d.q2[0] = static_cast<float>(s.poly2.c[4]);
     d.q2[1] = static_cast<float>(s.poly2.c[5]);
     // The patch's box in its frame, [-r, r]^2 x [lo, hi] (slim_patch.vert).
-    const auto range = height_range(s);
+    const auto& range = ranges[i];
     d.q2[2] = static_cast<float>(range[0]);
     d.q2[3] = static_cast<float>(range[1]);
     put(d.albedo, occ.albedo, static_cast<double>(occ.material.type));
@@ -346,14 +293,7 @@ class SlimPointsPass final : public Pass {
     }
     const bool depth_cull = patch && !depth_;
     for_each_view_offset(ctx, self, program, "u_offset", slim->anchor(), [&] {
-      if (patch) {  // one box per sphere (slim_patch.vert)
-        static const bool diag = std::getenv("BEAMCAST_SLIM_DIAG") != nullptr;
-        GLuint q[2] = {0, 0};
-        if (diag) {
-          glGenQueries(2, q);
-          glBeginQuery(0x82F4, q[0]);
-          glBeginQuery(GL_SAMPLES_PASSED, q[1]);
-        }
+      if (patch) {  // one rectangle per sphere (slim_patch.vert)
         if (depth_cull) {
           // slim_near into the depth buffer (slim_near_depth.frag), then
           // the rectangles depth-tested against it (slim_patch.vert).
@@ -361,8 +301,7 @@ class SlimPointsPass final : public Pass {
           glUseProgram(copy.get(multi));
           if (multi) glUniform1i(copy.uniform(true, "u_view"), view);
           glDisable(GL_BLEND);
-          glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-          for (GLuint b = 1; b < 6; ++b) glColorMaski(b, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+          glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
           glEnable(GL_DEPTH_TEST);
           glDepthFunc(GL_ALWAYS);
           glDepthMask(GL_TRUE);
@@ -379,16 +318,6 @@ class SlimPointsPass final : public Pass {
           glDisable(GL_DEPTH_TEST);
         }
         ++view;
-        if (diag) {
-          glEndQuery(0x82F4);
-          glEndQuery(GL_SAMPLES_PASSED);
-          GLuint64 a = 0, b = 0;
-          glGetQueryObjectui64v(q[0], GL_QUERY_RESULT, &a);
-          glGetQueryObjectui64v(q[1], GL_QUERY_RESULT, &b);
-          std::fprintf(stderr, "%s: fragments %llu passed %llu\n", depth_ ? "depth" : "accum",
-                       static_cast<unsigned long long>(a), static_cast<unsigned long long>(b));
-          glDeleteQueries(2, q);
-        }
         return;
       }
       glUniform1i(grid_base, view * n);

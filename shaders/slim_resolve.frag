@@ -5,10 +5,10 @@
 // slim.evaluation "blend" (the seed's): the points' weighted mean normal
 // and depth. "field": F's sums at two points of the centre ray, x1 at the
 // nearest depth (slim_near: where the ray meets the nearest patch) and x2
-// u_step pixel footprints behind; where sum w h changes sign between them
-// or nearly (its zero within one step outside), the zero of its linear
-// interpolation is the depth and the interpolated gradient the normal;
-// else x1 and F's gradient there.
+// u_step pixel footprints behind; where F = sum w h / sum w changes sign
+// between them or nearly (its zero within one step outside), the zero of
+// its linear interpolation is the depth and the sums interpolated there
+// give the normal; else x1 and F's gradient there.
 layout(binding = 0) uniform VIEW_SAMPLER u_sum_normal;
 layout(binding = 1) uniform VIEW_SAMPLER u_sum_albedo;
 layout(binding = 2) uniform VIEW_SAMPLER u_sum_field;
@@ -53,14 +53,18 @@ void main() {
     float near = VIEW_TEXEL(u_near, px).r;
     float radius = VIEW_TEXEL(u_radius, px).r;
     float step = slim_field_step(near, radius);
-    float lambda = sf.w / (sf.w - sf2.w);  // the zero of sum w h between x1 (0) and x2 (1)
+    // The zero of F = sum w h / sum w, linearly interpolated between x1 (0)
+    // and x2 (1). (Interpolating sum w h instead misplaces it where the
+    // weights change fast, at a support's rim: by up to a step.)
+    float f1 = sf.w / sw.w, f2 = sw2.w > 0.0 ? sf2.w / sw2.w : f1;
+    float lambda = f1 / (f1 - f2);
     vec4 f = sf;
     vec4 w = sw;
     depth = near;
     // The zero is taken within one step outside [x1, x2], or, where the
     // step is shorter than that bound, up to a tenth of the radius away.
     float reach = max(1.0, 0.1 * radius / step);
-    if (sw2.w > 0.0 && sf.w != sf2.w && lambda > -reach && lambda < 1.0 + reach) {
+    if (sw2.w > 0.0 && f1 != f2 && lambda > -reach && lambda < 1.0 + reach) {
       f = mix(sf, sf2, lambda);
       w = mix(sw, sw2, lambda);
       depth = near + lambda * step;

@@ -25,6 +25,8 @@ struct SlimSurface {
 
   const std::vector<SlimSphere> spheres;
   const Aabb box;
+  // Each sphere's slim_height_range (computed once, with the surface).
+  const std::vector<std::array<double, 2>> height_ranges;
   const SlimField field;  // points into `spheres`
 };
 
