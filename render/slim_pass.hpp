@@ -15,6 +15,13 @@
 // which bounds every pixel centre's distance to a sample by half a pixel
 // within the patch. Points are drawn with glMultiDrawArraysIndirect, one
 // command per sphere (its sample count; 0 when the sphere is culled).
+//
+// slim.evaluation "patch" (the default) samples nothing: each sphere is one
+// rectangle facing the eye that bounds its patch (slim_patch.vert), whose
+// fragments solve where their centre ray meets the height field
+// (slim_patch.glsl); the accumulate pass first writes slim_near into a
+// depth buffer (slim_zbuf) so that patches lying wholly behind the
+// threshold fail the early depth test.
 #pragma once
 
 #include <cstdint>
