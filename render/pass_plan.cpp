@@ -64,9 +64,10 @@ const std::vector<TargetDecl>& target_catalog() {
       {"slim_near", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
       {"slim_radius", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
       // slim.evaluation "patch": slim_near as a depth buffer, which culls
-      // the accumulate pass's hidden patches before their fragments run.
-      {"slim_zbuf", TargetFormat::kDepth32f, TargetSize::kRender, TargetClear::kFarDepth},
-      {"slim_sum_normal", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
+      // the accumulate pass's hidden patches before their fragments run
+      // (written over the surfaces' pixel bounds before each use; outside
+      // them no patch can be, so it is never cleared).
+      {"slim_zbuf", TargetFormat::kDepth32f, TargetSize::kRender, TargetClear::kNone},
       {"slim_sum_albedo", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       {"slim_sum_field", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       {"slim_sum_weight", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
@@ -115,18 +116,18 @@ const std::vector<PassDecl>& pass_catalog() {
       {PassId::kSlimAccumulate, "slim_accumulate",
        [](const PlanInput& in) { return has_slim(in.scene); },
        {"view_depth", "slim_near", "slim_radius"}, {},
-       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight",
-        "slim_sum_field2", "slim_sum_weight2", "slim_zbuf"},
+       {"slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_sum_field2",
+        "slim_sum_weight2", "slim_zbuf"},
        {"slim"}},
       {PassId::kSlimResolve, "slim_resolve",
        [](const PlanInput& in) { return has_slim(in.scene) && !in.scene.has_gi(); },
-       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_near",
+       {"slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_near",
         "slim_sum_field2", "slim_sum_weight2", "slim_radius"},
        {},
        {"hdr", "view_depth", "slim_surface"}, {}},
       {PassId::kSlimGbuffer, "slim_gbuffer",
        [](const PlanInput& in) { return has_slim(in.scene) && in.scene.has_gi(); },
-       {"slim_sum_normal", "slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_near",
+       {"slim_sum_albedo", "slim_sum_field", "slim_sum_weight", "slim_near",
         "slim_sum_field2", "slim_sum_weight2", "slim_radius"},
        {},
        {"hdr", "view_depth", "slim_surface", "gb_normal", "gb_albedo"}, {}},

@@ -365,10 +365,6 @@ class DirectPass final : public Pass {
 constexpr float kSplatMinCos = 0.906f;
 constexpr float kSplatMaxPlane = 0.1f;
 
-// A rectangle of pixels, lower-left and upper-right inclusive, in window
-// coordinates (y up): gi_resolve tests a quad light's outline only there.
-constexpr std::array<int, 4> kEveryPixel = {-(1 << 30), -(1 << 30), 1 << 30, 1 << 30};
-
 // The pixels a quad light's projection can touch, 2 pixels wider on each
 // side (a pixel meets the light only if its square meets the light's
 // projection; the outline test's rays are within the pixel); every pixel if
@@ -376,21 +372,7 @@ constexpr std::array<int, 4> kEveryPixel = {-(1 << 30), -(1 << 30), 1 << 30, 1 <
 std::array<int, 4> light_pixel_rect(const QuadLight& q, const Camera& cam, const CameraBasis& b) {
   const Vec3 corners[4] = {q.corner, q.corner + q.edge_u, q.corner + q.edge_v,
                            q.corner + q.edge_u + q.edge_v};
-  std::array<double, 2> lo{std::numeric_limits<double>::infinity(),
-                           std::numeric_limits<double>::infinity()};
-  std::array<double, 2> hi{-lo[0], -lo[1]};
-  for (const Vec3& c : corners) {
-    const auto w = window_position(cam, b, c);
-    if (!w) return kEveryPixel;
-    for (int a = 0; a < 2; ++a) {
-      lo[a] = std::min(lo[a], (*w)[a]);
-      hi[a] = std::max(hi[a], (*w)[a]);
-    }
-  }
-  auto pixel = [](double x, int margin) {
-    return static_cast<int>(std::clamp(std::floor(x) + margin, -1e9, 1e9));
-  };
-  return {pixel(lo[0], -2), pixel(lo[1], -2), pixel(hi[0], 2), pixel(hi[1], 2)};
+  return pixel_rect(corners, cam, b, 2);
 }
 
 // The splats' sum (gi_indirect) into hdr, upsampled, each splat pixel
@@ -795,6 +777,25 @@ std::unique_ptr<Pass> make_pass(PassId id) {
       return std::make_unique<UpscalePass>();
   }
   throw GlError("make_pass: unknown pass id");
+}
+
+std::array<int, 4> pixel_rect(std::span<const Vec3> points, const Camera& cam, const CameraBasis& b,
+                              int margin) {
+  std::array<double, 2> lo{std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::infinity()};
+  std::array<double, 2> hi{-lo[0], -lo[1]};
+  for (const Vec3& p : points) {
+    const auto w = window_position(cam, b, p);
+    if (!w) return kEveryPixel;
+    for (int a = 0; a < 2; ++a) {
+      lo[a] = std::min(lo[a], (*w)[a]);
+      hi[a] = std::max(hi[a], (*w)[a]);
+    }
+  }
+  auto pixel = [](double x, int m) {
+    return static_cast<int>(std::clamp(std::floor(x) + m, -1e9, 1e9));
+  };
+  return {pixel(lo[0], -margin), pixel(lo[1], -margin), pixel(hi[0], margin), pixel(hi[1], margin)};
 }
 
 }  // namespace beamcast

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -236,5 +237,15 @@ void set_photon_lod(ProgramPair& program, bool multiview, const GiSettings& gi);
 // The executor of a catalog pass; programs are compiled here, so a GL context
 // must be current. Multi-view programs are compiled on first use.
 std::unique_ptr<Pass> make_pass(PassId id);
+
+// A rectangle of pixels, lower-left and upper-right inclusive, in window
+// coordinates (y up); kEveryPixel: no bound.
+inline constexpr std::array<int, 4> kEveryPixel = {-(1 << 30), -(1 << 30), 1 << 30, 1 << 30};
+// The pixels the projections of `points` can touch, `margin` pixels wider on
+// each side (their convex hull's projection when every point lies in front
+// of the near plane); kEveryPixel if a point has no place in the image (at
+// or behind the near plane's depth).
+std::array<int, 4> pixel_rect(std::span<const Vec3> points, const Camera& cam, const CameraBasis& b,
+                              int margin);
 
 }  // namespace beamcast

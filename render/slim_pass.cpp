@@ -134,6 +134,7 @@ SlimResources::SlimResources(const Scene& scene) {
       box.grow(slim->bounds());
     }
   }
+  box_ = box;
   if (!box.empty()) anchor_ = 0.5 * (box.lo + box.hi);
   std::vector<SlimGpu> data(spheres_.size());
   std::vector<std::uint32_t> index(spheres_.size());
@@ -229,6 +230,26 @@ void SlimResources::plan_views(const std::vector<Camera>& cams, const std::vecto
 
 namespace {
 
+// Full-screen draws of the slim passes (the accumulate pass's depth copy,
+// the resolve) touch only the pixels the SLIM surfaces' bounds can reach
+// in view `view` (-1: the single camera): a scissor box, one pixel wider.
+void scissor_to_slim(const FrameContext& ctx, const SlimResources& slim, int view) {
+  const Camera& cam = view < 0 ? ctx.camera : (*ctx.view_cameras)[static_cast<std::size_t>(view)];
+  const CameraBasis& b = view < 0 ? ctx.basis : (*ctx.view_bases)[static_cast<std::size_t>(view)];
+  const Aabb& box = slim.bounds();
+  std::array<Vec3, 8> corners;
+  for (int k = 0; k < 8; ++k) {
+    corners[static_cast<std::size_t>(k)] = {(k & 1) ? box.hi[0] : box.lo[0],
+                                            (k & 2) ? box.hi[1] : box.lo[1],
+                                            (k & 4) ? box.hi[2] : box.lo[2]};
+  }
+  const std::array<int, 4> r = pixel_rect(corners, cam, b, 1);
+  const int x0 = std::clamp(r[0], 0, cam.width), y0 = std::clamp(r[1], 0, cam.height);
+  const int x1 = std::clamp(r[2] + 1, 0, cam.width), y1 = std::clamp(r[3] + 1, 0, cam.height);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(x0, y0, std::max(0, x1 - x0), std::max(0, y1 - y0));
+}
+
 // Field evaluation: the second point of the centre ray lies this many pixel
 // footprints behind the first (the nearest depth).
 constexpr float kSlimFieldStep = 2.0f;
@@ -305,7 +326,9 @@ class SlimPointsPass final : public Pass {
           glEnable(GL_DEPTH_TEST);
           glDepthFunc(GL_ALWAYS);
           glDepthMask(GL_TRUE);
+          scissor_to_slim(ctx, *slim, multi ? view : -1);
           glDrawArrays(GL_TRIANGLES, 0, 3);
+          glDisable(GL_SCISSOR_TEST);
           glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
           glDepthFunc(GL_GEQUAL);
           glDepthMask(GL_FALSE);
@@ -348,7 +371,6 @@ class SlimResolvePass final : public Pass {
     glUniform1i(program_.uniform(multi, "u_gi"), self.id == PassId::kSlimGbuffer ? 1 : 0);
     glUniform1i(program_.uniform(multi, "u_field"),
                 ctx.scene.slim.evaluation != SlimEvaluation::kBlend ? 1 : 0);
-    glBindTextureUnit(0, ctx.targets.texture("slim_sum_normal"));
     glBindTextureUnit(1, ctx.targets.texture("slim_sum_albedo"));
     glBindTextureUnit(2, ctx.targets.texture("slim_sum_field"));
     glBindTextureUnit(3, ctx.targets.texture("slim_sum_weight"));
@@ -361,7 +383,12 @@ class SlimResolvePass final : public Pass {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glBindVertexArray(ctx.empty_vao);
-    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    int view = 0;
+    for_each_view(ctx, self, program_, [&] {
+      scissor_to_slim(ctx, *ctx.resources.slim(), multi ? view++ : -1);
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+    });
+    glDisable(GL_SCISSOR_TEST);
     gl_check("slim_resolve pass");
   }
 

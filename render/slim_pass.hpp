@@ -71,6 +71,8 @@ class SlimResources {
   GLuint sphere_buffer() const { return sphere_ssbo_.get(); }
   GLuint instance_vao() const { return vao_.get(); }
   const Vec3& anchor() const { return anchor_; }
+  // The union of the SLIM surfaces' bounds (world space).
+  const Aabb& bounds() const { return box_; }
 
   // Plans the samples of `views` cameras (one command and one grid per
   // sphere and view, view-major) and uploads them; returns the sample slots
@@ -88,6 +90,7 @@ class SlimResources {
  private:
   std::vector<const SlimSphere*> spheres_;
   Vec3 anchor_{};
+  Aabb box_;
   GlBuffer sphere_ssbo_, index_vbo_, command_buffer_, grid_ssbo_;
   GlVertexArray vao_;
   std::size_t capacity_views_ = 0;

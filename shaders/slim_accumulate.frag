@@ -26,12 +26,11 @@ flat in vec3 v_point;
 flat in vec2 v_window;
 flat in vec3 v_cell;
 
-layout(location = 0) out vec4 out_normal;  // blend: (w n, w) of the points in the pixel
-layout(location = 1) out vec4 out_albedo;  // blend: (w albedo, w depth); field: (w(x1) albedo, 0)
-layout(location = 2) out vec4 out_field;   // (w grad h + h grad w, w h) at x
-layout(location = 3) out vec4 out_weight;  // (grad w, w) at x
-layout(location = 4) out vec4 out_field2;  // the same at x2
-layout(location = 5) out vec4 out_weight2;
+layout(location = 0) out vec4 out_albedo;  // blend: (w albedo, w depth); field: (w(x1) albedo, 0)
+layout(location = 1) out vec4 out_field;   // field: (w grad h + h grad w, w h) at x; blend: (w n, w)
+layout(location = 2) out vec4 out_weight;  // (grad w, w) at x
+layout(location = 3) out vec4 out_field2;  // the same at x2
+layout(location = 4) out vec4 out_weight2;
 
 
 // Sphere s's terms of F at x (relative to its centre): (w grad h + h grad w,
@@ -58,7 +57,6 @@ void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   float near = VIEW_TEXEL(u_near, px).r;
   if (near >= 1e29) discard;  // nothing reaches this pixel: not covered
-  out_normal = vec4(0.0);
   out_albedo = vec4(0.0);
   out_field = vec4(0.0);
   out_weight = vec4(0.0);
@@ -67,7 +65,7 @@ void main() {
   if (u_field == 0) {
     if (v_depth >= VIEW_TEXEL(u_scene_depth, px).r) discard;
     if (v_depth > near + u_threshold * v_radius) discard;
-    out_normal = vec4(v_weight * v_normal, v_weight);
+    out_field = vec4(v_weight * v_normal, v_weight);  // blend: the normal sums
     out_albedo = vec4(v_weight * v_albedo, v_weight * v_depth);
     return;
   }

@@ -10,12 +10,11 @@ layout(binding = 1) uniform VIEW_SAMPLER u_near;
 layout(binding = 2) uniform VIEW_SAMPLER u_radius;
 uniform float u_threshold;  // slim.depth_threshold, in units of the sphere's radius
 
-layout(location = 0) out vec4 out_normal;  // unused by the field evaluation
-layout(location = 1) out vec4 out_albedo;  // (w(x1) albedo, 0)
-layout(location = 2) out vec4 out_field;   // (w grad h + h grad w, w h) at x1
-layout(location = 3) out vec4 out_weight;  // (grad w, w) at x1
-layout(location = 4) out vec4 out_field2;  // the same at x2
-layout(location = 5) out vec4 out_weight2;
+layout(location = 0) out vec4 out_albedo;  // (w(x1) albedo, 0)
+layout(location = 1) out vec4 out_field;   // (w grad h + h grad w, w h) at x1
+layout(location = 2) out vec4 out_weight;  // (grad w, w) at x1
+layout(location = 3) out vec4 out_field2;  // the same at x2
+layout(location = 4) out vec4 out_weight2;
 
 void main() {
   select_view(view_index());
@@ -31,7 +30,6 @@ void main() {
   bool any = patch_terms(ray_org + near * ray_dir, t1, t2);
   any = patch_terms(ray_org + (near + step) * ray_dir, t3, t4) || any;
   if (!any) discard;
-  out_normal = vec4(0.0);
   out_albedo = vec4(t2.w * v_albedo, 0.0);
   out_field = t1;
   out_weight = t2;

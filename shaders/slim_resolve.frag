@@ -9,7 +9,6 @@
 // between them or nearly (its zero within one step outside), the zero of
 // its linear interpolation is the depth and the sums interpolated there
 // give the normal; else x1 and F's gradient there.
-layout(binding = 0) uniform VIEW_SAMPLER u_sum_normal;
 layout(binding = 1) uniform VIEW_SAMPLER u_sum_albedo;
 layout(binding = 2) uniform VIEW_SAMPLER u_sum_field;
 layout(binding = 3) uniform VIEW_SAMPLER u_sum_weight;
@@ -29,14 +28,16 @@ layout(location = 4) out vec4 out_albedo;
 void main() {
   select_view(view_index());
   ivec2 px = ivec2(gl_FragCoord.xy);
-  vec4 sn = VIEW_TEXEL(u_sum_normal, px);
-  vec4 sa = VIEW_TEXEL(u_sum_albedo, px);
+  // The field's coverage test first: one fetch where nothing was drawn.
   vec4 sw = VIEW_TEXEL(u_sum_weight, px);
+  if (u_field == 1 && !(sw.w > 0.0)) discard;
+  vec4 sa = VIEW_TEXEL(u_sum_albedo, px);
   ViewRay ray = view_ray(vec2(px) + 0.5);
   vec3 n;
   vec3 albedo;
   float depth;
   if (u_field == 0) {
+    vec4 sn = VIEW_TEXEL(u_sum_field, px);  // the blend's (w n, w)
     if (!(sn.w > 0.0)) discard;
     float len = length(sn.xyz);
     n = len > 1e-6 * sn.w ? sn.xyz / len : -ray.dir;
