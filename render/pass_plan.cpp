@@ -59,20 +59,21 @@ const std::vector<TargetDecl>& target_catalog() {
       // the depth threshold behind it: blend (the seed's) (w n, w) and
       // (w albedo, w view depth); field F's terms at two points of the
       // centre ray, (w grad h + h grad w, w h) and (grad w, w), and
-      // (w albedo, -). The resolved surface: (unit normal, view depth), zero
-      // where none.
-      {"slim_near", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
-      {"slim_radius", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNoSurface},
+      // (w albedo, -). The slim passes clear these themselves, over the
+      // surfaces' pixel bounds only (render/slim_pass.cpp). The resolved
+      // surface: (unit normal, view depth), zero where none.
+      {"slim_near", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNone},
+      {"slim_radius", TargetFormat::kR32f, TargetSize::kRender, TargetClear::kNone},
       // slim.evaluation "patch": slim_near as a depth buffer, which culls
       // the accumulate pass's hidden patches before their fragments run
       // (written over the surfaces' pixel bounds before each use; outside
       // them no patch can be, so it is never cleared).
       {"slim_zbuf", TargetFormat::kDepth32f, TargetSize::kRender, TargetClear::kNone},
-      {"slim_sum_albedo", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
-      {"slim_sum_field", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
-      {"slim_sum_weight", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
-      {"slim_sum_field2", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
-      {"slim_sum_weight2", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
+      {"slim_sum_albedo", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kNone},
+      {"slim_sum_field", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kNone},
+      {"slim_sum_weight", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kNone},
+      {"slim_sum_field2", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kNone},
+      {"slim_sum_weight2", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kNone},
       {"slim_surface", TargetFormat::kRgba32f, TargetSize::kRender, TargetClear::kZero},
       // The volumes' transmittance along each pixel's ray, for the beams
       // behind and inside them (shaders/volume_knots.glsl): the ray's

@@ -314,6 +314,17 @@ class SlimPointsPass final : public Pass {
     }
     const bool depth_cull = patch && !depth_;
     for_each_view_offset(ctx, self, program, "u_offset", slim->anchor(), [&] {
+      // The view's targets are cleared here, over the surfaces' pixel
+      // bounds only (the plan does not clear them: nothing reads them
+      // outside those bounds), and the draws stay inside the bounds too.
+      scissor_to_slim(ctx, *slim, multi ? view : -1);
+      if (depth_) {
+        const float none[4] = {FrameTargets::kNoSurface, 0.0f, 0.0f, 0.0f};
+        for (GLint b = 0; b < 2; ++b) glClearBufferfv(GL_COLOR, b, none);
+      } else {
+        const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        for (GLint b = 0; b < 5; ++b) glClearBufferfv(GL_COLOR, b, zero);
+      }
       if (patch) {  // one rectangle per sphere (slim_patch.vert)
         if (depth_cull) {
           // slim_near into the depth buffer (slim_near_depth.frag), then
@@ -326,9 +337,7 @@ class SlimPointsPass final : public Pass {
           glEnable(GL_DEPTH_TEST);
           glDepthFunc(GL_ALWAYS);
           glDepthMask(GL_TRUE);
-          scissor_to_slim(ctx, *slim, multi ? view : -1);
           glDrawArrays(GL_TRIANGLES, 0, 3);
-          glDisable(GL_SCISSOR_TEST);
           glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
           glDepthFunc(GL_GEQUAL);
           glDepthMask(GL_FALSE);
@@ -348,6 +357,7 @@ class SlimPointsPass final : public Pass {
       glMultiDrawArraysIndirect(GL_POINTS, reinterpret_cast<const void*>(offset), n, 0);
       ++view;
     });
+    glDisable(GL_SCISSOR_TEST);
     glBlendEquation(GL_FUNC_ADD);
     glDisable(GL_BLEND);
     glDisable(GL_PROGRAM_POINT_SIZE);
