@@ -1,12 +1,11 @@
 // SLIM without sampling (slim.evaluation "patch"; render/slim_pass.hpp):
-// instance i is support sphere i, drawn as the box that holds its patch in
-// its own frame, [-r, r]^2 x [lo, hi] (lo, hi: the height field's range,
-// render/slim_pass.cpp), 36 vertices, of which only the faces turned to the
-// eye are kept (the others collapse): the box's projection is covered once.
-// Each fragment solves where its centre ray meets the sphere's height field
-// (slim_patch.glsl). A box reaching in front of the near plane (or holding
-// the eye) gets the whole viewport instead. Spheres whose patch faces away
-// from the camera are dropped (as the points' CPU plan does with
+// instance i is support sphere i, drawn as one rectangle (a 4-vertex strip)
+// facing the eye through the sphere's centre that bounds the patch's body,
+// the sphere within the slab lo <= w <= hi of its frame (lo, hi from
+// slim_height_range, protocol/slim_model.hpp). Each fragment solves where
+// its centre ray meets the sphere's height field (slim_patch.glsl). A
+// sphere holding the eye gets the whole viewport. Spheres whose patch faces
+// away from the camera are dropped (as the points' CPU plan does with
 // slim.cull_backfaces). The sphere's data goes to the fragments as flat
 // varyings (no buffer reads per fragment).
 uniform vec3 u_offset;  // slim anchor minus eye
@@ -88,13 +87,11 @@ void main() {
   ea += vec2(-1e-3, 1e-3) * r;
   eb += vec2(-1e-3, 1e-3) * r;
   vec3 p = c + mix(ea.x, ea.y, corner.x) * a + mix(eb.x, eb.y, corner.y) * b;
-  if (!ortho) {
-    // A rectangle reaching in front of the near plane would be clipped
-    // where the patch may still be seen: the whole viewport then.
-    float fa = dot(a, cam.cam_forward.xyz), fb = dot(b, cam.cam_forward.xyz);
-    float nearest = dot(c, cam.cam_forward.xyz) + min(ea.x * fa, ea.y * fa) + min(eb.x * fb, eb.y * fb);
-    if (nearest < cam.viewport.z) return;
-  }
+  // A rectangle reaching in front of the near plane is not cut there (its
+  // window depth is set below, at or behind the near plane), and the part
+  // of it that can hold the patch's projection lies in front of the eye
+  // (every point of the body is at least L - r > 0 along v, and the ray to
+  // it meets the plane at a point in front of the eye).
   gl_Position = cam.view_proj * vec4(p, 1.0);
   // The rectangle's window depth is that of the body's nearest view depth
   // less the depth threshold, the same over it (z = that depth's window

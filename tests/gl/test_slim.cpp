@@ -379,9 +379,8 @@ TEST(Slim, ARidgeStaysSharpWithTheFieldEvaluation) {
 }
 
 // The patch evaluation's proxies where they are hardest: a camera inside
-// support spheres and near the surface (their rectangles reach in front of
-// the near plane, so those spheres cover the whole viewport), far away, and
-// orthographic. Against the reference as the first test: no interior
+// support spheres (those cover the whole viewport), near the surface, with
+// the near plane cutting through supports, far away, and orthographic. Against the reference as the first test: no interior
 // holes, no far spurious pixels, normals within the first test's bounds
 // (0.5 degrees p99, 0.1 mean).
 TEST(Slim, PatchProxiesCoverNearFarAndOrthographicViews) {
@@ -390,12 +389,20 @@ TEST(Slim, PatchProxiesCoverNearFarAndOrthographicViews) {
     const char* name;
     double distance;
     bool ortho;
+    double near_plane = 1e-3;
   };
+  // "near plane cuts the surface": the surface is 0.40 away at its nearest
+  // and the near plane at 0.45, so the view looks through the cut into the
+  // sphere (back faces kept: the inside is seen), past supports (radius
+  // 0.35) whose bodies start in front of the near plane; their rectangles
+  // are drawn at the near plane's depth, not cut there (slim_patch.vert).
   for (const View& v : {View{"inside supports", 1.12, false}, View{"near", 1.6, false},
+                        View{"near plane cuts the surface", 1.317, false, 0.45},
                         View{"far", 40.0, false}, View{"orthographic", 4.0, true}}) {
     Scene scene = sphere_scene(96, v.distance, SlimSettings{});
     Camera& cam = scene.cameras[0];
-    cam.near_plane = 1e-3;
+    cam.near_plane = v.near_plane;
+    if (v.near_plane > 0.1) scene.slim.cull_backfaces = false;
     if (v.distance > 10.0) cam.fov_y_deg = 4.0;  // the sphere fills the frame
     if (v.ortho) {
       cam.projection = Projection::kOrthographic;
