@@ -161,7 +161,7 @@ SlimResources::SlimResources(const Scene& scene) {
     d.p2[3] = static_cast<float>(std::atan(slim_max_slope(s)));
     d.q2[0] = static_cast<float>(s.poly2.c[4]);
     d.q2[1] = static_cast<float>(s.poly2.c[5]);
-    // The patch's box in its frame, [-r, r]^2 x [lo, hi] (slim_patch.vert).
+    // The slab holding the patch's heights inside the sphere (slim_patch.vert).
     const auto& range = ranges[i];
     d.q2[2] = static_cast<float>(range[0]);
     d.q2[3] = static_cast<float>(range[1]);
@@ -254,7 +254,8 @@ void scissor_to_slim(const FrameContext& ctx, const SlimResources& slim, int vie
 // footprints behind the first (the nearest depth).
 constexpr float kSlimFieldStep = 2.0f;
 
-// Passes 1 and 2: every sphere's points, one indirect command each, per view.
+// Passes 1 and 2: every sphere's points, one indirect command each, per
+// view; or with slim.evaluation "patch" one rectangle per sphere.
 class SlimPointsPass final : public Pass {
  public:
   explicit SlimPointsPass(bool depth) : depth_(depth) {}

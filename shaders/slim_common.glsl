@@ -7,9 +7,9 @@ struct SlimGpu {
   vec4 axis_v;
   vec4 axis_w;
   vec4 p1;      // A, B, C, D of w = A u^2 + B u v + C v^2 + D u + E v + F
-  vec4 p2;      // E, F, crease (0 none, 1 min, 2 max), -
+  vec4 p2;      // E, F, crease (0 none, 1 min, 2 max), atan(the largest slope)
   vec4 q1;      // the second polynomial (creases)
-  vec4 q2;
+  vec4 q2;      // E, F, and the slab [lo, hi] of the patch's heights inside the sphere
   vec4 albedo;  // rgb, material
 };
 layout(std430, binding = 5) readonly buffer SlimSpheres { SlimGpu spheres[]; };
@@ -84,4 +84,3 @@ float slim_field_step(float near, float radius) {
   float footprint = 2.0 * cam.cam_right.w / cam.viewport.y * (is_orthographic() ? 1.0 : near);
   return min(u_step * footprint, 0.05 * radius);
 }
-
