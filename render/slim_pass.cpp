@@ -123,13 +123,17 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
 SlimResources::SlimResources(const Scene& scene) {
   Aabb box;
   std::vector<const Occluder*> occluder_of;  // each sphere's occluder (its albedo)
-  std::vector<std::array<double, 2>> ranges;  // each sphere's height range
+  // Each sphere's height range, which only the patch evaluation reads
+  // (computed on first use by the shared surface).
+  const bool patch = scene.slim.evaluation == SlimEvaluation::kPatch;
+  std::vector<const std::array<double, 2>*> range_of;
   for (const Occluder& occ : scene.occluders) {
     if (const auto* slim = std::get_if<SlimOccluder>(&occ.shape)) {
-      for (const SlimSphere& s : slim->spheres()) {
-        spheres_.push_back(&s);
+      const auto* ranges = patch ? slim->surface->height_ranges().data() : nullptr;
+      for (std::size_t k = 0; k < slim->spheres().size(); ++k) {
+        spheres_.push_back(&slim->spheres()[k]);
         occluder_of.push_back(&occ);
-        ranges.push_back(slim->surface->height_ranges[&s - slim->spheres().data()]);
+        range_of.push_back(ranges ? ranges + k : nullptr);
       }
       box.grow(slim->bounds());
     }
@@ -162,9 +166,10 @@ SlimResources::SlimResources(const Scene& scene) {
     d.q2[0] = static_cast<float>(s.poly2.c[4]);
     d.q2[1] = static_cast<float>(s.poly2.c[5]);
     // The slab holding the patch's heights inside the sphere (slim_patch.vert).
-    const auto& range = ranges[i];
-    d.q2[2] = static_cast<float>(range[0]);
-    d.q2[3] = static_cast<float>(range[1]);
+    if (range_of[i]) {
+      d.q2[2] = static_cast<float>((*range_of[i])[0]);
+      d.q2[3] = static_cast<float>((*range_of[i])[1]);
+    }
     put(d.albedo, occ.albedo, static_cast<double>(occ.material.type));
     index[i] = static_cast<std::uint32_t>(i);
   }

@@ -20,19 +20,21 @@ float poly(vec4 a, vec4 b, vec2 x, out vec2 grad) {
   return a.x * x.x * x.x + a.y * x.x * x.y + a.z * x.y * x.y + a.w * x.x + b.x * x.y + b.y;
 }
 
-// f(u, v) with the crease rule, and the gradient of the polynomial it took.
-float height(SlimGpu s, vec2 x, out vec2 grad) {
-  float f = poly(s.p1, s.p2, x, grad);
-  if (s.p2.z < 0.5) return f;
+// f(u, v) with the crease rule (crease = p2.z: 0 none, 1 min, 2 max of the
+// polynomials (p1, p2) and (q1, q2)), and the gradient of the one it took.
+float crease_height(vec4 p1, vec4 p2, vec4 q1, vec4 q2, vec2 x, out vec2 grad) {
+  float f = poly(p1, p2, x, grad);
+  if (p2.z < 0.5) return f;
   vec2 g2;
-  float f2 = poly(s.q1, s.q2, x, g2);
-  bool second = s.p2.z < 1.5 ? f2 < f : f2 > f;
-  if (second) {
+  float f2 = poly(q1, q2, x, g2);
+  if (p2.z < 1.5 ? f2 < f : f2 > f) {
     grad = g2;
     return f2;
   }
   return f;
 }
+
+float height(SlimGpu s, vec2 x, out vec2 grad) { return crease_height(s.p1, s.p2, s.q1, s.q2, x, grad); }
 
 // Field evaluation: where the centre ray `ray` meets the height field of
 // sphere s (centre c, camera-relative), by Newton steps along the ray from

@@ -90,19 +90,6 @@ bool patch_crossing(out float z) {
   return true;
 }
 
-// f(u, v) with the crease rule, and the gradient of the polynomial it took.
-float patch_height(vec2 x, out vec2 grad) {
-  float f = poly(v_p1, vec4(v_p2.xy, 0.0, 0.0), x, grad);
-  if (v_p2.z < 0.5) return f;
-  vec2 g2;
-  float f2 = poly(v_q1, vec4(v_q2, 0.0, 0.0), x, g2);
-  if (v_p2.z < 1.5 ? f2 < f : f2 > f) {
-    grad = g2;
-    return f2;
-  }
-  return f;
-}
-
 vec3 patch_to_world(vec3 v) { return v.x * v_au + v.y * v_av + v.z * v_aw; }
 
 // The sphere's terms of F at x (its frame): (w grad h + h grad w, w h) and
@@ -114,7 +101,7 @@ bool patch_terms(vec3 x, out vec4 field, out vec4 weight) {
   float q = 1.0 - dot(x, x) / (r * r);
   if (q <= 0.0) return false;
   vec2 gf;
-  float h = x.z - patch_height(x.xy, gf);
+  float h = x.z - crease_height(v_p1, v_p2, v_q1, vec4(v_q2, 0.0, 0.0), x.xy, gf);
   float w = q * q * q;
   vec3 gw = (-6.0 * q * q / (r * r)) * x;
   field = vec4(patch_to_world(w * vec3(-gf, 1.0) + h * gw), w * h);

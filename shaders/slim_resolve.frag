@@ -45,8 +45,7 @@ void main() {
     depth = sa.w / sn.w;
   } else {
     // Covered where the centre ray meets a sphere's patch at x1 inside
-    // some support.
-    if (!(sw.w > 0.0)) discard;
+    // some support (tested above: sw.w > 0).
     albedo = sa.rgb / sw.w;
     vec4 sw2 = VIEW_TEXEL(u_sum_weight2, px);
     vec4 sf = VIEW_TEXEL(u_sum_field, px);

@@ -37,14 +37,15 @@ std::string read_model_file(const SceneLoadOptions& opts, const std::string& nam
 }  // namespace
 
 SlimSurface::SlimSurface(std::vector<SlimSphere> s)
-    : spheres(std::move(s)),
-      box(slim_bounds(spheres)),
-      height_ranges([this] {
-        std::vector<std::array<double, 2>> r(spheres.size());
-        for (std::size_t i = 0; i < spheres.size(); ++i) r[i] = slim_height_range(spheres[i]);
-        return r;
-      }()),
-      field(&spheres) {}
+    : spheres(std::move(s)), box(slim_bounds(spheres)), field(&spheres) {}
+
+const std::vector<std::array<double, 2>>& SlimSurface::height_ranges() const {
+  std::call_once(ranges_once_, [this] {
+    ranges_.resize(spheres.size());
+    for (std::size_t i = 0; i < spheres.size(); ++i) ranges_[i] = slim_height_range(spheres[i]);
+  });
+  return ranges_;
+}
 
 SlimOccluder SlimOccluder::from_spheres(std::vector<SlimSphere> spheres) {
   SlimOccluder o;
