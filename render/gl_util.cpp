@@ -1,7 +1,9 @@
 #include "render/gl_util.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 
 #include "render/gl_debug.hpp"
 #include "shaders/shader_sources.hpp"
@@ -62,22 +64,13 @@ void delete_vertex_array(GLuint id) { glDeleteVertexArrays(1, &id); }
 void delete_program(GLuint id) { glDeleteProgram(id); }
 void delete_query(GLuint id) { glDeleteQueries(1, &id); }
 
-GlProgram build_program(std::string_view name, const std::string& vertex_src,
-                        const std::string& fragment_src) {
-  GLuint vs = compile_stage(name, GL_VERTEX_SHADER, "vertex", vertex_src);
-  GLuint fs = 0;
-  try {
-    fs = compile_stage(name, GL_FRAGMENT_SHADER, "fragment", fragment_src);
-  } catch (...) {
-    glDeleteShader(vs);
-    throw;
-  }
+namespace {
+// Links compiled stages into a program (the stages deleted either way).
+GlProgram link_program(std::string_view name, std::initializer_list<GLuint> stages) {
   GlProgram prog(glCreateProgram());
-  glAttachShader(prog.get(), vs);
-  glAttachShader(prog.get(), fs);
+  for (const GLuint s : stages) glAttachShader(prog.get(), s);
   glLinkProgram(prog.get());
-  glDeleteShader(vs);
-  glDeleteShader(fs);
+  for (const GLuint s : stages) glDeleteShader(s);
   GLint ok = GL_FALSE;
   glGetProgramiv(prog.get(), GL_LINK_STATUS, &ok);
   if (!ok) {
@@ -90,6 +83,46 @@ GlProgram build_program(std::string_view name, const std::string& vertex_src,
   }
   gl_check("build_program");
   return prog;
+}
+}  // namespace
+
+GlProgram build_program(std::string_view name, const std::string& vertex_src,
+                        const std::string& fragment_src) {
+  GLuint vs = compile_stage(name, GL_VERTEX_SHADER, "vertex", vertex_src);
+  GLuint fs = 0;
+  try {
+    fs = compile_stage(name, GL_FRAGMENT_SHADER, "fragment", fragment_src);
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  return link_program(name, {vs, fs});
+}
+
+GlProgram build_compute_program(std::string_view name, const std::string& compute_src) {
+  return link_program(name, {compile_stage(name, GL_COMPUTE_SHADER, "compute", compute_src)});
+}
+
+void QuadIndices::draw(GLsizei first, GLsizei count) {
+  if (!vao_) {
+    std::vector<GLuint> index;
+    index.reserve(6 * static_cast<std::size_t>(kChunk));
+    for (GLuint q = 0; q < static_cast<GLuint>(kChunk); ++q) {
+      for (const GLuint k : {0u, 1u, 2u, 2u, 1u, 3u}) index.push_back(4 * q + k);
+    }
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    indices_ = GlBuffer(id);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(index.size() * sizeof(GLuint)), index.data(), 0);
+    glCreateVertexArrays(1, &id);
+    vao_ = GlVertexArray(id);
+    glVertexArrayElementBuffer(id, indices_.get());
+  }
+  glBindVertexArray(vao_.get());
+  for (GLsizei done = 0; done < count; done += kChunk) {
+    const GLsizei n = std::min(kChunk, count - done);
+    glDrawElementsBaseVertex(GL_TRIANGLES, 6 * n, GL_UNSIGNED_INT, nullptr, 4 * (first + done));
+  }
 }
 
 GlTexture make_texture_2d(GLenum internal_format, int width, int height) {

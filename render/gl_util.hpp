@@ -67,9 +67,31 @@ using GlQuery = GlHandle<delete_query>;
 // GlError with the program name, the stage, the info log and numbered source.
 GlProgram build_program(std::string_view name, const std::string& vertex_src,
                         const std::string& fragment_src);
+// The same for a compute program.
+GlProgram build_compute_program(std::string_view name, const std::string& compute_src);
 
 // Creates an immutable 2D texture with the given internal format.
 GlTexture make_texture_2d(GLenum internal_format, int width, int height);
+
+// Draws of many quads without instancing: quad i is vertices 4i .. 4i+3 in
+// a triangle strip's order, i.e. corner (gl_VertexID & 1, (gl_VertexID >> 1)
+// & 1) of item gl_VertexID >> 2, as two indexed triangles. llvmpipe runs
+// its vertex pipeline (fetch, shader, clip, emit) once per instance of an
+// instanced draw, for 4 vertices; indexed, it shades the vertices of
+// thousands of quads a batch (docs/slim.md, "Indexed quads", measures
+// it). The index buffer holds kChunk quads; larger draws go in chunks, each
+// shifted by its base vertex (which gl_VertexID includes).
+class QuadIndices {
+ public:
+  static constexpr GLsizei kChunk = 16384;
+  // Draws quads first .. first + count - 1 (gl_VertexID >> 2 runs over
+  // them) with the vertex array bound here (no attributes).
+  void draw(GLsizei first, GLsizei count);
+
+ private:
+  GlBuffer indices_;
+  GlVertexArray vao_;
+};
 
 // Checks the bound draw framebuffer; throws GlError naming its status.
 void check_framebuffer(GLuint fbo, const char* what);

@@ -42,7 +42,7 @@ class MediumPass final : public Pass {
 };
 
 // The volume photons' in-scattered light (shaders/volume_splat.frag): one
-// instanced camera-facing quad per photon over its kernel sphere, added to
+// camera-facing quad per photon (QuadIndices) over its kernel sphere, added to
 // hdr. gi.display_fraction draws the first share of the photons at 1/share
 // power, as the surface photons.
 class VolumePhotonPass final : public Pass {
@@ -68,7 +68,6 @@ class VolumePhotonPass final : public Pass {
     glUniform1i(program.uniform(multi, "u_estimator"),
                 medium.estimator == VolumeEstimator::kSeed ? 1 : 0);
     glUniform1i(program.uniform(multi, "u_segments"), medium.segments);
-    glUniform1i(program.uniform(multi, "u_first"), 0);
     glUniform1f(program.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
     set_photon_lod(program, multi, ctx.scene.gi);
     glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
@@ -78,7 +77,7 @@ class VolumePhotonPass final : public Pass {
     for_each_view_offset(ctx, self, program, "u_photon_offset", ctx.resources.volume_anchor(),
                          [&] {
                            set_region_eye(ctx, region_eye, view++);
-                           glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, count);
+                           quads_.draw(0, count);
                          });
     glDisable(GL_BLEND);
     gl_check("volume photon pass");
@@ -86,6 +85,7 @@ class VolumePhotonPass final : public Pass {
 
  private:
   RegionProgram programs_;
+  QuadIndices quads_;
 };
 
 }  // namespace

@@ -446,7 +446,7 @@ class GiResolvePass final : public Pass {
   ProgramPair program_;
 };
 
-// Photon splatting: one instanced draw of camera-facing quads, one per
+// Photon splatting: one draw of camera-facing quads (QuadIndices), one per
 // photon; the fragment shader reads the G-buffer and adds the photon's
 // reflected radiance (shaders/photon_splat.frag), additively into hdr.
 class PhotonPass final : public Pass {
@@ -509,7 +509,6 @@ class PhotonPass final : public Pass {
     }
     // Two draws: the global map's photons, then the caustic map's with their
     // own (smaller) radius.
-    const GLint first_uniform = program.uniform(multi, "u_first");
     const GLint radius_uniform = program.uniform(multi, "u_radius");
     // The buffer holds the drawn share of each map (gi.display_fraction),
     // its power already scaled, clustered (gi.cluster): all of it is drawn.
@@ -520,14 +519,12 @@ class PhotonPass final : public Pass {
     for_each_view_offset(ctx, self, program, "u_photon_offset", ctx.resources.photon_anchor(), [&] {
       per_band(program, [&] {
         if (split > 0) {
-          glUniform1i(first_uniform, 0);
           glUniform1f(radius_uniform, radius);
-          glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, split);
+          quads_.draw(0, split);
         }
         if (caustic > 0) {
-          glUniform1i(first_uniform, split);
           glUniform1f(radius_uniform, caustic_radius);
-          glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, caustic);
+          quads_.draw(split, caustic);
         }
       });
     });
@@ -539,6 +536,7 @@ class PhotonPass final : public Pass {
 
  private:
   LazyPrograms programs_;  // by kernel
+  QuadIndices quads_;
 };
 
 // Beams: additive energy from the line-integral tables, one instanced draw of

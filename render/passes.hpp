@@ -133,6 +133,7 @@ class ProgramPair {
 
  private:
   static GlProgram build(const ShaderProgramSpec& spec) {
+    if (!spec.compute.empty()) return build_compute_program(spec.name, assemble_shader(spec.compute));
     return build_program(spec.name, assemble_shader(spec.vertex), assemble_shader(spec.fragment));
   }
   std::string name_;

@@ -161,11 +161,11 @@ SlimResources::SlimResources(const Scene& scene) {
     d.p2[0] = static_cast<float>(s.poly.c[4]);
     d.p2[1] = static_cast<float>(s.poly.c[5]);
     d.p2[2] = static_cast<float>(s.crease);
-    // The patch's normal cone (slim_patch.vert's backface cull).
+    // The patch's normal cone (slim_patch_plan.comp's backface cull).
     d.p2[3] = static_cast<float>(std::atan(slim_max_slope(s)));
     d.q2[0] = static_cast<float>(s.poly2.c[4]);
     d.q2[1] = static_cast<float>(s.poly2.c[5]);
-    // The slab holding the patch's heights inside the sphere (slim_patch.vert).
+    // The slab holding the patch's heights inside the sphere (slim_patch_plan.comp).
     if (range_of[i]) {
       d.q2[2] = static_cast<float>((*range_of[i])[0]);
       d.q2[3] = static_cast<float>((*range_of[i])[1]);
@@ -193,6 +193,14 @@ SlimResources::SlimResources(const Scene& scene) {
 
 void SlimResources::plan_patches(std::size_t views) {
   slots_.assign(views, static_cast<std::int64_t>(spheres_.size()));
+  const std::size_t corners = 4 * spheres_.size() * views;
+  if (corners > corner_capacity_) {
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    corner_ssbo_ = GlBuffer(id);
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(corners * 4 * sizeof(float)), nullptr, 0);
+    corner_capacity_ = corners;
+  }
 }
 
 void SlimResources::plan_views(const std::vector<Camera>& cams, const std::vector<CameraBasis>& bases,
@@ -271,7 +279,7 @@ class SlimPointsPass final : public Pass {
     const bool patch = ctx.scene.slim.evaluation == SlimEvaluation::kPatch;
     const std::string name = depth_ ? "slim_depth" : "slim_accumulate";
     ProgramPair& program = programs_.get(patch ? name + "_patch" : name);
-    if (depth_ && patch) slim->plan_patches(multi ? ctx.views : 1);
+    if (depth_ && patch) plan_patch_corners(ctx, *slim);
     if (depth_ && !patch) {  // the first of the slim passes plans the frame's samples
       if (multi) {
         slim->plan_views(*ctx.view_cameras, *ctx.view_bases, ctx.scene.slim);
@@ -313,11 +321,8 @@ class SlimPointsPass final : public Pass {
     const auto n = static_cast<GLsizei>(slim->sphere_count());
     const GLint grid_base = program.uniform(multi, "u_grid_base");
     int view = 0;
-    if (patch) {
-      glBindVertexArray(ctx.empty_vao);
-      glUniform1f(program.uniform(multi, "u_threshold"),
-                  static_cast<float>(ctx.scene.slim.depth_threshold));
-    }
+    const GLint corner_base = program.uniform(multi, "u_corner_base");
+    if (patch) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, slim->corner_buffer());
     const bool depth_cull = patch && !depth_;
     for_each_view_offset(ctx, self, program, "u_offset", slim->anchor(), [&] {
       // The view's targets are cleared here, over the surfaces' pixel
@@ -350,7 +355,8 @@ class SlimPointsPass final : public Pass {
           glEnable(GL_BLEND);
           glUseProgram(program.get(multi));
         }
-        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, n);
+        glUniform1i(corner_base, 4 * view * n);
+        quads_.draw(0, n);
         if (depth_cull) {
           glDepthMask(GL_TRUE);
           glDisable(GL_DEPTH_TEST);
@@ -372,8 +378,36 @@ class SlimPointsPass final : public Pass {
   }
 
  private:
+  // slim.evaluation "patch": each view's rectangles (slim_patch_plan.comp),
+  // once per frame for both passes.
+  void plan_patch_corners(FrameContext& ctx, SlimResources& slim) {
+    const bool multi = ctx.views > 0;
+    const int views = multi ? ctx.views : 1;
+    slim.plan_patches(static_cast<std::size_t>(views));
+    ProgramPair& plan = programs_.get("slim_patch_plan");
+    glUseProgram(plan.get(multi));
+    const auto n = static_cast<GLint>(slim.sphere_count());
+    glUniform1i(plan.uniform(multi, "u_count"), n);
+    glUniform1i(plan.uniform(multi, "u_cull_backfaces"), ctx.scene.slim.cull_backfaces ? 1 : 0);
+    glUniform1f(plan.uniform(multi, "u_threshold"), static_cast<float>(ctx.scene.slim.depth_threshold));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, slim.sphere_buffer());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, slim.corner_buffer());
+    const GLint offset = plan.uniform(multi, "u_offset");
+    const GLint base = plan.uniform(multi, "u_corner_base");
+    for (int v = 0; v < views; ++v) {
+      if (multi) glUniform1i(plan.uniform(true, "u_view"), v);
+      const Vec3 off = slim.anchor() - (multi ? ctx.view_eyes[static_cast<std::size_t>(v)] : ctx.basis.eye);
+      glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
+                  static_cast<float>(off[2]));
+      glUniform1i(base, 4 * v * n);
+      glDispatchCompute(static_cast<GLuint>((n + 63) / 64), 1, 1);
+    }
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  }
+
   bool depth_;
   LazyPrograms programs_;
+  QuadIndices quads_;
 };
 
 // Pass 3: normalization into the surfaces' targets.

@@ -9,7 +9,6 @@ struct PhotonData {
 layout(std430, binding = 3) readonly buffer Photons { PhotonData photons[]; };
 uniform vec3 u_photon_offset;  // photon anchor minus eye
 uniform float u_radius;
-uniform int u_first;  // the draw's first photon (the caustic map's follow the global map's)
 uniform float u_power_scale;  // 1 / the share of the maps drawn (gi.display_fraction)
 // The splat grid's bands (render/pass_plan.hpp, SplatBands): with
 // u_band_cull 1 a disk whose quad lies wholly above or below the rows of
@@ -57,13 +56,14 @@ float lod_weight(vec3 c, int index) {
 
 void main() {
   select_view(view_index());
-  PhotonData p = photons[gl_InstanceID + u_first];
+  int index = gl_VertexID >> 2;  // quad `index` (QuadIndices, render/gl_util.hpp)
+  PhotonData p = photons[index];
   vec3 c = p.position.xyz + u_photon_offset;
   v_center = c;
 #ifdef BEAMCAST_VOLUME_PHOTONS
   v_extra = vec2(p.position.w, p.normal.w);
 #endif
-  float lod = lod_weight(c, gl_InstanceID + u_first);
+  float lod = lod_weight(c, index);
   if (lod <= 0.0) {  // dropped: a degenerate quad outside the clip volume
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
     v_power = vec3(0.0);
@@ -72,8 +72,8 @@ void main() {
   }
   v_power = p.power.rgb * (u_power_scale * lod);
   v_normal = p.normal.xyz;
-  // Corner of a triangle strip of 4 vertices: (-1,-1) (1,-1) (-1,1) (1,1)
-  // (llvmpipe shades the vertices on one thread: 4 a quad, not 6).
+  // Corner (-1,-1) (1,-1) (-1,1) (1,1) of the quad (llvmpipe shades the
+  // vertices on one thread: 4 a quad, not 6).
   vec2 k = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0);
   // Perspective: a sphere of radius r at distance D subtends asin(r / D); a
   // quad in its centre's plane facing the camera covers that cone with half

@@ -25,6 +25,7 @@ struct ShaderProgramSpec {
   std::string name;  // e.g. "beam"; a variant's is "beam_multiview"
   std::vector<std::string_view> vertex;
   std::vector<std::string_view> fragment;
+  std::vector<std::string_view> compute;  // a compute program has this stage only
 };
 
 // Every program of the manifest, then every program again in each variant

@@ -52,15 +52,16 @@ std::vector<ShaderProgramSpec> parse_manifest() {
       variants.emplace_back(w[1], w[2]);
       continue;
     }
-    if (w[0] != "program" || w.size() < 4 || (w[2] != "vert" && w[2] != "frag")) {
-      fail(where + ": expected 'program <name> <vert|frag> <file>...' or 'variant <name> <file>'");
+    if (w[0] != "program" || w.size() < 4 || (w[2] != "vert" && w[2] != "frag" && w[2] != "comp")) {
+      fail(where +
+           ": expected 'program <name> <vert|frag|comp> <file>...' or 'variant <name> <file>'");
     }
     ShaderProgramSpec* p = nullptr;
     for (auto& q : programs) {
       if (q.name == w[1]) p = &q;
     }
-    if (!p) p = &programs.emplace_back(ShaderProgramSpec{std::string(w[1]), {}, {}});
-    auto& stage = w[2] == "vert" ? p->vertex : p->fragment;
+    if (!p) p = &programs.emplace_back(ShaderProgramSpec{std::string(w[1]), {}, {}, {}});
+    auto& stage = w[2] == "vert" ? p->vertex : w[2] == "frag" ? p->fragment : p->compute;
     if (!stage.empty()) fail(where + ": second " + std::string(w[2]) + " stage of " + p->name);
     for (std::size_t i = 3; i < w.size(); ++i) {
       shader_text(w[i]);  // aborts if the file is not embedded
@@ -69,16 +70,21 @@ std::vector<ShaderProgramSpec> parse_manifest() {
   }
   const std::size_t base = programs.size();
   for (std::size_t i = 0; i < base; ++i) {
-    if (programs[i].vertex.empty() || programs[i].fragment.empty()) {
-      fail("shaders/programs.txt: program " + programs[i].name + " lacks a stage");
+    const ShaderProgramSpec& p = programs[i];
+    const bool graphics = !p.vertex.empty() && !p.fragment.empty() && p.compute.empty();
+    const bool compute = p.vertex.empty() && p.fragment.empty() && !p.compute.empty();
+    if (!graphics && !compute) {
+      fail("shaders/programs.txt: program " + p.name +
+           " needs a vert and a frag stage, or a comp stage alone");
     }
   }
   for (const auto& [variant, file] : variants) {
     for (std::size_t i = 0; i < base; ++i) {
       ShaderProgramSpec v = programs[i];
       v.name += "_" + std::string(variant);
-      v.vertex.insert(v.vertex.begin(), file);
-      v.fragment.insert(v.fragment.begin(), file);
+      for (auto* stage : {&v.vertex, &v.fragment, &v.compute}) {
+        if (!stage->empty()) stage->insert(stage->begin(), file);
+      }
       programs.push_back(std::move(v));
     }
   }

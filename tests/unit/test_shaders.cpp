@@ -38,7 +38,9 @@ std::pair<int, std::string> validate(const std::string& name, const std::string&
 TEST(Shaders, EveryStageCompilesWithGlslangValidator) {
   ASSERT_GE(shader_programs().size(), 8u);
   for (const ShaderProgramSpec& p : shader_programs()) {
-    for (const auto& [parts, ext] : {std::pair{p.vertex, "vert"}, std::pair{p.fragment, "frag"}}) {
+    for (const auto& [parts, ext] : {std::pair{p.vertex, "vert"}, std::pair{p.fragment, "frag"},
+                                     std::pair{p.compute, "comp"}}) {
+      if (parts.empty()) continue;
       const auto [rc, log] = validate(p.name + "." + ext, assemble_shader(parts));
       EXPECT_EQ(rc, 0) << p.name << "." << ext << ":\n" << log;
     }
@@ -52,11 +54,12 @@ TEST(Shaders, ManifestNamesEveryShaderFile) {
   for (const ShaderProgramSpec& p : shader_programs()) {
     listed.insert(p.vertex.begin(), p.vertex.end());
     listed.insert(p.fragment.begin(), p.fragment.end());
+    listed.insert(p.compute.begin(), p.compute.end());
   }
   std::set<std::string> on_disk;
   for (const auto& e : std::filesystem::directory_iterator(BEAMCAST_SOURCE_DIR "/shaders")) {
     const auto ext = e.path().extension();
-    if (ext == ".glsl" || ext == ".vert" || ext == ".frag") on_disk.insert(e.path().filename());
+    if (ext == ".glsl" || ext == ".vert" || ext == ".frag" || ext == ".comp") on_disk.insert(e.path().filename());
   }
   EXPECT_EQ(listed, on_disk);
   EXPECT_EQ(shader_program("beam_multiview").fragment.front(), "multiview.glsl");
