@@ -103,6 +103,14 @@ GlProgram build_compute_program(std::string_view name, const std::string& comput
   return link_program(name, {compile_stage(name, GL_COMPUTE_SHADER, "compute", compute_src)});
 }
 
+GlBuffer make_buffer(std::size_t bytes, const void* data, GLbitfield flags) {
+  GLuint id = 0;
+  glCreateBuffers(1, &id);
+  GlBuffer buffer(id);
+  glNamedBufferStorage(id, static_cast<GLsizeiptr>(bytes), data, flags);
+  return buffer;
+}
+
 void QuadIndices::draw(GLsizei first, GLsizei count) {
   if (!vao_) {
     std::vector<GLuint> index;
@@ -110,10 +118,8 @@ void QuadIndices::draw(GLsizei first, GLsizei count) {
     for (GLuint q = 0; q < static_cast<GLuint>(kChunk); ++q) {
       for (const GLuint k : {0u, 1u, 2u, 2u, 1u, 3u}) index.push_back(4 * q + k);
     }
+    indices_ = make_buffer(index);
     GLuint id = 0;
-    glCreateBuffers(1, &id);
-    indices_ = GlBuffer(id);
-    glNamedBufferStorage(id, static_cast<GLsizeiptr>(index.size() * sizeof(GLuint)), index.data(), 0);
     glCreateVertexArrays(1, &id);
     vao_ = GlVertexArray(id);
     glVertexArrayElementBuffer(id, indices_.get());

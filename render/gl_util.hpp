@@ -5,6 +5,7 @@
 
 #include <GL/glcorearb.h>
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -72,6 +73,14 @@ GlProgram build_compute_program(std::string_view name, const std::string& comput
 
 // Creates an immutable 2D texture with the given internal format.
 GlTexture make_texture_2d(GLenum internal_format, int width, int height);
+
+// An immutable buffer of `bytes` (glNamedBufferStorage), from `data`
+// (nullptr: uninitialized) with storage `flags`.
+GlBuffer make_buffer(std::size_t bytes, const void* data, GLbitfield flags = 0);
+template <class T>
+GlBuffer make_buffer(const std::vector<T>& data, GLbitfield flags = 0) {
+  return make_buffer(data.size() * sizeof(T), data.data(), flags);
+}
 
 // Draws of many quads without instancing: quad i is vertices 4i .. 4i+3 in
 // a triangle strip's order, i.e. corner (gl_VertexID & 1, (gl_VertexID >> 1)

@@ -174,13 +174,9 @@ SlimResources::SlimResources(const Scene& scene) {
     index[i] = static_cast<std::uint32_t>(i);
   }
   if (spheres_.empty()) return;
+  sphere_ssbo_ = make_buffer(data);
+  index_vbo_ = make_buffer(index);
   GLuint id = 0;
-  glCreateBuffers(1, &id);
-  sphere_ssbo_ = GlBuffer(id);
-  glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(SlimGpu)), data.data(), 0);
-  glCreateBuffers(1, &id);
-  index_vbo_ = GlBuffer(id);
-  glNamedBufferStorage(id, static_cast<GLsizeiptr>(index.size() * sizeof(std::uint32_t)), index.data(), 0);
   glCreateVertexArrays(1, &id);
   vao_ = GlVertexArray(id);
   glVertexArrayVertexBuffer(id, 0, index_vbo_.get(), 0, sizeof(std::uint32_t));
@@ -195,10 +191,7 @@ void SlimResources::plan_patches(std::size_t views) {
   slots_.assign(views, static_cast<std::int64_t>(spheres_.size()));
   const std::size_t corners = 4 * spheres_.size() * views;
   if (corners > corner_capacity_) {
-    GLuint id = 0;
-    glCreateBuffers(1, &id);
-    corner_ssbo_ = GlBuffer(id);
-    glNamedBufferStorage(id, static_cast<GLsizeiptr>(corners * 4 * sizeof(float)), nullptr, 0);
+    corner_ssbo_ = make_buffer(corners * 4 * sizeof(float), nullptr);
     corner_capacity_ = corners;
   }
 }
