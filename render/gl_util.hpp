@@ -87,8 +87,8 @@ GlBuffer make_buffer(const std::vector<T>& data, GLbitfield flags = 0) {
 // & 1) of item gl_VertexID >> 2, as two indexed triangles. llvmpipe runs
 // its vertex pipeline (fetch, shader, clip, emit) once per instance of an
 // instanced draw, for 4 vertices; indexed, it shades the vertices of
-// thousands of quads a batch (docs/slim.md, "Indexed quads", measures
-// it). The index buffer holds kChunk quads; larger draws go in chunks, each
+// thousands of quads a batch (docs/gi.md, "Quads without instancing",
+// and docs/slim.md measure it). The index buffer holds kChunk quads; larger draws go in chunks, each
 // shifted by its base vertex (which gl_VertexID includes).
 class QuadIndices {
  public:

@@ -189,10 +189,8 @@ SlimResources::SlimResources(const Scene& scene) {
 
 void SlimResources::plan_patches(std::size_t views) {
   slots_.assign(views, static_cast<std::int64_t>(spheres_.size()));
-  const std::size_t corners = 4 * spheres_.size() * views;
-  if (corners > corner_capacity_) {
-    corner_ssbo_ = make_buffer(corners * 4 * sizeof(float), nullptr);
-    corner_capacity_ = corners;
+  if (!corner_ssbo_ && !spheres_.empty()) {
+    corner_ssbo_ = make_buffer(spheres_.size() * 4 * 4 * sizeof(float), nullptr);
   }
 }
 
@@ -272,7 +270,7 @@ class SlimPointsPass final : public Pass {
     const bool patch = ctx.scene.slim.evaluation == SlimEvaluation::kPatch;
     const std::string name = depth_ ? "slim_depth" : "slim_accumulate";
     ProgramPair& program = programs_.get(patch ? name + "_patch" : name);
-    if (depth_ && patch) plan_patch_corners(ctx, *slim);
+    if (depth_ && patch) slim->plan_patches(multi ? ctx.views : 1);
     if (depth_ && !patch) {  // the first of the slim passes plans the frame's samples
       if (multi) {
         slim->plan_views(*ctx.view_cameras, *ctx.view_bases, ctx.scene.slim);
@@ -314,7 +312,6 @@ class SlimPointsPass final : public Pass {
     const auto n = static_cast<GLsizei>(slim->sphere_count());
     const GLint grid_base = program.uniform(multi, "u_grid_base");
     int view = 0;
-    const GLint corner_base = program.uniform(multi, "u_corner_base");
     if (patch) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, slim->corner_buffer());
     const bool depth_cull = patch && !depth_;
     for_each_view_offset(ctx, self, program, "u_offset", slim->anchor(), [&] {
@@ -330,6 +327,8 @@ class SlimPointsPass final : public Pass {
         for (GLint b = 0; b < 5; ++b) glClearBufferfv(GL_COLOR, b, zero);
       }
       if (patch) {  // one rectangle per sphere (slim_patch.vert)
+        plan_patch_corners(ctx, *slim, multi ? view : -1);
+        glUseProgram(program.get(multi));
         if (depth_cull) {
           // slim_near into the depth buffer (slim_near_depth.frag), then
           // the rectangles depth-tested against it (slim_patch.vert).
@@ -348,7 +347,6 @@ class SlimPointsPass final : public Pass {
           glEnable(GL_BLEND);
           glUseProgram(program.get(multi));
         }
-        glUniform1i(corner_base, 4 * view * n);
         quads_.draw(0, n);
         if (depth_cull) {
           glDepthMask(GL_TRUE);
@@ -371,30 +369,25 @@ class SlimPointsPass final : public Pass {
   }
 
  private:
-  // slim.evaluation "patch": each view's rectangles (slim_patch_plan.comp),
-  // once per frame for both passes.
-  void plan_patch_corners(FrameContext& ctx, SlimResources& slim) {
-    const bool multi = ctx.views > 0;
-    const int views = multi ? ctx.views : 1;
-    slim.plan_patches(static_cast<std::size_t>(views));
+  // slim.evaluation "patch": the rectangles of view `view` (-1: the single
+  // camera) into the corner buffer (slim_patch_plan.comp), before each
+  // pass's draw: the buffer holds one view, so its size does not grow
+  // with the batch (a compute step per sphere where the vertex shader
+  // placed each of the 4 corners itself).
+  void plan_patch_corners(FrameContext& ctx, SlimResources& slim, int view) {
+    const bool multi = view >= 0;
     ProgramPair& plan = programs_.get("slim_patch_plan");
     glUseProgram(plan.get(multi));
     const auto n = static_cast<GLint>(slim.sphere_count());
     glUniform1i(plan.uniform(multi, "u_count"), n);
     glUniform1i(plan.uniform(multi, "u_cull_backfaces"), ctx.scene.slim.cull_backfaces ? 1 : 0);
     glUniform1f(plan.uniform(multi, "u_threshold"), static_cast<float>(ctx.scene.slim.depth_threshold));
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, slim.sphere_buffer());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, slim.corner_buffer());
-    const GLint offset = plan.uniform(multi, "u_offset");
-    const GLint base = plan.uniform(multi, "u_corner_base");
-    for (int v = 0; v < views; ++v) {
-      if (multi) glUniform1i(plan.uniform(true, "u_view"), v);
-      const Vec3 off = slim.anchor() - (multi ? ctx.view_eyes[static_cast<std::size_t>(v)] : ctx.basis.eye);
-      glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
-                  static_cast<float>(off[2]));
-      glUniform1i(base, 4 * v * n);
-      glDispatchCompute(static_cast<GLuint>((n + 63) / 64), 1, 1);
-    }
+    if (multi) glUniform1i(plan.uniform(true, "u_view"), view);
+    const Vec3 off =
+        slim.anchor() - (multi ? ctx.view_eyes[static_cast<std::size_t>(view)] : ctx.basis.eye);
+    glUniform3f(plan.uniform(multi, "u_offset"), static_cast<float>(off[0]),
+                static_cast<float>(off[1]), static_cast<float>(off[2]));
+    glDispatchCompute(static_cast<GLuint>((n + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   }
 

@@ -17,8 +17,8 @@
 // command per sphere (its sample count; 0 when the sphere is culled).
 //
 // slim.evaluation "patch" (the default) samples nothing: each sphere is one
-// rectangle facing the eye that bounds its patch (placed once per frame and
-// view by slim_patch_plan.comp for both passes, drawn by slim_patch.vert), whose
+// rectangle facing the eye that bounds its patch (placed by
+// slim_patch_plan.comp, drawn by slim_patch.vert), whose
 // fragments solve where their centre ray meets the height field
 // (slim_patch.glsl); the accumulate pass first writes slim_near into a
 // depth buffer (slim_zbuf) so that patches lying wholly behind the
@@ -81,9 +81,9 @@ class SlimResources {
   void plan_views(const std::vector<Camera>& cams, const std::vector<CameraBasis>& bases,
                   const SlimSettings& settings);
   // slim.evaluation "patch" draws one quad per sphere and view, planned on
-  // the GPU (slim_patch_plan.comp writes each view's 4 corners a sphere,
-  // view-major, into corner_buffer()): here the slots are recorded (one a
-  // sphere) and the corner buffer sized.
+  // the GPU (slim_patch_plan.comp writes a view's 4 corners a sphere into
+  // corner_buffer() before each pass draws that view): here the slots are
+  // recorded (one a sphere) and the corner buffer made.
   void plan_patches(std::size_t views);
   GLuint corner_buffer() const { return corner_ssbo_.get(); }
   GLuint command_buffer() const { return command_buffer_.get(); }
@@ -96,7 +96,6 @@ class SlimResources {
   Vec3 anchor_{};
   Aabb box_;
   GlBuffer sphere_ssbo_, index_vbo_, command_buffer_, grid_ssbo_, corner_ssbo_;
-  std::size_t corner_capacity_ = 0;  // corners (vec4)
   GlVertexArray vao_;
   std::size_t capacity_views_ = 0;
   std::vector<std::int64_t> slots_;

@@ -1,12 +1,11 @@
 // SLIM without sampling (slim.evaluation "patch"; render/slim_pass.hpp):
 // quad i (QuadIndices, render/gl_util.hpp) is support sphere i, the
 // rectangle bounding its patch that slim_patch_plan.comp placed for this
-// view. Each fragment solves where its centre ray meets the sphere's height
+// view just before. Each fragment solves where its centre ray meets the sphere's height
 // field (slim_patch.glsl). The sphere's data goes to the fragments as flat
 // varyings (no buffer reads per fragment).
 layout(std430, binding = 8) readonly buffer SlimPatchCorners { vec4 corners[]; };
 uniform vec3 u_offset;      // slim anchor minus eye
-uniform int u_corner_base;  // this view's first corner
 
 flat out vec3 v_c;             // the centre, camera-relative
 flat out vec4 v_p1;            // A, B, C, D
@@ -29,5 +28,5 @@ void main() {
   v_av = s.axis_v.xyz;
   v_aw = s.axis_w.xyz;
   v_albedo = s.albedo.rgb;
-  gl_Position = corners[u_corner_base + gl_VertexID];
+  gl_Position = corners[gl_VertexID];
 }

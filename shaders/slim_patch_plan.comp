@@ -1,8 +1,7 @@
 // SLIM without sampling (slim.evaluation "patch"; render/slim_pass.hpp), the
-// frame's plan for one view: per support sphere the clip positions of the
-// rectangle that slim_patch.vert draws, computed once here for both slim
-// passes (their vertex shaders read them) rather than at each of the
-// rectangle's 4 vertices in each pass. The rectangle faces the eye through
+// plan of one view: per support sphere the clip positions of the rectangle
+// that slim_patch.vert draws next, computed once here rather than at each
+// of the rectangle's 4 vertices. The rectangle faces the eye through
 // the sphere's centre and bounds the patch's body, the sphere within the
 // slab lo <= w <= hi of its frame (lo, hi from slim_height_range,
 // protocol/slim_model.hpp). A sphere holding the eye gets the whole
@@ -13,7 +12,6 @@ layout(local_size_x = 64) in;
 layout(std430, binding = 8) writeonly buffer SlimPatchCorners { vec4 corners[]; };
 uniform vec3 u_offset;      // slim anchor minus eye
 uniform int u_count;        // spheres
-uniform int u_corner_base;  // this view's first corner (4 a sphere)
 uniform int u_cull_backfaces;
 uniform float u_threshold;  // slim.depth_threshold
 
@@ -32,7 +30,7 @@ vec2 body_extent(float en, float r, float lo, float hi) {
 // Corners in a triangle strip's order: (0,0) (1,0) (0,1) (1,1) of the
 // rectangle's (a, b) extent (QuadIndices, render/gl_util.hpp).
 void store(int i, vec4 p0, vec4 p1, vec4 p2, vec4 p3) {
-  int k = u_corner_base + 4 * i;
+  int k = 4 * i;
   corners[k] = p0;
   corners[k + 1] = p1;
   corners[k + 2] = p2;
