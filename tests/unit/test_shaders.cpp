@@ -66,6 +66,23 @@ TEST(Shaders, ManifestNamesEveryShaderFile) {
   EXPECT_EQ(shader_program("beam").fragment.back(), "beam.frag");
 }
 
+// A compute program has its comp stage alone, and variants prepend their
+// prelude to it as to the other stages.
+TEST(Shaders, ComputeProgramsHaveTheirStageAlone) {
+  const ShaderProgramSpec& plan = shader_program("slim_patch_plan");
+  EXPECT_TRUE(plan.vertex.empty());
+  EXPECT_TRUE(plan.fragment.empty());
+  ASSERT_FALSE(plan.compute.empty());
+  EXPECT_EQ(plan.compute.back(), "slim_patch_plan.comp");
+  const ShaderProgramSpec& multi = shader_program("slim_patch_plan_multiview");
+  ASSERT_EQ(multi.compute.size(), plan.compute.size() + 1);
+  EXPECT_EQ(multi.compute.front(), "multiview.glsl");
+  EXPECT_TRUE(multi.vertex.empty());
+  for (const ShaderProgramSpec& p : shader_programs()) {
+    EXPECT_TRUE(p.compute.empty() || (p.vertex.empty() && p.fragment.empty())) << p.name;
+  }
+}
+
 // A compile error names the file and its own line, in the log and the listing.
 TEST(Shaders, CompileErrorNamesFileAndLine) {
   const std::string src = assemble_shader_text(
