@@ -1,7 +1,10 @@
-// SLIM pass 2, slim.evaluation "patch": each sphere whose patch the centre
-// ray meets within the depth threshold behind the nearest depth adds its
-// terms of F at x1 (the nearest depth) and x2 (a step behind), as
-// slim_accumulate.frag's field evaluation.
+// SLIM pass 2, slim.evaluation "patch": each sphere holding x1 (the
+// nearest depth on the centre ray) or x2 (a step behind) whose surface
+// passes within the depth threshold of it (|h| there, in the sphere's
+// radii) adds its terms of F at x1 and x2, as slim_accumulate.frag's field
+// evaluation. (The field's points test their crossing along the ray
+// instead; the height, which the terms compute anyway, spares solving for
+// the crossing again and differs only for supports seen edge-on.)
 // The patch's box is culled by the depth test against slim_near (slim_zbuf,
 // slim_near_depth.frag) before this runs.
 layout(early_fragment_tests) in;
@@ -21,15 +24,17 @@ void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   float near = VIEW_TEXEL(u_near, px).r;
   if (near >= 1e29) discard;  // no patch reaches this pixel
-  float z;
-  if (!patch_crossing(z)) discard;
-  if (z >= VIEW_TEXEL(u_scene_depth, px).r) discard;
-  if (z > near + u_threshold * v_p2.w) discard;  // a hidden layer
+  patch_ray();
   float step = slim_field_step(near, VIEW_TEXEL(u_radius, px).r);
   vec4 t1, t2, t3, t4;
-  bool any = patch_terms(ray_org + near * ray_dir, t1, t2);
-  any = patch_terms(ray_org + (near + step) * ray_dir, t3, t4) || any;
-  if (!any) discard;
+  bool in1 = patch_terms(ray_org + near * ray_dir, t1, t2);
+  bool in2 = patch_terms(ray_org + (near + step) * ray_dir, t3, t4);
+  if (!in1 && !in2) discard;
+  // A hidden layer: this sphere's surface passes farther than the
+  // threshold (in its radii) from the nearest point, |h| there (w h / w),
+  // or from the second point where the first is outside the sphere.
+  vec2 hw = in1 ? vec2(t1.w, t2.w) : vec2(t3.w, t4.w);
+  if (abs(hw.x) > u_threshold * v_p2.w * hw.y) discard;
   out_albedo = vec4(t2.w * v_albedo, 0.0);
   out_field = t1;
   out_weight = t2;
