@@ -88,8 +88,9 @@ GlBuffer make_buffer(const std::vector<T>& data, GLbitfield flags = 0) {
 // its vertex pipeline (fetch, shader, clip, emit) once per instance of an
 // instanced draw, for 4 vertices; indexed, it shades the vertices of
 // thousands of quads a batch (docs/gi.md, "Quads without instancing",
-// and docs/slim.md measure it). The index buffer holds kChunk quads; larger draws go in chunks, each
-// shifted by its base vertex (which gl_VertexID includes).
+// and docs/slim.md measure it). The index buffer holds kChunk quads;
+// larger draws go in chunks, each shifted by its base vertex (which
+// gl_VertexID includes).
 class QuadIndices {
  public:
   static constexpr GLsizei kChunk = 16384;

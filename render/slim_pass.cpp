@@ -381,7 +381,8 @@ class SlimPointsPass final : public Pass {
     const auto n = static_cast<GLint>(slim.sphere_count());
     glUniform1i(plan.uniform(multi, "u_count"), n);
     glUniform1i(plan.uniform(multi, "u_cull_backfaces"), ctx.scene.slim.cull_backfaces ? 1 : 0);
-    glUniform1f(plan.uniform(multi, "u_threshold"), static_cast<float>(ctx.scene.slim.depth_threshold));
+    glUniform1f(plan.uniform(multi, "u_threshold"),
+                static_cast<float>(ctx.scene.slim.depth_threshold));
     if (multi) glUniform1i(plan.uniform(true, "u_view"), view);
     const Vec3 off =
         slim.anchor() - (multi ? ctx.view_eyes[static_cast<std::size_t>(view)] : ctx.basis.eye);

@@ -6,9 +6,9 @@
 // instead; the height, which the terms compute anyway, spares solving for
 // the crossing again and differs only for supports seen edge-on.)
 // The patch's box is culled by the depth test against slim_near (slim_zbuf,
-// slim_near_depth.frag) before this runs.
+// slim_near_depth.frag) before this runs. (x1 lies in front of the scene's
+// other surfaces: the depth pass kept only crossings in front of them.)
 layout(early_fragment_tests) in;
-layout(binding = 0) uniform VIEW_SAMPLER u_scene_depth;
 layout(binding = 1) uniform VIEW_SAMPLER u_near;
 layout(binding = 2) uniform VIEW_SAMPLER u_radius;
 uniform float u_threshold;  // slim.depth_threshold, in units of the sphere's radius
