@@ -33,6 +33,7 @@ struct RenderArgs {
   int threads = 0;
   int spp = 64;
   std::uint64_t seed = 1;
+  int bounces = 32;
   std::string gather;  // "", "radius" or "nearest": the CPU photon gather
   int gather_k = 50;
 };
@@ -118,7 +119,11 @@ int run_render(const RenderArgs& args) {
     refopts.threads = args.threads;
     refopts.gi_spp = args.spp;
     refopts.gi_seed = args.seed;
-    if (scene.has_gi()) summary["gi_spp"] = args.spp;
+    refopts.gi_max_depth = args.bounces;
+    if (scene.has_gi()) {
+      summary["gi_spp"] = args.spp;
+      summary["gi_bounces"] = args.bounces;
+    }
     for (const Camera& cam : scene.cameras) {
       const auto t0 = std::chrono::steady_clock::now();
       FrameResult fr;
@@ -212,6 +217,12 @@ void add_render_command(CLI::App& app) {
                          ->check(CLI::Range(1, 1 << 20));
   CLI::Option* seed = cmd->add_option("--seed", args->seed,
                                       "CPU reference, scenes with lights: the path tracer's seed");
+  CLI::Option* bounces =
+      cmd->add_option("--bounces", args->bounces,
+                      "CPU reference, scenes with lights: surface interactions a path may have "
+                      "(1: direct light only)")
+          ->check(CLI::Range(1, 64))
+          ->needs(reference);
   CLI::Option* gather =
       cmd->add_option("--gather", args->gather,
                       "Scenes with lights: the CPU photon gather on the same photons instead of "
@@ -269,7 +280,8 @@ void add_render_command(CLI::App& app) {
     o->excludes(gather);
   }
   // Options of the local renderer mean nothing to a server render.
-  for (CLI::Option* local : {assets, reference, hdr, device, platform, threads, spp, seed, gather})
+  for (CLI::Option* local :
+       {assets, reference, hdr, device, platform, threads, spp, seed, bounces, gather})
     server->excludes(local);
 
   cmd->callback([args, remote, seq, batch, connections] {

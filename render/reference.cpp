@@ -423,6 +423,7 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
     po.spp = opts.gi_spp;
     po.seed = opts.gi_seed;
     po.threads = opts.threads;
+    po.max_depth = opts.gi_max_depth;
     gi_radiance = path_trace(*gi, cam, po);
   }
 

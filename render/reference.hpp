@@ -18,6 +18,11 @@ struct ReferenceOptions {
   // of the surfaces' radiance (gi/path_tracer.hpp).
   int gi_spp = 64;
   std::uint64_t gi_seed = 1;
+  // Surface interactions a path may have (PathTraceOptions::max_depth): 1
+  // is direct light only (emitters seen and next-event estimation at the
+  // first surface), which with the full image splits an error into its
+  // direct and indirect parts.
+  int gi_max_depth = 32;
   // Scalar volumes (Scene::volumes): the march's step in world units (0: a
   // sixteenth of the volume's smallest voxel spacing, each step sampled at
   // its middle), and whether to sample the exact field of procedural

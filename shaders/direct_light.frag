@@ -76,13 +76,19 @@ vec3 point_light(int i, vec3 x, vec3 n) {
     angular = c >= p.flux.w ? 1.0 : (c <= p.axis.w ? 0.0 : smoothstep(p.axis.w, p.flux.w, c));
   }
   if (angular <= 0.0) return vec3(0.0);
-  // Normal-offset lookup: x moved off its surface by about a texel's
-  // footprint (more where the light grazes it), compared half a texel
-  // short, so a lit surface does not shadow itself (acne).
+  // Slope-scaled lookup: x's own distance compared short by what its
+  // surface's distance can change over the bilinear lookup's texels (half a
+  // texel's footprint, and 1.5 footprints times tan of the light's angle to
+  // the normal, capped at 64), so a lit surface does not shadow itself
+  // (acne). Along the shadow ray, so the outlines and penumbrae stay where
+  // they are (a normal offset, used until 2026-11-27, moved them by up to
+  // 2 texels: test Gi.AShadowsOutlineStaysWhereTheOccluderPutsIt); light
+  // leaks only within that distance of a contact.
   float foot = dist * u_texel;
-  float sin_x = sqrt(max(0.0, 1.0 - cos_x * cos_x));
-  vec3 v = x + (foot * (0.5 + 1.5 * sin_x)) * n - (p.position.xyz + u_point_offset);
-  float visible = texture(u_shadows, vec4(v, float(i)), (length(v) - 0.5 * foot) / u_far);
+  float tan_x = sqrt(max(0.0, 1.0 - cos_x * cos_x)) / cos_x;
+  vec3 v = x - (p.position.xyz + u_point_offset);
+  float short_by = foot * (0.5 + 1.5 * min(tan_x, 64.0));
+  float visible = texture(u_shadows, vec4(v, float(i)), (dist - short_by) / u_far);
   if (visible <= 0.0) return vec3(0.0);
 #ifdef BEAMCAST_DIRECT_LEAN
   return p.flux.rgb * (angular * cos_x * visible / d2);

@@ -17,7 +17,6 @@
 // through the pixel's corners do not all agree. What the rest of such a
 // pixel shows is left out: the ceiling beside the light is ~3% of its
 // radiance.
-layout(binding = 2) uniform VIEW_SAMPLER u_gb_albedo;
 layout(binding = 3) uniform VIEW_SAMPLER u_indirect;  // rgb: the splats' sum; a: the share
 uniform int u_correct;      // 0: no share correction (gi.edge_correction off)
 uniform int u_direct_split;  // 1: the interleaved direct light to filter (direct_filter.glsl)

@@ -11,6 +11,8 @@
 // upsampling had pulled from further inside: 1.08 at splat_scale 2 on the
 // GL test's edge band). The share is found in the G-buffer at 48 points of
 // the disk (4 rings of 12), each projected into the image:
+//   - the pixel shows a quad light: not covered (the light stops the photons
+//     of what lies behind it);
 //   - the pixel shows the same surface (the splats' normal and plane tests):
 //     covered;
 //   - no surface, or the visible surface lies behind the point by more than
@@ -20,7 +22,6 @@
 //     reaches under the floor), else unknown, counted as covered (something
 //     in front hides the rest of x's surface);
 //   - off the image: unknown, covered.
-layout(binding = 2) uniform VIEW_SAMPLER u_gb_albedo;
 // A band's texel plus u_band_shift is its splat-grid texel (render/pass_plan.hpp,
 // SplatBands; the pass draws once per band).
 uniform ivec2 u_band_shift;

@@ -3,6 +3,7 @@
 // "gi_resolve" (gi_resolve.frag).
 layout(binding = 0) uniform VIEW_SAMPLER u_view_depth;
 layout(binding = 1) uniform VIEW_SAMPLER u_gb_normal;
+layout(binding = 2) uniform VIEW_SAMPLER u_gb_albedo;  // w: the material (surface.frag)
 uniform float u_radius;
 // The kernel, SplatKernel: 0 box, 1 cone, 2 Epanechnikov (set by the
 // programs' preludes, gi_kernel_*.glsl).
@@ -65,6 +66,9 @@ float disk_share(vec3 x, vec3 n) {
         covered += w;
         continue;
       }
+      // A quad light stops the photons that would reach what lies behind
+      // it (the Cornell light hangs 0.1 under the ceiling): none there.
+      if (VIEW_TEXEL(u_gb_albedo, q).w > 2.5) continue;
       if (same_surface(q, x, n)) {
         covered += w;
         continue;
