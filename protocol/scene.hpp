@@ -207,6 +207,10 @@ struct OutputSettings {
   double exposure = 1.0;
   ToneCurve tone = ToneCurve::kExponential;
   int bit_depth = 8;  // 8 or 16 bits per channel PNG
+  // Antialiasing: each camera rendered at supersample x its width and
+  // height, its linear HDR averaged over each supersample^2 block (a box
+  // filter, the reference's pixel average) before tone mapping. 1: none.
+  int supersample = 1;
 };
 
 // How the beam line integrals are evaluated; every accuracy knob lives here

@@ -405,7 +405,7 @@ DirectionalLight parse_light(const Node& n) {
 
 OutputSettings parse_output(const Node& n) {
   ObjectReader o(n, "output settings");
-  o.allow_only({"exposure", "tone", "bit_depth"});
+  o.allow_only({"exposure", "tone", "bit_depth", "supersample"});
   OutputSettings out;
   if (auto e = o.optional("exposure")) out.exposure = check_positive(*e, read_number(*e));
   if (auto t = o.optional("tone")) {
@@ -420,6 +420,7 @@ OutputSettings parse_output(const Node& n) {
     }
     out.bit_depth = static_cast<int>(v);
   }
+  if (auto k = o.optional("supersample")) out.supersample = read_int_in(*k, 1, kMaxSupersample);
   return out;
 }
 
@@ -606,6 +607,16 @@ void check_frame_size(std::int64_t width, std::int64_t height, const SceneLimits
     fail("limit_exceeded", width_path,
          std::string(what) + " of " + w + " x " + h + " = " + std::to_string(width * height) +
              " pixels is over the limit max_pixels = " + std::to_string(limits.max_pixels));
+  }
+}
+
+void check_supersampled_size(const std::vector<Camera>& cameras, int supersample,
+                             const SceneLimits& limits, const std::string& path) {
+  if (supersample <= 1) return;
+  for (const Camera& c : cameras) {
+    check_frame_size(static_cast<std::int64_t>(c.width) * supersample,
+                     static_cast<std::int64_t>(c.height) * supersample, limits, path, path,
+                     "supersampled camera");
   }
 }
 
@@ -898,6 +909,7 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
 
   const Node cameras = o.required("cameras");
   scene.cameras = parse_camera_list(cameras.json(), cameras.path, limits);
+  check_supersampled_size(scene.cameras, scene.output.supersample, limits, "/output/supersample");
   check_method_fits_densities(scene);
   // Last: reading volume files is the costliest step, so a scene with a
   // cheaper mistake is refused without it.
@@ -964,6 +976,7 @@ nlohmann::json scene_capabilities() {
           {"material_types", {"diffuse", "mirror", "glass"}},
           {"gi_kernels", {"box", "cone", "epanechnikov"}},
           {"gi_direct", {"shadow_maps", "photons"}},
+          {"max_supersample", kMaxSupersample},
           {"camera_rigs", enum_names(kRigKinds)},
           {"slim_settings",
            std::vector<std::string_view>(kSlimSettingFields.begin(), kSlimSettingFields.end())},

@@ -88,6 +88,11 @@ void check_frame_size(std::int64_t width, std::int64_t height, const SceneLimits
                       const std::string& width_path, const std::string& height_path,
                       std::string_view what);
 
+// output.supersample: each camera's rendered size (its size times k) within
+// the same limits, the error at `path`.
+void check_supersampled_size(const std::vector<Camera>& cameras, int supersample,
+                             const SceneLimits& limits, const std::string& path);
+
 // The grid of an atlas of frames of these sizes (PROTOCOL.md, "Atlas";
 // render/atlas.hpp composes it): columns = ceil(sqrt(K)), rows = ceil(K /
 // columns), cells as large as the largest frame.
@@ -101,7 +106,8 @@ AtlasGrid atlas_grid(const std::vector<std::pair<int, int>>& sizes);
 // A camera as scene JSON (parse_camera of the result gives the camera back;
 // numbers are written with full double precision).
 nlohmann::json camera_to_json(const Camera& c);
-// An "output" object (exposure, tone, bit_depth); missing fields take defaults.
+// An "output" object (exposure, tone, bit_depth, supersample); missing fields take defaults.
+constexpr int kMaxSupersample = 4;
 OutputSettings parse_output_settings(const nlohmann::json& j, const std::string& path);
 // The scene element types this parser accepts, from the parser's own tables
 // (hello's capabilities): beam_types, densities, occluder_types, camera_rigs.

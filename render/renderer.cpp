@@ -483,8 +483,64 @@ std::vector<std::vector<std::size_t>> camera_batches(const std::vector<Camera>& 
   return batches;
 }
 
+namespace {
+
+// The mean of each k x k block of `big` (k times hdr's size each way).
+HdrImage box_downsample(const HdrImage& big, int k) {
+  HdrImage small;
+  small.width = big.width / k;
+  small.height = big.height / k;
+  small.rgb.assign(3 * static_cast<std::size_t>(small.width) * small.height, 0.0f);
+  const double scale = 1.0 / (k * k);
+  for (int y = 0; y < small.height; ++y) {
+    for (int x = 0; x < small.width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0.0;
+        for (int dy = 0; dy < k; ++dy) {
+          const float* row = &big.rgb[3 * ((static_cast<std::size_t>(y) * k + dy) * big.width)];
+          for (int dx = 0; dx < k; ++dx) sum += row[3 * (x * k + dx) + c];
+        }
+        small.rgb[3 * (static_cast<std::size_t>(y) * small.width + x) + c] =
+            static_cast<float>(sum * scale);
+      }
+    }
+  }
+  return small;
+}
+
+}  // namespace
+
 std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<Camera>& cameras,
                                           const FrameOptions& opts) {
+  const int k = scene.output.supersample;
+  // Supersampled: every camera at k times the size, its HDR box-filtered
+  // back and tone-mapped here (render/image.hpp's tone_map, the same curve
+  // as the tonemap pass). Frames of a preview's lower resolution scale skip
+  // it: they are a moving camera's quick frames.
+  if (k <= 1 || PlanInput{scene, opts.resolution_scale}.scaled()) {
+    return render_cameras(scene, cameras, opts);
+  }
+  std::vector<Camera> big = cameras;
+  for (Camera& c : big) {
+    c.width *= k;
+    c.height *= k;
+  }
+  FrameOptions o = opts;
+  o.read_hdr = true;
+  std::vector<FrameResult> frames = render_cameras(scene, big, o);
+  for (FrameResult& f : frames) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f.hdr = box_downsample(f.hdr, k);
+    f.image = tone_map(f.hdr, scene.output);
+    if (!opts.read_hdr) f.hdr = {};
+    f.wall_ms += ms_since(t0);
+  }
+  return frames;
+}
+
+std::vector<FrameResult> Renderer::render_cameras(const Scene& scene,
+                                                  const std::vector<Camera>& cameras,
+                                                  const FrameOptions& opts) {
   const FramePlan plan = make_plan(PlanInput{scene, opts.resolution_scale});
   SceneResources res(scene, impl_->tables, plan, &impl_->photons, &impl_->volumes);
   if (std::exchange(impl_->fail_next, false)) {

@@ -147,6 +147,9 @@ class Renderer {
   void fail_next_render_for_test();
 
  private:
+  // render() without output.supersample.
+  std::vector<FrameResult> render_cameras(const Scene& scene, const std::vector<Camera>& cameras,
+                                          const FrameOptions& opts);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

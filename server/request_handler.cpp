@@ -138,6 +138,10 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     scene = std::move(copy);
   }
   std::vector<Camera> cameras = rp.cameras ? *rp.cameras : scene->cameras;
+  check_supersampled_size(cameras, scene->output.supersample, core.config.scene_limits,
+                          rp.output && rp.output->contains("supersample")
+                              ? "/params/output/supersample"
+                              : (rp.cameras ? "/params/cameras" : "/params/scene/output/supersample"));
   if (rp.atlas) {
     // The composed image is a frame too: same limits as every camera.
     std::vector<std::pair<int, int>> sizes;

@@ -402,6 +402,26 @@ TEST(Server, SceneAndRequestLimitsAreEnforced) {
   sc["occluders"] = {{{"type", "mesh"}, {"file", "meshes/torus.obj"}}};  // 256 triangles
   r = c.call(render_req(5, sc));
   EXPECT_EQ(error_code(r), "limit_exceeded");
+
+  // A supersampled camera renders at k times its size: 3 x 100 > max_width,
+  // in the scene and as the request's output override.
+  sc = small_scene();
+  sc["cameras"][0]["width"] = 100;
+  sc["cameras"][0]["height"] = 50;
+  sc["output"] = {{"supersample", 3}};
+  r = c.call(render_req(6, sc));
+  EXPECT_EQ(error_code(r), "limit_exceeded");
+  EXPECT_EQ(error_path(r), "/params/scene/output/supersample");
+  sc.erase("output");
+  req = render_req(7, sc);
+  req["params"]["output"] = {{"supersample", 3}};
+  r = c.call(req);
+  EXPECT_EQ(error_code(r), "limit_exceeded");
+  EXPECT_EQ(error_path(r), "/params/output/supersample");
+  req["params"]["output"] = {{"supersample", 2}};  // 200 x 100: within both limits
+  r = c.call(req);
+  EXPECT_TRUE(r.json["ok"]) << r.json;
+  EXPECT_EQ(frame_png(r, 0).width, 100);
   EXPECT_TRUE(s.healthy());
 }
 

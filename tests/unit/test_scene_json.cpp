@@ -193,6 +193,24 @@ TEST(SceneJson, ScalarTableSizeSetsBothAxes) {
   EXPECT_EQ(s.render.table_s, 32);
 }
 
+// output.supersample: k in [1, 4]; the camera at k times its size within
+// the frame-size limits, the error at the knob (its default 1 adds nothing).
+TEST(SceneJson, SupersampleIsCheckedAgainstTheFrameLimits) {
+  EXPECT_EQ(parse_scene(minimal(), {}).output.supersample, 1);
+  const json wide = with(minimal(), "/cameras/0", {{"width", 4096}, {"height", 256}});
+  EXPECT_EQ(parse_scene(with(wide, "/output", {{"supersample", 2}}), {}).output.supersample, 2);
+  for (const int bad : {0, 5}) {
+    const ErrorInfo e = error_of(with(minimal(), "/output", {{"supersample", bad}}));
+    EXPECT_EQ(e.code, "out_of_range");
+    EXPECT_EQ(e.path, "/output/supersample");
+  }
+  // 3 x 4096 = 12288 > max_width 8192.
+  const ErrorInfo e = error_of(with(wide, "/output", {{"supersample", 3}}));
+  EXPECT_EQ(e.code, "limit_exceeded");
+  EXPECT_EQ(e.path, "/output/supersample");
+  EXPECT_NE(e.message.find("12288"), std::string::npos) << e.message;
+}
+
 TEST(SceneJson, NearParallelRule) {
   EXPECT_EQ(parse_scene(minimal(), {}).render.near_parallel, NearParallel::kQuadrature);
   const Scene s = parse_scene(with(minimal(), "/render", {{"near_parallel", "none"}}), {});
