@@ -9,13 +9,16 @@ Runs `beamcast render` (this build) on the Cornell box (examples/cornell_box.jso
     of one);
   - the path tracer alone at a few sample counts (time to equal error);
   - the GPU frame (photon splatting) for each setting: photon counts 1e3 ...
-    1e6 (default kernel and radius), each kernel at 1e5, the radius at 0.5x
+    4e6 (default kernel and radius), each kernel at 1e5, the radius at 0.5x
     and 2x its default at 1e5; at 1e5 also direct light from photons (the
     seed's way) in place of the direct pass, and the direct pass's knobs
     (points per quad light 4 and 64, shadow maps of 128 and 512 texels), the
     splats' edge correction off, splatting at 1/2 and 1/8 of the size (the
     default is 1/4), and photons merged into disks (gi.cluster) 0, 0.25 and
-    0.5 (the default is 0.35).
+    0.5 (the default is 0.35); and output.supersample 2 (antialiasing) at 1e5, 1e6
+    and 4e6.
+The reference can instead be given as path-traced renders made before
+(`--reference-hdr PATH:SPP`, repeated), so a long one serves several runs.
 Then the default frame as the preview gets it: one camera per request to a
 beamcast-server (next to the binary) holding the scene, maps cached.
 Per photon count also the CPU photon gather on the same photons
@@ -167,6 +170,38 @@ def default_radius(scene, photons):
     return math.sqrt(k * area / (math.pi * photons))
 
 
+def given_reference(specs, size):
+    """The reference from renders made before (--reference-hdr PATH:SPP):
+    their spp-weighted mean, and its noise: the files split into the two
+    groups of most nearly equal spp, whose means A and B (weights wA, wB)
+    differ by noise of variance s^2 (1/wA + 1/wB) where the whole mean has
+    s^2 / (wA + wB): rel_l1(A, B) x sqrt(wA wB) / (wA + wB)."""
+    imgs, w = [], []
+    for spec in specs:
+        path, spp = spec.rsplit(":", 1)
+        imgs.append(np.fromfile(path, dtype=np.float32).reshape(size, size, 3).astype(np.float64))
+        w.append(float(spp))
+    if len(imgs) < 2:
+        sys.exit("--reference-hdr: give at least two independent renders")
+    total = sum(w)
+    best = None
+    for mask in range(1, 2 ** len(w) - 1):
+        wa = sum(x for i, x in enumerate(w) if mask >> i & 1)
+        if best is None or abs(2 * wa - total) < abs(2 * best[1] - total):
+            best = (mask, wa)
+    mask, wa = best
+    wb = total - wa
+    mean = lambda sel: sum(x * im for x, im, s in zip(w, imgs, sel) if s) / sum(
+        x for x, s in zip(w, sel) if s)
+    sel = [bool(mask >> i & 1) for i in range(len(w))]
+    a_img, b_img = mean(sel), mean([not x for x in sel])
+    noise = rel_l1(a_img, b_img) * math.sqrt(wa * wb) / total
+    ref = sum(x * im for x, im in zip(w, imgs)) / total
+    desc = (f"{len(imgs)} path-traced renders given, {total:.0f} spp in all "
+            f"({', '.join(f'{x:.0f}' for x in w)})")
+    return ref, noise, desc
+
+
 def write_png(path, hdr, exposure):
     """Tone curve 1 - exp(-x), sRGB, 8 bits (render/image.cpp's default), via matplotlib."""
     x = 1 - np.exp(-exposure * np.maximum(hdr, 0))
@@ -191,6 +226,10 @@ def main():
     ap.add_argument("--spp", type=int, help="reference samples per pixel (default 1024, 64 quick)")
     ap.add_argument("--views", type=int, default=4,
                     help="camera copies per GPU render (frame time = median over them)")
+    ap.add_argument("--reference-hdr", action="append", default=[], metavar="PATH:SPP",
+                    help="use these path-traced renders (.rgb32f of this scene at --size, each "
+                         "independent, with its spp) as the reference instead of rendering two; "
+                         "at least two; repeat the option")
     a = ap.parse_args()
     size = a.size or (128 if a.quick else 512)
     spp = a.spp or (64 if a.quick else 1024)
@@ -204,7 +243,9 @@ def main():
 
     refs = []
     ref_wall = []
-    for seed in (1, 2):
+    if a.reference_hdr:
+        ref, ref_noise, ref_desc = given_reference(a.reference_hdr, size)
+    for seed in ((1, 2) if not a.reference_hdr else ()):
         s = dict(base, gi=dict(base.get("gi", {}), seed=seed))
         # The path tracer's seed is its own option; two renders with
         # different seeds give independent references.
@@ -212,14 +253,18 @@ def main():
                                    ["--reference", "--spp", str(spp), "--seed", str(seed)])
         refs.append(load_hdr(summary["frames"][0]))
         ref_wall.append(wall)
-    ref = 0.5 * (refs[0] + refs[1])  # the reference: both, 2 x spp
-    # Noise of the averaged reference: |ref1 - ref2| / 2 estimates it (each
-    # has sqrt(2) x its noise; the mean has 1 / sqrt(2) x).
-    ref_noise = rel_l1(refs[0], refs[1]) / 2
+    if not a.reference_hdr:
+        ref = 0.5 * (refs[0] + refs[1])  # the reference: both, 2 x spp
+        # Noise of the averaged reference: |ref1 - ref2| / 2 estimates it (each
+        # has sqrt(2) x its noise; the mean has 1 / sqrt(2) x).
+        ref_noise = rel_l1(refs[0], refs[1]) / 2
+        ref_desc = (f"2 x {spp} spp path traced ({ref_wall[0]:.0f} + {ref_wall[1]:.0f} s wall)")
     write_png(os.path.join(a.out, "reference.png"), ref, exposure)
 
+    # Up to 4e6: the server's photon limit (max_photons 4 000 000) is the
+    # top a client can ask for.
     counts = [1000, 3000, 10000, 30000, 100000] if a.quick else \
-        [1000, 3000, 10000, 30000, 100000, 300000, 1000000]
+        [1000, 3000, 10000, 30000, 100000, 300000, 1000000, 4000000]
     mid = 10000 if a.quick else 100000
     # (knob, photons, kernel, radius scale, other gi fields, what the row varies)
     settings = [("photons", n, "epanechnikov", 1.0, {}, "") for n in counts]
@@ -245,11 +290,21 @@ def main():
     # Photons merged into disks (gi.cluster; default 0.35): none, finer, coarser.
     settings += [("cluster", mid, "epanechnikov", 1.0, {"cluster": c}, f"cluster {c}")
                  for c in (0.0, 0.25, 0.5)]
+    # Antialiasing (output.supersample 2: 4 times the pixels, box-filtered):
+    # the reference is a pixel average, so surfaces' outlines differ from a
+    # frame sampled at pixel centres; at the default and the top counts.
+    settings += [("supersample", n, "epanechnikov", 1.0, {"supersample": 2}, "supersample 2")
+                 for n in ([mid] if a.quick else [mid, 1000000, 4000000])]
     regions = sorted(set(CORNELL_LABELS)) if len(base["occluders"]) == len(CORNELL_LABELS) else []
 
     rows = []
     for knob, n, kernel, rscale, extra, varied in settings:
-        s = dict(base, gi=dict(base.get("gi", {}), photons=n, kernel=kernel, **extra))
+        extra = dict(extra)
+        output = dict(base.get("output", {}))
+        if "supersample" in extra:
+            output["supersample"] = extra.pop("supersample")
+        s = dict(base, gi=dict(base.get("gi", {}), photons=n, kernel=kernel, **extra),
+                 output=output)
         r = default_radius(s, n) * rscale
         s["gi"]["radius"] = r
         # Copies of the camera, each nudged by a hair so no two frames are
@@ -334,8 +389,7 @@ def main():
     with open(os.path.join(a.out, "gi.md"), "w") as f:
         f.write(f"# Photon splatting against the path tracer ({os.path.basename(a.scene)}, "
                 f"{size}x{size})\n\n")
-        f.write(f"Reference: 2 x {spp} spp path traced ({ref_wall[0]:.0f} + {ref_wall[1]:.0f} s "
-                f"wall); its own noise (rel. L1): {ref_noise:.4f}.\n")
+        f.write(f"Reference: {ref_desc}; its own noise (rel. L1): {ref_noise:.4f}.\n")
         f.write(f"Log-log slope of error against photon count: {slope:.2f}.\n\n")
         if rate:
             f.write("Camera-only change at the defaults, one camera per request to a "
@@ -365,7 +419,7 @@ def main():
         ax[0].set_ylabel("relative L1 error")
         ax[0].legend(fontsize=7)
         for knob, mk in (("photons", "o"), ("kernel", "s"), ("radius", "^"), ("direct", "d"),
-                         ("splat", "v"), ("cluster", "P")):
+                         ("splat", "v"), ("cluster", "P"), ("supersample", "*")):
             pts = [r for r in rows if r["knob"] == knob]
             ax[1].loglog([r["frame_ms"] for r in pts], [r["rel_l1"] for r in pts], mk, label=knob)
         pts = [r for r in rows if r["knob"] == "path_tracer"]

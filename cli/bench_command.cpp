@@ -195,6 +195,7 @@ void add_bench_command(CLI::App& app) {
     std::string out, scene;
     bool quick = false;
     int size = 0, spp = 0;
+    std::vector<std::string> references;  // --reference-hdr PATH:SPP
   };
   auto gopts = std::make_shared<GiArgs>();
   CLI::App* gi = bench->add_subcommand(
@@ -209,12 +210,18 @@ void add_bench_command(CLI::App& app) {
   gi->add_option("--spp", gopts->spp, "Reference samples per pixel (default 1024, 64 with --quick)")
       ->check(CLI::Range(1, 1 << 20));
   gi->add_option("--scene", gopts->scene, "Scene (default examples/cornell_box.json)");
+  gi->add_option("--reference-hdr", gopts->references,
+                 "PATH:SPP of a path-traced render (.rgb32f) of the scene to use as the reference "
+                 "instead of rendering one; at least two, independent");
   gi->callback([gopts] {
     std::string extra;
     if (gopts->quick) extra += " --quick";
     if (gopts->size > 0) extra += " --size " + std::to_string(gopts->size);
     if (gopts->spp > 0) extra += " --spp " + std::to_string(gopts->spp);
     if (!gopts->scene.empty()) extra += " --scene " + bench::shell_quote(gopts->scene);
+    for (const std::string& r : gopts->references) {
+      extra += " --reference-hdr " + bench::shell_quote(r);
+    }
     run_python_bench("gi_bench.py", gopts->out, extra);
   });
 
