@@ -111,35 +111,30 @@ bool to_window(vec3 p, out vec2 f) {
   return true;
 }
 
-// The area of the convex quadrilateral q (window positions) inside the
-// square [lo, lo + 1]^2: q clipped by the square's four sides
-// (Sutherland-Hodgman; each side adds at most one vertex), then the
-// shoelace formula.
+// The area of the quadrilateral q (window positions, either winding) inside
+// the square [lo, lo + 1]^2, by Green's theorem: the area of a region R
+// inside the square is the integral around R's boundary of
+// clamp(x - lo.x, 0, 1) dy over the y in [lo.y, lo.y + 1], summed edge by
+// edge in closed form (no clipped polygon: llvmpipe pays for local arrays
+// at every fragment of the pass, 16 ms at 512^2, measured 2026-11-27).
+float clamp_integral(float u) {  // the integral of clamp(t, 0, 1) dt from 0 to u
+  return u <= 0.0 ? 0.0 : (u < 1.0 ? 0.5 * u * u : u - 0.5);
+}
+
 float area_in_pixel(vec2 q[4], vec2 lo) {
-  vec2 a[8], b[8];
-  int n = 4;
-  for (int i = 0; i < 4; ++i) a[i] = q[i];
-  for (int side = 0; side < 4; ++side) {
-    int axis = side & 1;
-    float sgn = side < 2 ? 1.0 : -1.0;  // keep x >= lo.x, y >= lo.y, x <= lo.x + 1, y <= lo.y + 1
-    float bound = lo[axis] + (side < 2 ? 0.0 : 1.0);
-    int m = 0;
-    for (int i = 0; i < n; ++i) {
-      vec2 p = a[i], r = a[(i + 1) % n];
-      float dp = sgn * (p[axis] - bound), dr = sgn * (r[axis] - bound);
-      if (dp >= 0.0) b[m++] = p;
-      if ((dp >= 0.0) != (dr >= 0.0)) b[m++] = mix(p, r, dp / (dp - dr));
-    }
-    n = m;
-    if (n == 0) return 0.0;
-    for (int i = 0; i < n; ++i) a[i] = b[i];
+  float area = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    vec2 a = q[i] - lo, b = q[(i + 1) & 3] - lo;
+    if (a.y == b.y) continue;
+    float y0 = max(min(a.y, b.y), 0.0), y1 = min(max(a.y, b.y), 1.0);
+    if (y1 <= y0) continue;
+    float m = (b.x - a.x) / (b.y - a.y);  // dx / dy along the edge
+    float u0 = a.x + (y0 - a.y) * m, u1 = a.x + (y1 - a.y) * m;
+    float part = abs(u1 - u0) < 1e-4 ? clamp(0.5 * (u0 + u1), 0.0, 1.0) * (y1 - y0)
+                                     : (clamp_integral(u1) - clamp_integral(u0)) / m;
+    area += b.y > a.y ? part : -part;
   }
-  float twice = 0.0;
-  for (int i = 0; i < n; ++i) {
-    vec2 p = a[i], r = a[(i + 1) % n];
-    twice += p.x * r.y - r.x * p.y;
-  }
-  return 0.5 * abs(twice);
+  return abs(area);
 }
 
 // The share of pixel px whose rays meet light k's front before depth zlim:
