@@ -489,6 +489,36 @@ TEST(Gi, DirectLightOfAQuadLightMatchesItsIntegral) {
   EXPECT_LT(s.max_rel, 0.02);
 }
 
+// Mean of gpu / closed form over the floor (y = 0) pixels whose floor point
+// passes `keep`, the floor lit by a point light of power phi at `light`
+// (rho phi cos / (4 pi^2 d^2), all of it from photons with gi.direct
+// "photons"); `count` gets the pixels.
+template <class Keep>
+double floor_ratio(const Scene& scene, const Vec3& light, double rho, double phi, Keep keep,
+                   int* count) {
+  const auto frames = renderer().render(scene, FrameOptions{.read_hdr = true});
+  const Camera& cam = scene.cameras[0];
+  const CameraBasis basis = camera_basis(cam);
+  const HdrImage& hdr = frames[0].hdr;
+  double sum = 0.0;
+  int n = 0;
+  for (int row = 0; row < hdr.height; ++row) {
+    for (int px = 0; px < hdr.width; ++px) {
+      const Ray r = camera_ray(cam, basis, px, hdr.height - 1 - row);
+      const Vec3 x = r.origin + (-r.origin[1] / r.dir[1]) * r.dir;
+      if (!keep(x)) continue;
+      const Vec3 to = light - x;
+      const double d2 = dot(to, to);
+      const double want =
+          rho / std::numbers::pi * phi / (4.0 * std::numbers::pi) * (to[1] / std::sqrt(d2)) / d2;
+      sum += hdr.at(px, row)[0] / want;
+      ++n;
+    }
+  }
+  *count = n;
+  return sum / n;
+}
+
 // The splats' edge correction (pass gi_resolve): on a lone 2 x 2 floor under
 // a point light with direct light from photons, a pixel within half the
 // radius of the floor's edge gets photons from at most ~60% of its disk
@@ -516,32 +546,18 @@ TEST(Gi, TheEdgeCorrectionRemovesTheSplatsBiasAtASurfacesEdge) {
   };
   // Mean of gpu / closed form over floor pixels within kRadius / 2 of an edge.
   auto band_ratio = [&](bool correct, int size) {
-    const Scene scene = parse_scene(scene_json(correct, size), {});
-    const auto frames = renderer().render(scene, FrameOptions{.read_hdr = true});
-    const Camera& cam = scene.cameras[0];
-    const CameraBasis basis = camera_basis(cam);
-    const HdrImage& hdr = frames[0].hdr;
-    double sum = 0.0;
     int n = 0;
-    for (int row = 0; row < hdr.height; ++row) {
-      for (int px = 0; px < hdr.width; ++px) {
-        const Ray r = camera_ray(cam, basis, px, hdr.height - 1 - row);
-        const double t = -r.origin[1] / r.dir[1];
-        const Vec3 x = r.origin + t * r.dir;
-        const double edge = kHalf - std::max(std::abs(x[0]), std::abs(x[2]));
-        if (!(edge > 0.0 && edge < kRadius / 2)) continue;
-        const Vec3 to = light - x;
-        const double d2 = dot(to, to);
-        const double want = kRho / std::numbers::pi * kPhi / (4.0 * std::numbers::pi) *
-                            (to[1] / std::sqrt(d2)) / d2;
-        sum += hdr.at(px, row)[0] / want;
-        ++n;
-      }
-    }
-    std::printf("%d^2: %d edge-band pixels, mean gpu / closed form %.4f (%s)\n", size, n, sum / n,
+    const double ratio = floor_ratio(
+        parse_scene(scene_json(correct, size), {}), light, kRho, kPhi,
+        [&](const Vec3& x) {
+          const double edge = kHalf - std::max(std::abs(x[0]), std::abs(x[2]));
+          return edge > 0.0 && edge < kRadius / 2;
+        },
+        &n);
+    std::printf("%d^2: %d edge-band pixels, mean gpu / closed form %.4f (%s)\n", size, n, ratio,
                 correct ? "corrected" : "uncorrected");
     EXPECT_GT(n, size * size / 40);
-    return sum / n;
+    return ratio;
   };
   EXPECT_LT(band_ratio(false, 128), 0.85);
   EXPECT_NEAR(band_ratio(true, 128), 1.0, 0.04);
@@ -581,33 +597,19 @@ TEST(Gi, ASharesDiskOverAQuadLightCountsNoPhotonsThere) {
               {"direct", "photons"}, {"splat_scale", 1}}},
       {"cameras", {{{"position", {0, 3, 0.001}}, {"target", {0, 0, 0}}, {"fov_y", 45},
                     {"width", 128}, {"height", 128}}}}};
-  const Scene scene = parse_scene(j, {});
-  const auto frames = renderer().render(scene, FrameOptions{.read_hdr = true});
-  const Camera& cam = scene.cameras[0];
-  const CameraBasis basis = camera_basis(cam);
-  const HdrImage& hdr = frames[0].hdr;
-  double sum = 0.0;
   int n = 0;
-  for (int row = 0; row < hdr.height; ++row) {
-    for (int px = 0; px < hdr.width; ++px) {
-      const Ray r = camera_ray(cam, basis, px, hdr.height - 1 - row);
-      const double t = -r.origin[1] / r.dir[1];
-      const Vec3 x = r.origin + t * r.dir;
-      // Distance outside the light's square (its outline seen from above);
-      // the light's own shadow on the floor reaches kLift x 1.5 past it.
-      const double out = std::max(std::abs(x[0]), std::abs(x[2])) - kSide / 2;
-      if (!(out > 2 * kLift && out < kRadius / 2)) continue;
-      const Vec3 to = light - x;
-      const double d2 = dot(to, to);
-      const double want = kRho / std::numbers::pi * kPhi / (4.0 * std::numbers::pi) *
-                          (to[1] / std::sqrt(d2)) / d2;
-      sum += hdr.at(px, row)[0] / want;
-      ++n;
-    }
-  }
-  std::printf("%d pixels around the light, mean gpu / closed form %.4f\n", n, sum / n);
+  const double ratio = floor_ratio(
+      parse_scene(j, {}), light, kRho, kPhi,
+      [&](const Vec3& x) {
+        // Distance outside the light's square (its outline seen from above);
+        // the light's own shadow on the floor reaches kLift x 1.5 past it.
+        const double out = std::max(std::abs(x[0]), std::abs(x[2])) - kSide / 2;
+        return out > 2 * kLift && out < kRadius / 2;
+      },
+      &n);
+  std::printf("%d pixels around the light, mean gpu / closed form %.4f\n", n, ratio);
   EXPECT_GT(n, 200);
-  EXPECT_NEAR(sum / n, 1.0, 0.04);
+  EXPECT_NEAR(ratio, 1.0, 0.04);
 }
 
 TEST(Gi, ACameraOnlyChangeTracesNoPhotons) {
