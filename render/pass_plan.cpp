@@ -235,6 +235,9 @@ FramePlan make_plan(const PlanInput& in, const std::vector<PassDecl>& catalog,
                     const std::vector<TargetDecl>& targets) {
   FramePlan plan;
   plan.splat_scale = in.scene.gi.splat_scale;
+  if (in.scene.has_gi() && has_specular(in.scene) && in.scene.gi.caustic_photons > 0) {
+    plan.auto_splat_cap = 2;
+  }
   auto target = [&](const PassDecl& pass, const std::string& name) -> const TargetDecl* {
     for (const TargetDecl& t : targets) {
       if (t.name == name) return &t;

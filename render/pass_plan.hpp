@@ -146,6 +146,11 @@ struct FramePlan {
   std::vector<std::string> uploads;        // union of the planned passes' uploads
   std::string final_target;                // the last pass's first write: what is read back
   int splat_scale = 1;  // kSplat targets' divisor: the scene's gi.splat_scale (0: auto_splat_scale)
+  // The largest divisor auto_splat_scale may pick: 2 when a caustic map is
+  // drawn (its disks, a quarter of the global radius, fall between the
+  // texels of a coarser grid: the caustic region read 20% bright at 4,
+  // docs/gi.md "Caustics and the splat size"), else no cap.
+  int auto_splat_cap = 1 << 30;
 
   // True if a planned pass (not just the frame-start clear) writes `target`.
   bool written(std::string_view target) const;

@@ -39,7 +39,8 @@ GLenum internal_format(TargetFormat f, int bits) {
 void FrameTargets::ensure(const FramePlan& plan, int render_w, int render_h, int camera_w,
                           int camera_h, int bits, int layer_count) {
   const int splat_scale =
-      plan.splat_scale > 0 ? plan.splat_scale : auto_splat_scale(render_w, render_h);
+      plan.splat_scale > 0 ? plan.splat_scale
+                           : std::min(auto_splat_scale(render_w, render_h), plan.auto_splat_cap);
   if (render_w != render_w_ || render_h != render_h_ || camera_w != camera_w_ ||
       camera_h != camera_h_ || bits != bits_ || layer_count != layers_ ||
       splat_scale != splat_scale_) {

@@ -102,7 +102,8 @@ inline int splat_size(int render_size, int scale) { return (render_size + scale 
 // gi.splat_scale 0 (the default): 8 from 512 render pixels a side (the
 // smaller side) up, else 4. On the Cornell box at 512^2 8 has 4's error
 // within 0.1% per wall at 0.85x its GPU time on llvmpipe (docs/gi.md);
-// below 512 the splat grid would fall under 64 texels a side.
+// below 512 the splat grid would fall under 64 texels a side. With a
+// caustic map, FramePlan::auto_splat_cap bounds it (FrameTargets::ensure).
 inline int auto_splat_scale(int render_w, int render_h) {
   return std::min(render_w, render_h) >= 512 ? 8 : 4;
 }

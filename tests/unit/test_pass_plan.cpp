@@ -197,6 +197,13 @@ TEST(PassPlan, LitScenesSplatPhotonsOverAGbuffer) {
                                                       "specular", "beams", "tonemap"}));
   EXPECT_TRUE(mirror.uploads_group("specular"));
   EXPECT_FALSE(plan.uploads_group("specular"));
+  // A caustic map's small disks cap the automatic splat size at 1/2
+  // (docs/gi.md, "Caustics and the splat size"); no caustic photons, no cap.
+  EXPECT_EQ(mirror.auto_splat_cap, 2);
+  EXPECT_GT(plan.auto_splat_cap, 8);
+  Scene no_caustics = scene_with(true, true, true, false, true);
+  no_caustics.gi.caustic_photons = 0;
+  EXPECT_GT(make_plan(PlanInput{no_caustics}).auto_splat_cap, 8);
   EXPECT_EQ(make_plan(PlanInput{scene_with(true, false, true)}).names(),
             (std::vector<std::string>{"beams", "tonemap"}));
   // Unlit scenes never upload photons.
