@@ -97,20 +97,6 @@ bool inside(vec4 h, float zlim) {
          all(lessThanEqual(h.xy, vec2(1.0)));
 }
 
-// The window position of camera-relative point p (view_ray's inverse);
-// false in front of the near plane.
-bool to_window(vec3 p, out vec2 f) {
-  vec2 s = vec2(dot(p, cam.cam_right.xyz) / cam.cam_up.w, dot(p, cam.cam_up.xyz)) /
-           cam.cam_right.w;
-  if (!is_orthographic()) {
-    float z = dot(p, cam.cam_forward.xyz);
-    if (z <= cam.viewport.z) return false;
-    s /= z;
-  }
-  f = (s * 0.5 + 0.5) * cam.viewport.xy;
-  return true;
-}
-
 // The area of the quadrilateral q (window positions, either winding) inside
 // the square [lo, lo + 1]^2, by Green's theorem: the area of a region R
 // inside the square is the integral around R's boundary of
@@ -191,9 +177,9 @@ float light_coverage(ivec2 px, int k, float zlim) {
   }
   vec3 c = u_light_corner[k] + u_light_offset;
   vec2 q[4];
-  if (!(to_window(c, q[0]) && to_window(c + u_light_u[k], q[1]) &&
-        to_window(c + u_light_u[k] + u_light_v[k], q[2]) && to_window(c + u_light_v[k], q[3]))) {
-    return seen / 16.0;  // a corner in front of the near plane: the rays' share
+  if (!(window_of(c, q[0]) && window_of(c + u_light_u[k], q[1]) &&
+        window_of(c + u_light_u[k] + u_light_v[k], q[2]) && window_of(c + u_light_v[k], q[3]))) {
+    return seen / 16.0;  // a corner behind the eye: the rays' share
   }
   float covered = area_in_pixel(q, vec2(px));
   if (hits > 0.0) return covered * (seen / hits);

@@ -19,6 +19,15 @@ const int kPerRing = 12;  // of kPerRing points
 
 vec3 surface_point(ivec2 px, float z) { return view_point(vec2(px) + 0.5, z); }
 
+// The window position (pixel units) of camera-relative point p; false
+// behind the eye (clip w <= 0), where it has none.
+bool window_of(vec3 p, out vec2 f) {
+  vec4 clip = cam.view_proj * vec4(p, 1.0);
+  if (clip.w <= 0.0) return false;
+  f = (clip.xy / clip.w * 0.5 + 0.5) * cam.viewport.xy;
+  return true;
+}
+
 // The kernel's profile at distance fraction s = d / r (unnormalized).
 float profile(float s) {
 #if GI_KERNEL == 0
@@ -56,12 +65,12 @@ float disk_share(vec3 x, vec3 n) {
       float phi = (float(k) + 0.5 * float(ring)) * (kTwoPi / float(kPerRing));
       vec3 p = x + (u_radius * s) * (cos(phi) * t + sin(phi) * b);
       total += w;
-      vec4 clip = cam.view_proj * vec4(p, 1.0);
-      if (clip.w <= 0.0) {
+      vec2 f;
+      if (!window_of(p, f)) {
         covered += w;
         continue;
       }
-      ivec2 q = ivec2(floor((clip.xy / clip.w * 0.5 + 0.5) * cam.viewport.xy));
+      ivec2 q = ivec2(floor(f));
       if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) {
         covered += w;
         continue;
