@@ -200,6 +200,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
       FrameOptions fo;
       fo.batch = false;
       std::vector<double> gpu, slim_ms;
+      std::map<std::string, std::vector<double>> pass_ms;
       FrameResult last;
       for (int r = 0; r < std::max(1, opts.repeats); ++r) {
         fo.read_targets.clear();
@@ -209,10 +210,15 @@ int run_slim_bench(const SlimBenchOptions& opts) {
         double s = 0.0;
         for (const PassTiming& p : frames[0].passes) {
           if (p.name.rfind("slim", 0) == 0) s += p.gpu_ms;
+          pass_ms[p.name].push_back(p.gpu_ms);
         }
         slim_ms.push_back(s);
         last = std::move(frames[0]);
       }
+      std::fprintf(stderr, "%s zoom %g %s: passes (median ms)", model.name.c_str(), st.zoom,
+                   evaluation_name(st.slim.evaluation));
+      for (auto& [name, ms] : pass_ms) std::fprintf(stderr, " %s %.1f", name.c_str(), median(ms));
+      std::fputc('\n', stderr);
       const SlimPixels pts = slim_from_surface(last.targets["slim_surface"], size, size);
       const SlimErrors e = compare_slim(pts, ref->second, model_size);
       const char* eval_name = evaluation_name(st.slim.evaluation);

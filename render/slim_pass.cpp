@@ -127,15 +127,20 @@ SlimResources::SlimResources(const Scene& scene) {
   // (computed on first use by the shared surface).
   const bool patch = scene.slim.evaluation == SlimEvaluation::kPatch;
   std::vector<const std::array<double, 2>*> range_of;
-  for (const Occluder& occ : scene.occluders) {
-    if (const auto* slim = std::get_if<SlimOccluder>(&occ.shape)) {
-      const auto* ranges = patch ? slim->surface->height_ranges().data() : nullptr;
-      for (std::size_t k = 0; k < slim->spheres().size(); ++k) {
-        spheres_.push_back(&slim->spheres()[k]);
-        occluder_of.push_back(&occ);
-        range_of.push_back(ranges ? ranges + k : nullptr);
+  // Spheres without a crease first, then those with one (crease_begin()).
+  for (const bool creases : {false, true}) {
+    if (creases) crease_begin_ = spheres_.size();
+    for (const Occluder& occ : scene.occluders) {
+      if (const auto* slim = std::get_if<SlimOccluder>(&occ.shape)) {
+        const auto* ranges = patch ? slim->surface->height_ranges().data() : nullptr;
+        for (std::size_t k = 0; k < slim->spheres().size(); ++k) {
+          if ((slim->spheres()[k].crease != SlimCrease::kNone) != creases) continue;
+          spheres_.push_back(&slim->spheres()[k]);
+          occluder_of.push_back(&occ);
+          range_of.push_back(ranges ? ranges + k : nullptr);
+        }
+        if (!creases) box.grow(slim->bounds());
       }
-      box.grow(slim->bounds());
     }
   }
   box_ = box;
@@ -270,6 +275,11 @@ class SlimPointsPass final : public Pass {
     const bool patch = ctx.scene.slim.evaluation == SlimEvaluation::kPatch;
     const std::string name = depth_ ? "slim_depth" : "slim_accumulate";
     ProgramPair& program = programs_.get(patch ? name + "_patch" : name);
+    // Patch evaluation: the crease spheres (after crease_begin()) with the
+    // crease rule compiled in, the others without it.
+    const auto n = static_cast<GLsizei>(slim->sphere_count());
+    const auto plain = static_cast<GLsizei>(slim->crease_begin());
+    ProgramPair* creases = patch && plain < n ? &programs_.get(name + "_patch_creases") : nullptr;
     if (depth_ && patch) slim->plan_patches(multi ? ctx.views : 1);
     if (depth_ && !patch) {  // the first of the slim passes plans the frame's samples
       if (multi) {
@@ -278,14 +288,21 @@ class SlimPointsPass final : public Pass {
         slim->plan_views({ctx.camera}, {ctx.basis}, ctx.scene.slim);
       }
     }
-    glUseProgram(program.get(multi));
     glBindTextureUnit(0, ctx.targets.texture("view_depth"));
     if (!depth_) {
       glBindTextureUnit(1, ctx.targets.texture("slim_near"));
       glBindTextureUnit(2, ctx.targets.texture("slim_radius"));
-      glUniform1f(program.uniform(multi, "u_threshold"),
-                  static_cast<float>(ctx.scene.slim.depth_threshold));
     }
+    for (ProgramPair* p : {&program, creases}) {
+      if (!p) continue;
+      glUseProgram(p->get(multi));
+      if (!depth_) {
+        glUniform1f(p->uniform(multi, "u_threshold"),
+                    static_cast<float>(ctx.scene.slim.depth_threshold));
+        glUniform1f(p->uniform(multi, "u_step"), kSlimFieldStep);
+      }
+    }
+    glUseProgram(program.get(multi));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, slim->sphere_buffer());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, slim->grid_buffer());
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, slim->command_buffer());
@@ -298,7 +315,6 @@ class SlimPointsPass final : public Pass {
     glUniform1i(program.uniform(multi, "u_field"), field ? 1 : 0);
     glUniform1f(program.uniform(multi, "u_cell_diag"),
                 static_cast<float>(slim_cell_diagonal(ctx.scene.slim)));
-    if (!depth_) glUniform1f(program.uniform(multi, "u_step"), kSlimFieldStep);
     glUniform1i(program.uniform(multi, "u_cull_backfaces"), ctx.scene.slim.cull_backfaces ? 1 : 0);
     if (field) {
       glEnable(GL_PROGRAM_POINT_SIZE);
@@ -309,7 +325,6 @@ class SlimPointsPass final : public Pass {
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
     glBlendEquation(depth_ ? GL_MIN : GL_FUNC_ADD);
-    const auto n = static_cast<GLsizei>(slim->sphere_count());
     const GLint grid_base = program.uniform(multi, "u_grid_base");
     int view = 0;
     if (patch) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, slim->corner_buffer());
@@ -347,7 +362,20 @@ class SlimPointsPass final : public Pass {
           glEnable(GL_BLEND);
           glUseProgram(program.get(multi));
         }
-        quads_.draw(0, n);
+        if (plain > 0) quads_.draw(0, plain);
+        if (creases) {
+          // The crease spheres' run with its program (this view's offset
+          // and index set on it as for_each_view_offset set them on the
+          // plain one).
+          glUseProgram(creases->get(multi));
+          const Vec3 off = slim->anchor() -
+                           (multi ? ctx.view_eyes[static_cast<std::size_t>(view)] : ctx.basis.eye);
+          glUniform3f(creases->uniform(multi, "u_offset"), static_cast<float>(off[0]),
+                      static_cast<float>(off[1]), static_cast<float>(off[2]));
+          if (multi) glUniform1i(creases->uniform(true, "u_view"), view);
+          quads_.draw(plain, n - plain);
+          glUseProgram(program.get(multi));  // the next view's uniforms go to the plain one
+        }
         if (depth_cull) {
           glDepthMask(GL_TRUE);
           glDisable(GL_DEPTH_TEST);

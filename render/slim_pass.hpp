@@ -69,6 +69,12 @@ class SlimResources {
  public:
   explicit SlimResources(const Scene& scene);
   std::size_t sphere_count() const { return spheres_.size(); }
+  // The spheres are held with every crease sphere after every other one:
+  // spheres [0, crease_begin()) have one polynomial, the rest a min/max of
+  // two, so the patch evaluation draws each run with its own program (no
+  // crease rule where none is needed: llvmpipe runs a fragment shader's
+  // untaken branches too).
+  std::size_t crease_begin() const { return crease_begin_; }
   GLuint sphere_buffer() const { return sphere_ssbo_.get(); }
   GLuint instance_vao() const { return vao_.get(); }
   const Vec3& anchor() const { return anchor_; }
@@ -93,6 +99,7 @@ class SlimResources {
 
  private:
   std::vector<const SlimSphere*> spheres_;
+  std::size_t crease_begin_ = 0;
   Vec3 anchor_{};
   Aabb box_;
   GlBuffer sphere_ssbo_, index_vbo_, command_buffer_, grid_ssbo_, corner_ssbo_;

@@ -32,8 +32,9 @@ void patch_ray() {
 // along m + x d, f polynomial (p, e): -(a x^2 + b x + q) with a = f's
 // second-order part along d, b = grad f(m) . d - d_w, q = f(m) - m_w, its
 // roots from the cancellation-free pair. On a crease (crease 1 min, 2
-// max) a root counts where the min/max rule takes this polynomial (the
-// other one: (po, eo)). 1e30 if none.
+// max; the "_creases" programs, SLIM_CREASES, draw those spheres) a root
+// counts where the min/max rule takes this polynomial (the other one:
+// (po, eo)). 1e30 if none.
 float patch_root(vec4 p, vec4 e, vec3 m, vec3 d, float half_chord, float lo, vec4 po, vec4 eo,
                  float crease) {
   vec2 g;
@@ -53,18 +54,22 @@ float patch_root(vec4 p, vec4 e, vec3 m, vec3 d, float half_chord, float lo, vec
     }
   }
   float lo_x = max(-half_chord, lo);
+#ifdef SLIM_CREASES
   for (int i = 0; i < 2; ++i) {
     float x = i == 0 ? min(x1, x2) : max(x1, x2);
     if (!(x > lo_x && x < half_chord)) continue;
-    if (crease > 0.5) {
-      vec3 l = m + x * d;
-      vec2 go;
-      float fo = poly(po, eo, l.xy, go);
-      if (crease < 1.5 ? fo < l.z : fo > l.z) continue;  // the other polynomial holds there
-    }
+    vec3 l = m + x * d;
+    vec2 go;
+    float fo = poly(po, eo, l.xy, go);
+    if (crease < 1.5 ? fo < l.z : fo > l.z) continue;  // the other polynomial holds there
     return x;
   }
   return 1e30;
+#else
+  float first = min(x1, x2), second = max(x1, x2);
+  return first > lo_x && first < half_chord ? first
+         : second > lo_x && second < half_chord ? second : 1e30;
+#endif
 }
 
 // The view depth z where the ray first meets the patch beyond the near
@@ -82,9 +87,9 @@ bool patch_crossing(out float z) {
   float lo = cam.viewport.z - zc;
   vec4 e = vec4(v_p2.xy, 0.0, 0.0);
   float x = patch_root(v_p1, e, m, ray_dir, half_chord, lo, v_q1, vec4(v_q2, 0.0, 0.0), v_p2.z);
-  if (v_p2.z > 0.5) {
-    x = min(x, patch_root(v_q1, vec4(v_q2, 0.0, 0.0), m, ray_dir, half_chord, lo, v_p1, e, v_p2.z));
-  }
+#ifdef SLIM_CREASES
+  x = min(x, patch_root(v_q1, vec4(v_q2, 0.0, 0.0), m, ray_dir, half_chord, lo, v_p1, e, v_p2.z));
+#endif
   if (x >= 1e29) return false;
   z = zc + x;
   return true;
@@ -101,7 +106,11 @@ bool patch_terms(vec3 x, out vec4 field, out vec4 weight) {
   float q = 1.0 - dot(x, x) / (r * r);
   if (q <= 0.0) return false;
   vec2 gf;
+#ifdef SLIM_CREASES
   float h = x.z - crease_height(v_p1, v_p2, v_q1, vec4(v_q2, 0.0, 0.0), x.xy, gf);
+#else
+  float h = x.z - poly(v_p1, v_p2, x.xy, gf);
+#endif
   float w = q * q * q;
   vec3 gw = (-6.0 * q * q / (r * r)) * x;
   field = vec4(patch_to_world(w * vec3(-gf, 1.0) + h * gw), w * h);
