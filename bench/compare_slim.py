@@ -62,18 +62,32 @@ def main() -> None:
                 print(f"{Path(model).stem} zoom {zoom:g} round {r + 1}: " + "  ".join(
                     f"{name} {results[name][-1]['frame']:.1f}" for name, _ in binaries), flush=True)
             base = binaries[0][0]
+            print(f"{Path(model).stem} zoom {zoom:g}, {args.rounds} rounds:", flush=True)
+            medians = {}
             for name, _ in binaries:
                 rows = results[name]
                 keys = sorted({k for row in rows for k in row if k.startswith("slim_")} |
                               {"surfaces", "tonemap"} & {k for row in rows for k in row})
-                passes = "  ".join(f"{k} {statistics.median(row[k] for row in rows if k in row):.1f}"
-                                   for k in keys)
+                medians[name] = {k: statistics.median(row[k] for row in rows if k in row)
+                                 for k in keys}
+                passes = "  ".join(f"{k} {medians[name][k]:.1f}" for k in keys)
                 ratios = [row["frame"] / b["frame"] for row, b in zip(rows, results[base])]
                 print(f"  {name}: frame ms median {statistics.median(r['frame'] for r in rows):.1f} "
                       f"(min {min(r['frame'] for r in rows):.1f}, max {max(r['frame'] for r in rows):.1f}); "
                       f"/{base} median {statistics.median(ratios):.3f} "
                       f"({min(ratios):.3f}-{max(ratios):.3f}); normal p99 {rows[-1]['normal_p99']:.2f}°, "
                       f"depth p99 {rows[-1]['depth_p99']:.4f}, holes {rows[-1]['holes']}; {passes}",
+                      flush=True)
+            # bench/slim_floor.sh's binaries: each pass's floor from the
+            # binary whose fragment work in that pass was taken away.
+            if {"floor_depth", "floor_accumulate"} <= medians.keys():
+                parts = {"slim_depth": medians["floor_depth"]["slim_depth"],
+                         "slim_accumulate": medians["floor_accumulate"]["slim_accumulate"]}
+                for k in ("slim_resolve", "surfaces", "tonemap"):
+                    parts[k] = medians[base][k]
+                print(f"  floor: {sum(parts.values()):.1f} ms = " +
+                      " + ".join(f"{k} {v:.1f}" for k, v in parts.items()) +
+                      f" (the baseline's frame {statistics.median(r['frame'] for r in results[base]):.1f})",
                       flush=True)
 
 
