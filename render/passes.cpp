@@ -714,9 +714,19 @@ GLint set_medium_uniforms(ProgramPair& program, bool multiview, const FrameConte
   return program.uniform(multiview, "u_region_eye");
 }
 
+const Vec3& view_eye(const FrameContext& ctx, int view) {
+  return ctx.views > 0 && view >= 0 ? ctx.view_eyes[static_cast<std::size_t>(view)]
+                                    : ctx.basis.eye;
+}
+
+void set_view_offset(const FrameContext& ctx, GLint location, int view, const Vec3& anchor) {
+  const Vec3 off = anchor - view_eye(ctx, view);
+  glUniform3f(location, static_cast<float>(off[0]), static_cast<float>(off[1]),
+              static_cast<float>(off[2]));
+}
+
 void set_region_eye(const FrameContext& ctx, GLint location, int view) {
-  const Vec3& eye =
-      ctx.views > 0 && view >= 0 ? ctx.view_eyes[static_cast<std::size_t>(view)] : ctx.basis.eye;
+  const Vec3& eye = view_eye(ctx, view);
   glUniform3f(location, static_cast<float>(eye[0]), static_cast<float>(eye[1]),
               static_cast<float>(eye[2]));
 }

@@ -199,19 +199,25 @@ void for_each_view(FrameContext& ctx, const PassDecl& self, ProgramPair& program
   }
 }
 
+// The eye of view `view` of a multi-view batch, or (single camera, or
+// view < 0) the camera's.
+const Vec3& view_eye(const FrameContext& ctx, int view);
+// `anchor` minus view `view`'s eye (in double, then float) into the vec3
+// uniform at `location` of the bound program: world-anchored data drawn
+// relative to the eye.
+void set_view_offset(const FrameContext& ctx, GLint location, int view, const Vec3& anchor);
+
 // for_each_view for draws of world-anchored data: before each view's draw
-// the uniform `offset_uniform` gets `anchor` minus that view's eye (in
-// double, then float).
+// the uniform `offset_uniform` gets `anchor` minus that view's eye
+// (set_view_offset).
 template <class Draw>
 void for_each_view_offset(FrameContext& ctx, const PassDecl& self, ProgramPair& program,
                           const char* offset_uniform, const Vec3& anchor, Draw draw) {
   const bool multi = ctx.views > 0;
   const GLint offset = program.uniform(multi, offset_uniform);
-  std::size_t v = 0;
+  int v = 0;
   for_each_view(ctx, self, program, [&] {
-    const Vec3 off = anchor - (multi ? ctx.view_eyes[v++] : ctx.basis.eye);
-    glUniform3f(offset, static_cast<float>(off[0]), static_cast<float>(off[1]),
-                static_cast<float>(off[2]));
+    set_view_offset(ctx, offset, multi ? v++ : -1, anchor);
     draw();
   });
 }

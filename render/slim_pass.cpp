@@ -368,10 +368,8 @@ class SlimPointsPass final : public Pass {
           // and index set on it as for_each_view_offset set them on the
           // plain one).
           glUseProgram(creases->get(multi));
-          const Vec3 off = slim->anchor() -
-                           (multi ? ctx.view_eyes[static_cast<std::size_t>(view)] : ctx.basis.eye);
-          glUniform3f(creases->uniform(multi, "u_offset"), static_cast<float>(off[0]),
-                      static_cast<float>(off[1]), static_cast<float>(off[2]));
+          set_view_offset(ctx, creases->uniform(multi, "u_offset"), multi ? view : -1,
+                          slim->anchor());
           if (multi) glUniform1i(creases->uniform(true, "u_view"), view);
           quads_.draw(plain, n - plain);
           glUseProgram(program.get(multi));  // the next view's uniforms go to the plain one
@@ -412,10 +410,7 @@ class SlimPointsPass final : public Pass {
     glUniform1f(plan.uniform(multi, "u_threshold"),
                 static_cast<float>(ctx.scene.slim.depth_threshold));
     if (multi) glUniform1i(plan.uniform(true, "u_view"), view);
-    const Vec3 off =
-        slim.anchor() - (multi ? ctx.view_eyes[static_cast<std::size_t>(view)] : ctx.basis.eye);
-    glUniform3f(plan.uniform(multi, "u_offset"), static_cast<float>(off[0]),
-                static_cast<float>(off[1]), static_cast<float>(off[2]));
+    set_view_offset(ctx, plan.uniform(multi, "u_offset"), view, slim.anchor());
     glDispatchCompute(static_cast<GLuint>((n + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   }

@@ -273,8 +273,7 @@ void set_volume_box(ProgramPair& program, bool multiview, const FrameContext& ct
       hi[k] = std::max(hi[k], b[k]);
     }
   }
-  const Vec3& eye =
-      ctx.views > 0 && view >= 0 ? ctx.view_eyes[static_cast<std::size_t>(view)] : ctx.basis.eye;
+  const Vec3& eye = view_eye(ctx, view);
   const Vec3 l = lo - eye, h = hi - eye;
   glUniform3f(program.uniform(multiview, "u_volume_lo"), static_cast<float>(l[0]),
               static_cast<float>(l[1]), static_cast<float>(l[2]));
