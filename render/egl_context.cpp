@@ -118,6 +118,26 @@ int env_int(const char* name, int fallback) {
   return static_cast<int>(x);
 }
 
+// What is current on this thread, to put back later.
+struct Bound {
+  EGLDisplay display = eglGetCurrentDisplay();
+  EGLSurface draw = eglGetCurrentSurface(EGL_DRAW);
+  EGLSurface read = eglGetCurrentSurface(EGL_READ);
+  EGLContext context = eglGetCurrentContext();
+};
+
+// Makes `b` current again; with no context before, releases `fallback`'s
+// current context (a display is needed to release one).
+void rebind(const Bound& b, EGLDisplay fallback) {
+  if (b.context != EGL_NO_CONTEXT) {
+    eglMakeCurrent(b.display, b.draw, b.read, b.context);
+  } else if (eglGetCurrentContext() != EGL_NO_CONTEXT) {
+    eglMakeCurrent(fallback, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  }
+}
+
+thread_local const EglContext* t_guarded = nullptr;
+
 }  // namespace
 
 std::unique_ptr<EglContext> EglContext::create(const EglOptions& opts) {
@@ -133,6 +153,7 @@ std::unique_ptr<EglContext> EglContext::create(const EglOptions& opts) {
       opts.device_index >= 0 ? opts.device_index : env_int("BEAMCAST_EGL_DEVICE", -1);
 
   const bool debug = gl_debug_requested();
+  const Bound before;
   std::vector<std::string> tried;
   Attempt got;
   std::string how;
@@ -200,21 +221,43 @@ std::unique_ptr<EglContext> EglContext::create(const EglOptions& opts) {
   c->gl_renderer_ = renderer ? renderer : "?";
   c->description_ = how + ": " + c->gl_renderer_ + " / OpenGL " + (version ? version : "?");
   c->gl_debug_ = debug && install_gl_debug_output();
+  rebind(before, got.display);
   return c;
 }
 
 EglContext::~EglContext() {
   if (display_) {
-    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (is_current()) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (context_) eglDestroyContext(display_, context_);
     // No eglTerminate: the display of a device is shared by every context on
     // it (one per render worker), and terminating it would destroy theirs.
   }
 }
 
-void EglContext::make_current() {
-  if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {
+bool EglContext::is_current() const { return context_ && eglGetCurrentContext() == context_; }
+
+const EglContext* EglContext::guarded() { return t_guarded; }
+
+bool EglContext::any_current() { return eglGetCurrentContext() != EGL_NO_CONTEXT; }
+
+EglContext::Current::Current(const EglContext& c) : outer_(t_guarded) {
+  const Bound b;
+  display_ = b.display;
+  draw_ = b.draw;
+  read_ = b.read;
+  context_ = b.context;
+  if (b.context != c.context_ &&
+      !eglMakeCurrent(c.display_, EGL_NO_SURFACE, EGL_NO_SURFACE, c.context_)) {
     throw std::runtime_error("eglMakeCurrent failed (" + egl_error_name(eglGetError()) + ")");
+  }
+  t_guarded = &c;
+}
+
+EglContext::Current::~Current() {
+  const EglContext* mine = t_guarded;
+  t_guarded = outer_;
+  if (eglGetCurrentContext() != context_) {
+    rebind(Bound{display_, draw_, read_, context_}, mine ? mine->display_ : EGL_NO_DISPLAY);
   }
 }
 

@@ -17,18 +17,47 @@ struct EglOptions {
   std::string platform = "auto";
 };
 
+// Every GL call runs in a context that its caller owns: a renderer makes its
+// own context current for the length of each entry point (EglContext::Current)
+// and puts back what was current before, so renderers, bare contexts and
+// threads can interleave without one issuing calls into another's namespace.
 class EglContext {
  public:
   // Throws std::runtime_error with one line that says what was tried and why
-  // each attempt failed.
+  // each attempt failed. What was current on the calling thread before stays
+  // current (the new context is made current only while it is set up).
   static std::unique_ptr<EglContext> create(const EglOptions& opts = {});
+  // Releases this context if it is current on this thread (and nothing else).
   ~EglContext();
   EglContext(const EglContext&) = delete;
   EglContext& operator=(const EglContext&) = delete;
 
-  // Binds the context to the calling thread (a context is current on one
-  // thread at a time; the render worker that owns it calls this once).
-  void make_current();
+  // Scoped: makes `c` current on this thread and restores the display,
+  // surfaces and context that were current before when it ends. Nests. While
+  // one is alive, gl_check (render/gl_util.hpp) also checks that the
+  // innermost guard's context is still the current one.
+  class Current {
+   public:
+    explicit Current(const EglContext& c);
+    ~Current();
+    Current(const Current&) = delete;
+    Current& operator=(const Current&) = delete;
+
+   private:
+    void* display_;  // what was current before
+    void* draw_;
+    void* read_;
+    void* context_;
+    const EglContext* outer_;  // the enclosing guard's context on this thread
+  };
+
+  // Whether this context is the one current on the calling thread.
+  bool is_current() const;
+  // The context the innermost Current on this thread made current (nullptr
+  // outside any guard).
+  static const EglContext* guarded();
+  // Whether any context is current on the calling thread.
+  static bool any_current();
   // e.g. "EGL device 0 (EGL_EXT_platform_device): NVIDIA H100 ... / 4.5.0 NVIDIA 550"
   const std::string& description() const { return description_; }
   const std::string& gl_renderer() const { return gl_renderer_; }

@@ -57,7 +57,9 @@ void APIENTRY on_message(GLenum source, GLenum type, GLuint id, GLenum severity,
   GlDebugMessage m{name_of(source, kSources, "other"), name_of(type, kTypes, "other"),
                    name_of(severity, kSeverities, "notification"), id,
                    length >= 0 ? std::string(text, static_cast<std::size_t>(length)) : text};
-  if (severity == GL_DEBUG_SEVERITY_HIGH) {
+  // Errors and undefined behaviour, whatever their severity; not the
+  // compiler's warnings (Mesa sends those at high severity, type "other").
+  if (type == GL_DEBUG_TYPE_ERROR || type == GL_DEBUG_TYPE_UNDEFINED_BEHAVIOR) {
     t_errors += (t_errors.empty() ? "" : "; ") + format_gl_debug_message(m);
   }
   std::lock_guard lock(g_sink_mutex);

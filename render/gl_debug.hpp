@@ -1,7 +1,8 @@
 // KHR_debug output: in a debug context (Debug builds, -DBEAMCAST_GL_DEBUG=ON,
 // or BEAMCAST_GL_DEBUG=1 in the environment) the driver reports misuse, errors
 // and performance warnings as messages. They go to stderr (or a test's sink);
-// a high-severity message fails the next gl_check on that thread.
+// a message of type error or undefined behaviour fails the next gl_check on
+// that thread.
 #pragma once
 
 #include <functional>
@@ -35,7 +36,7 @@ GlDebugSink set_gl_debug_sink(GlDebugSink sink);
 // output into the sink. Returns whether it did.
 bool install_gl_debug_output();
 
-// High-severity messages seen on this thread since the last call, joined with
+// Error and undefined-behaviour messages seen on this thread since the last call, joined with
 // "; " (empty if none); clears them. gl_check() throws when this is not empty.
 std::string take_gl_debug_errors();
 

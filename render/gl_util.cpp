@@ -5,7 +5,9 @@
 #include <cstring>
 #include <vector>
 
+#include "render/egl_context.hpp"
 #include "render/gl_debug.hpp"
+#include "render/gl_validate.hpp"
 #include "shaders/shader_sources.hpp"
 
 namespace beamcast {
@@ -47,6 +49,12 @@ GLuint compile_stage(std::string_view program, GLenum stage, const char* stage_n
 }  // namespace
 
 void gl_check(const char* call) {
+  // A call issued in another context's namespace finds stale or foreign names
+  // (on NVIDIA: errors, wrong images, crashes); say so rather than what it broke.
+  if (const EglContext* owner = EglContext::guarded(); owner && !owner->is_current()) {
+    throw GlError(std::string(call) + ": issued while another context than its owner's is current");
+  }
+  if (!EglContext::any_current()) throw GlError(std::string(call) + ": issued with no context current");
   GLenum e = glGetError();
   // In a debug context, high-severity KHR_debug messages say what went wrong.
   const std::string debug = take_gl_debug_errors();
@@ -81,6 +89,9 @@ GlProgram link_program(std::string_view name, std::initializer_list<GLuint> stag
     log.resize(std::strlen(log.c_str()));
     throw GlError("linking program '" + std::string(name) + "' failed:\n" + log);
   }
+  // The name that validation (render/gl_validate.hpp) and debuggers show.
+  const std::string label(name);
+  glObjectLabel(GL_PROGRAM, prog.get(), static_cast<GLsizei>(label.size()), label.c_str());
   gl_check("build_program");
   return prog;
 }
@@ -127,8 +138,25 @@ void QuadIndices::draw(GLsizei first, GLsizei count) {
   glBindVertexArray(vao_.get());
   for (GLsizei done = 0; done < count; done += kChunk) {
     const GLsizei n = std::min(kChunk, count - done);
-    glDrawElementsBaseVertex(GL_TRIANGLES, 6 * n, GL_UNSIGNED_INT, nullptr, 4 * (first + done));
+    draw_elements_base_vertex(GL_TRIANGLES, 6 * n, GL_UNSIGNED_INT, nullptr, 4 * (first + done));
   }
+}
+
+GlTexture make_shadow_cube_array(GLsizei size, GLsizei cubes) {
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_CUBE_MAP_ARRAY, 1, &id);
+  GlTexture tex(id);
+  glTextureStorage3D(id, 1, GL_DEPTH_COMPONENT32F, size, size, 6 * cubes);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  for (const GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) {
+    glTextureParameteri(id, wrap, GL_CLAMP_TO_EDGE);
+  }
+  glTextureParameteri(id, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glTextureParameteri(id, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  // Context state (GL 4.5 core, 8.13.1): cube-map lookups filter across faces.
+  glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+  return tex;
 }
 
 GlTexture make_texture_2d(GLenum internal_format, int width, int height) {

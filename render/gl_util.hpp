@@ -74,6 +74,14 @@ GlProgram build_compute_program(std::string_view name, const std::string& comput
 // Creates an immutable 2D texture with the given internal format.
 GlTexture make_texture_2d(GLenum internal_format, int width, int height);
 
+// A depth cube-map array of `cubes` cubes (6 layers each), size x size a
+// face, for shadow lookups (samplerCubeArrayShadow): linear filtering with
+// depth comparison, clamped at the edges, and seamless cube-map filtering
+// enabled on the current context, so a lookup near a face's edge blends
+// with the neighbouring face rather than the far edge of its own (the
+// default GL_REPEAT, which NVIDIA honours and llvmpipe clamps).
+GlTexture make_shadow_cube_array(GLsizei size, GLsizei cubes);
+
 // An immutable buffer of `bytes` (glNamedBufferStorage), from `data`
 // (nullptr: uninitialized) with storage `flags`.
 GlBuffer make_buffer(std::size_t bytes, const void* data, GLbitfield flags = 0);

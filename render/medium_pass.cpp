@@ -6,6 +6,7 @@
 #include "render/gl_util.hpp"
 #include "render/passes.hpp"
 #include "render/scene_resources.hpp"
+#include "render/gl_validate.hpp"
 
 namespace beamcast {
 
@@ -22,7 +23,7 @@ class MediumPass final : public Pass {
     const bool surfaces = ctx.plan.written("view_depth");
     glUniform1i(program.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
     const GLint region_eye = set_medium_uniforms(program, multi, ctx);
-    glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
+    bind_view_target_or_placeholder(ctx, 0, "view_depth");
     glEnable(GL_BLEND);
     glBlendFunc(GL_ZERO, GL_SRC_COLOR);  // hdr *= transmittance
     glBlendEquation(GL_FUNC_ADD);
@@ -31,7 +32,7 @@ class MediumPass final : public Pass {
     int view = 0;
     for_each_view(ctx, self, program, [&] {
       set_region_eye(ctx, region_eye, view++);
-      glDrawArrays(GL_TRIANGLES, 0, 3);
+      draw_arrays(GL_TRIANGLES, 0, 3);
     });
     glDisable(GL_BLEND);
     gl_check("medium pass");
@@ -70,7 +71,7 @@ class VolumePhotonPass final : public Pass {
     glUniform1i(program.uniform(multi, "u_segments"), medium.segments);
     glUniform1f(program.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
     set_photon_lod(program, multi, ctx.scene.gi);
-    glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
+    bind_view_target_or_placeholder(ctx, 0, "view_depth");
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, ctx.resources.volume_buffer());
     begin_additive(ctx);
     int view = 0;

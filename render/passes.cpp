@@ -14,6 +14,7 @@
 #include "render/slim_pass.hpp"
 #include "render/specular_pass.hpp"
 #include "render/volume_pass.hpp"
+#include "render/gl_validate.hpp"
 #include "shaders/shader_sources.hpp"
 
 namespace beamcast {
@@ -92,6 +93,27 @@ const FrameTargets::Target* FrameTargets::find(std::string_view name) const {
 GLuint FrameTargets::texture(std::string_view name) const {
   const Target* t = find(name);
   return t ? t->texture.get() : 0;
+}
+
+GLuint FrameTargets::placeholder(GLenum target) {
+  GlTexture& tex = placeholders_[target];
+  if (!tex) {
+    GLuint id = 0;
+    glCreateTextures(target, 1, &id);
+    tex = GlTexture(id);
+    const float zero = 0.0f;
+    if (target == GL_TEXTURE_2D) {
+      glTextureStorage2D(id, 1, GL_R32F, 1, 1);
+      glTextureSubImage2D(id, 0, 0, 0, 1, 1, GL_RED, GL_FLOAT, &zero);
+    } else {  // GL_TEXTURE_2D_ARRAY, GL_TEXTURE_3D: one layer or slice
+      glTextureStorage3D(id, 1, GL_R32F, 1, 1, 1);
+      glTextureSubImage3D(id, 0, 0, 0, 0, 1, 1, 1, GL_RED, GL_FLOAT, &zero);
+    }
+    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl_check("FrameTargets::placeholder");
+  }
+  return tex.get();
 }
 
 void FrameTargets::clear(const FramePlan& plan, const Color& background) {
@@ -200,7 +222,7 @@ class SurfacePass final : public Pass {
         if (multi) glUniform1i(raster_.uniform(true, "u_view"), v);
         glUniform1i(raster_.uniform(multi, "u_gi"), gi);
         glBindVertexArray(ctx.resources.triangle_vao());
-        glDrawArrays(GL_TRIANGLES, 0, ctx.resources.triangle_vertex_count());
+        draw_arrays(GL_TRIANGLES, 0, ctx.resources.triangle_vertex_count());
       }
       if (analytic) {
         glUseProgram(analytic_.get(multi));
@@ -208,7 +230,7 @@ class SurfacePass final : public Pass {
         glUniform1i(analytic_.uniform(multi, "u_gi"), gi);
         glUniform1i(analytic_.uniform(multi, "u_count"), ctx.resources.analytic_count());
         glBindVertexArray(ctx.empty_vao);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+        draw_arrays(GL_TRIANGLES, 0, 3);
       }
     }
     glDisable(GL_DEPTH_TEST);
@@ -277,7 +299,7 @@ class DirectPass final : public Pass {
     int view = 0;
     for_each_view_offset(ctx, self, program, "u_point_offset", res.direct_anchor(), [&] {
       set_region_eye(ctx, region_eye, view++);
-      glDrawArrays(GL_TRIANGLES, 0, 3);
+      draw_arrays(GL_TRIANGLES, 0, 3);
     });
     glDisable(GL_BLEND);
     gl_check("direct pass");
@@ -288,15 +310,7 @@ class DirectPass final : public Pass {
     const SceneResources& res = ctx.resources;
     const std::vector<DirectPoint>& points = res.direct_points();
     size_ = ctx.scene.gi.shadow_size;
-    const auto layers = static_cast<GLsizei>(6 * points.size());
-    GLuint id = 0;
-    glCreateTextures(GL_TEXTURE_CUBE_MAP_ARRAY, 1, &id);
-    cubes_ = GlTexture(id);
-    glTextureStorage3D(id, 1, GL_DEPTH_COMPONENT32F, size_, size_, layers);
-    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(id, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-    glTextureParameteri(id, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    cubes_ = make_shadow_cube_array(size_, static_cast<GLsizei>(points.size()));
     // Distances are stored over the farthest the triangles can be from any
     // point (1 = nothing there: the clear value).
     const Aabb& box = res.mesh_bounds();
@@ -313,6 +327,7 @@ class DirectPass final : public Pass {
     const float near = 1e-5f * far_;
     GLint viewport[4];
     glGetIntegerv(GL_VIEWPORT, viewport);
+    GLuint id = 0;
     glCreateFramebuffers(1, &id);
     GlFramebuffer fbo(id);
     glNamedFramebufferDrawBuffer(id, GL_NONE);
@@ -340,7 +355,7 @@ class DirectPass final : public Pass {
         if (res.triangle_vertex_count() == 0) continue;
         const std::array<float, 16> m = cube_face_matrix(face, near);
         glUniformMatrix4fv(face_matrix, 1, GL_TRUE, m.data());
-        glDrawArrays(GL_TRIANGLES, 0, res.triangle_vertex_count());
+        draw_arrays(GL_TRIANGLES, 0, res.triangle_vertex_count());
       }
     }
     glDisable(GL_DEPTH_TEST);
@@ -403,7 +418,11 @@ class GiResolvePass final : public Pass {
     // The interleaved direct light's quarters, filtered here (direct_filter.glsl).
     const bool split = ctx.plan.written("direct_split") && ctx.resources.direct_interleaved() > 0;
     glUniform1i(program.uniform(multi, "u_direct_split"), split ? 1 : 0);
-    if (split) glBindTextureUnit(4, ctx.targets.texture("direct_split"));
+    if (split) {
+      glBindTextureUnit(4, ctx.targets.texture("direct_split"));
+    } else {
+      bind_view_placeholder(ctx, 4);  // compiled in, not read
+    }
     begin_additive(ctx);
     // Quad lights whose outlines are antialiased: corners relative to the
     // first one's (in double, then float).
@@ -438,7 +457,7 @@ class GiResolvePass final : public Pass {
                   rect[3]);
     }
     for_each_view_offset(ctx, self, program, "u_light_offset", anchor,
-                         [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+                         [] { draw_arrays(GL_TRIANGLES, 0, 3); });
     glDisable(GL_BLEND);
     gl_check("gi_resolve pass");
   }
@@ -505,7 +524,7 @@ class PhotonPass final : public Pass {
       glUniform1f(share.uniform(multi, "u_max_plane"), kSplatMaxPlane);
       glUniform1i(share.uniform(multi, "u_splat_scale"), scale);
       for_each_view(ctx, self, share,
-                    [&] { per_band(share, [] { glDrawArrays(GL_TRIANGLES, 0, 3); }); });
+                    [&] { per_band(share, [] { draw_arrays(GL_TRIANGLES, 0, 3); }); });
       glUseProgram(program.get(multi));
     }
     // Two draws: the global map's photons, then the caustic map's with their
@@ -598,7 +617,7 @@ class BeamPass final : public Pass {
     }
     glBindTextureUnit(0, ctx.resources.g_texture());
     glBindTextureUnit(1, ctx.resources.f_texture());
-    glBindTextureUnit(2, surfaces ? ctx.targets.texture("view_depth") : 0);
+    bind_view_target_or_placeholder(ctx, 2, "view_depth");
     glBindTextureUnit(3, ctx.resources.warp_texture());
     if (medium) glBindTextureUnit(4, ctx.resources.moment_texture());
     if (volumes) {
@@ -620,7 +639,7 @@ class BeamPass final : public Pass {
       const int v = view++;
       if (medium) set_region_eye(ctx, region_eye, v);
       if (volumes) set_volume_box(program, multi, ctx, v);
-      glDrawArraysInstanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count());
+      draw_arrays_instanced(GL_TRIANGLES, 0, 36, ctx.resources.beam_count());
     });
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
@@ -648,7 +667,7 @@ class TonemapPass final : public Pass {
     glUniform1f(program_.uniform(multi, "u_levels"), out.bit_depth == 16 ? 65535.0f : 255.0f);
     glBindTextureUnit(0, ctx.targets.texture("hdr"));
     glBindVertexArray(ctx.empty_vao);
-    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    for_each_view(ctx, self, program_, [] { draw_arrays(GL_TRIANGLES, 0, 3); });
     gl_check("tonemap pass");
   }
 
@@ -744,6 +763,21 @@ void bind_gbuffer(const FrameContext& ctx) {
   glBindTextureUnit(0, ctx.targets.texture("view_depth"));
   glBindTextureUnit(1, ctx.targets.texture("gb_normal"));
   glBindTextureUnit(2, ctx.targets.texture("gb_albedo"));
+}
+
+void bind_view_placeholder(FrameContext& ctx, GLuint unit) {
+  glBindTextureUnit(unit, ctx.targets.placeholder(ctx.views > 0 ? GL_TEXTURE_2D_ARRAY
+                                                                : GL_TEXTURE_2D));
+}
+
+bool bind_view_target_or_placeholder(FrameContext& ctx, GLuint unit, const char* name) {
+  const bool written = ctx.plan.written(name);
+  if (written) {
+    glBindTextureUnit(unit, ctx.targets.texture(name));
+  } else {
+    bind_view_placeholder(ctx, unit);
+  }
+  return written;
 }
 
 void set_photon_lod(ProgramPair& program, bool multiview, const GiSettings& gi) {

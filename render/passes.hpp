@@ -40,6 +40,10 @@ class FrameTargets {
   // Clears every cleared target of the plan (all layers) to its start value.
   void clear(const FramePlan& plan, const Color& background);
   GLuint texture(std::string_view name) const;  // 0: not allocated
+  // A 1x1 (x1 layer) R32F texture of `target` holding 0, for a sampler that
+  // a program has compiled in but does not read in this frame: the spec
+  // leaves sampling unit with no texture undefined (GL 4.5 core 8.17).
+  GLuint placeholder(GLenum target);
   // The framebuffer of `pass` for `view` (view < 0 or no layers: the plain one).
   GLuint fbo(const PassDecl& pass, int view);
   int layers() const { return layers_; }
@@ -63,6 +67,7 @@ class FrameTargets {
   SplatBands splat_bands_;
   std::vector<Target> targets_;
   std::array<PassFbos, kPassCount> fbos_;
+  std::map<GLenum, GlTexture> placeholders_;  // by target; kept across sizes
   const Target* find(std::string_view name) const;
   GLuint make_fbo(const PassDecl& pass, int layer);
 };
@@ -237,6 +242,14 @@ void begin_additive(const FrameContext& ctx);
 // The G-buffer of lit scenes on texture units 0-2: view_depth, gb_normal,
 // gb_albedo (the binding order of the lighting passes' shaders).
 void bind_gbuffer(const FrameContext& ctx);
+
+// Binds the view-sized target `name` (VIEW_SAMPLER: sampler2D, or
+// sampler2DArray in multi-view batches) to `unit` if a planned pass writes
+// it, else that sampler's placeholder (FrameTargets::placeholder). Returns
+// whether the target is there.
+bool bind_view_target_or_placeholder(FrameContext& ctx, GLuint unit, const char* name);
+// The VIEW_SAMPLER placeholder alone, for a sampler compiled in but unread.
+void bind_view_placeholder(FrameContext& ctx, GLuint unit);
 
 // The photon LOD uniforms of shaders/photon_splat.vert (GiSettings::lod_*),
 // for the passes that draw photons with it.

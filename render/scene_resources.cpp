@@ -502,7 +502,21 @@ void SceneResources::fill_camera(const Camera& cam, const CameraBasis& basis, vo
   set3(cb.mesh_offset, mesh_anchor_ - eye, 0.0f);
 }
 
-void SceneResources::fill_beams(const Vec3& eye, void* beams) const {
+bool beam_proxy_full_screen(const BeamGpu& g, double radius, const Camera& cam,
+                            const CameraBasis& basis) {
+  if (cam.projection != Projection::kPerspective) return false;
+  // Half the diagonal of the near plane's rectangle: the farthest a clipped
+  // proxy's visible part can start from the eye.
+  const double tan_y = basis.tan_half_fov;
+  const double tan_x = tan_y * basis.aspect;
+  const double near_corner = cam.near_plane * std::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y);
+  // Twice that, and a float-rounding share of the box, keep the rasterized
+  // box well away from the cases it cannot cover.
+  return proxy_box_distance(g, radius) <= 2.0 * near_corner + 1e-5 * radius;
+}
+
+void SceneResources::fill_beams(const Camera& cam, const CameraBasis& basis, void* beams) const {
+  const Vec3& eye = basis.eye;
   auto* data = static_cast<BeamData*>(beams);
   for (std::size_t i = 0; i < beam_layers_.size(); ++i) {
     const Beam& beam = scene_.beams[i];
@@ -517,6 +531,7 @@ void SceneResources::fill_beams(const Vec3& eye, void* beams) const {
     set3(d.p0_radius, g.p0, r);
     set3(d.axis_length, g.axis, static_cast<float>(g.length));
     set3(d.caps_kind, g.caps_kind, 0.0f);
+    d.density[2] = beam_proxy_full_screen(g, beam.radius, cam, basis) ? 1.0f : 0.0f;
   }
 }
 
@@ -550,7 +565,7 @@ void SceneResources::bind_camera(const Camera& cam, const CameraBasis& basis) {
   glNamedBufferSubData(camera_ubo_.get(), 0, sizeof cb, &cb);
   if (beam_ssbo_) {
     std::vector<BeamData> data(beam_layers_.size());
-    fill_beams(basis.eye, data.data());
+    fill_beams(cam, basis, data.data());
     glNamedBufferSubData(beam_ssbo_.get(), 0,
                          static_cast<GLsizeiptr>(data.size() * sizeof(BeamData)), data.data());
   }
@@ -588,7 +603,7 @@ void SceneResources::bind_views(const std::vector<Camera>& cams,
   std::vector<AnalyticData> analytic(k * na);
   for (std::size_t v = 0; v < k; ++v) {
     fill_camera(cams[v], bases[v], &blocks[v]);
-    fill_beams(bases[v].eye, beams.data() + v * nb);
+    fill_beams(cams[v], bases[v], beams.data() + v * nb);
     fill_analytic(bases[v].eye, analytic.data() + v * na);
   }
   glNamedBufferSubData(views_camera_ubo_.get(), 0,

@@ -23,6 +23,15 @@
 
 namespace beamcast {
 
+// Whether beam `g` (BeamGpu, camera-relative) is drawn as one full-screen
+// triangle rather than its box: a perspective camera whose eye is inside
+// the box or within twice the near plane's corner distance of it. There the
+// box's faces are clipped at w = 0 and a pixel can fall between the pieces
+// (NVIDIA, fov 178.4 deg, near 1e-4: stability sweep 55288); the fragment
+// shader's exact ray test makes the larger cover correct.
+bool beam_proxy_full_screen(const BeamGpu& g, double radius, const Camera& cam,
+                            const CameraBasis& basis);
+
 // CPU tables by (density, size), least recently used evicted first.
 class TableCache {
  public:
@@ -173,7 +182,7 @@ class SceneResources {
   std::shared_ptr<const PhotonGather> photon_gather_;
   // The per-camera data of bind_camera, written to `out` (for bind_views).
   void fill_camera(const Camera& cam, const CameraBasis& basis, void* block) const;
-  void fill_beams(const Vec3& eye, void* beams) const;
+  void fill_beams(const Camera& cam, const CameraBasis& basis, void* beams) const;
   void fill_analytic(const Vec3& eye, void* analytic) const;
 };
 

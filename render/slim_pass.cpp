@@ -9,6 +9,7 @@
 
 #include "protocol/occluders/slim.hpp"
 #include "render/passes.hpp"
+#include "render/gl_validate.hpp"
 
 namespace beamcast {
 
@@ -355,7 +356,7 @@ class SlimPointsPass final : public Pass {
           glEnable(GL_DEPTH_TEST);
           glDepthFunc(GL_ALWAYS);
           glDepthMask(GL_TRUE);
-          glDrawArrays(GL_TRIANGLES, 0, 3);
+          draw_arrays(GL_TRIANGLES, 0, 3);
           glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
           glDepthFunc(GL_GEQUAL);
           glDepthMask(GL_FALSE);
@@ -383,7 +384,7 @@ class SlimPointsPass final : public Pass {
       }
       glUniform1i(grid_base, view * n);
       const auto offset = static_cast<std::intptr_t>(view) * n * 16;
-      glMultiDrawArraysIndirect(GL_POINTS, reinterpret_cast<const void*>(offset), n, 0);
+      multi_draw_arrays_indirect(GL_POINTS, reinterpret_cast<const void*>(offset), n, 0);
       ++view;
     });
     glDisable(GL_SCISSOR_TEST);
@@ -411,7 +412,7 @@ class SlimPointsPass final : public Pass {
                 static_cast<float>(ctx.scene.slim.depth_threshold));
     if (multi) glUniform1i(plan.uniform(true, "u_view"), view);
     set_view_offset(ctx, plan.uniform(multi, "u_offset"), view, slim.anchor());
-    glDispatchCompute(static_cast<GLuint>((n + 63) / 64), 1, 1);
+    dispatch_compute(static_cast<GLuint>((n + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   }
 
@@ -446,7 +447,7 @@ class SlimResolvePass final : public Pass {
     int view = 0;
     for_each_view(ctx, self, program_, [&] {
       scissor_to_slim(ctx, *ctx.resources.slim(), multi ? view++ : -1);
-      glDrawArrays(GL_TRIANGLES, 0, 3);
+      draw_arrays(GL_TRIANGLES, 0, 3);
     });
     glDisable(GL_SCISSOR_TEST);
     gl_check("slim_resolve pass");

@@ -6,6 +6,7 @@
 #include "gi/photon_gather.hpp"
 #include "protocol/camera.hpp"
 #include "render/passes.hpp"
+#include "render/gl_validate.hpp"
 
 namespace beamcast {
 
@@ -70,7 +71,7 @@ class SpecularPass final : public Pass {
     glBlendEquation(GL_FUNC_ADD);
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(ctx.empty_vao);
-    for_each_view(ctx, self, program_, [] { glDrawArrays(GL_TRIANGLES, 0, 3); });
+    for_each_view(ctx, self, program_, [] { draw_arrays(GL_TRIANGLES, 0, 3); });
     glDisable(GL_BLEND);
     gl_check("specular pass");
   }

@@ -7,6 +7,7 @@
 
 #include "render/passes.hpp"
 #include "render/scene_resources.hpp"
+#include "render/gl_validate.hpp"
 
 namespace beamcast {
 
@@ -300,7 +301,7 @@ class VolumePass final : public Pass {
     const bool knots = self.id == PassId::kVolumesForBeams;
     const bool multi = ctx.views > 0;
     const bool surfaces = ctx.plan.written("view_depth");
-    glBindTextureUnit(0, surfaces ? ctx.targets.texture("view_depth") : 0);
+    bind_view_target_or_placeholder(ctx, 0, "view_depth");
     // hdr = volume colour + (1 - volume opacity) hdr, hdr's alpha kept; the
     // transmittance knots multiplied over the volumes.
     glEnable(GL_BLEND);
@@ -358,11 +359,12 @@ class VolumePass final : public Pass {
       glBindTextureUnit(1, u.gpu->values.get());
       glBindTextureUnit(2, u.gpu->transfer.get());
       glBindTextureUnit(3, u.gpu->bricks.get());
-      glBindTextureUnit(4, u.preintegration ? u.preintegration->get() : 0);
+      glBindTextureUnit(4, u.preintegration ? u.preintegration->get()
+                                            : ctx.targets.placeholder(GL_TEXTURE_2D));
       int view = 0;
       for_each_view_offset(ctx, self, program, "u_origin", vol.origin, [&] {
         set_volume_box(program, multi, ctx, view++);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+        draw_arrays(GL_TRIANGLES, 0, 3);
       });
     }
     glBlendFunc(GL_ONE, GL_ONE);  // every attachment's state back to one value

@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
-# The benchmarks to run on a machine with a GPU (docs/performance.md, "On a
-# GPU"), in order of what matters most, each under its own time limit so a
-# short lease still brings back the first ones:
+# The one call that checks a machine with a GPU (docs/performance.md, "On a
+# GPU"). First every GL, stability and server test binary, each run as one
+# whole process with --gtest_shuffle --gtest_repeat=2 (tests sharing a
+# process and its renderers, as a server's workers do; the three binaries
+# side by side, TESTS_LIMIT seconds each, default 240), summed up in
+# tests.txt; then the benchmarks in order of what matters most, each under
+# its own time limit so a short lease still brings back the first ones:
 #
 #   scripts/gpu_benches.sh OUT [DATA]
 #
@@ -12,8 +16,9 @@
 #       and skull_2.9.inr (scripts/fetch_cgal_volumes.sh); steps that need a
 #       missing file leave it out
 #
-# Environment: BIN (folder of beamcast and beamcast-server; default
-# build/bin), DEADLINE (seconds for the whole run; default 3600),
+# Environment: BIN (folder of beamcast, beamcast-server and the test
+# binaries; default build/bin; scripts/gpu_pack.sh packs one with its
+# libraries for a machine without this project's packages), DEADLINE (seconds for the whole run; default 3600),
 # BEAMCAST_PYTHON (the Python with numpy and matplotlib; default
 # /usr/bin/python3). A step over its limit is stopped (exit 124 in log.txt)
 # and the next one runs; `tar` of OUT after each step keeps OUT.tgz current.
@@ -59,6 +64,32 @@ have() { [ -n "$data" ] && [ -f "$data/$1" ]; }
 } >"$out/info.txt"
 renderer=$("$bin/beamcast" info --platform device 2>/dev/null | head -1)
 echo "renderer: $renderer" >>"$log"
+
+# The test binaries, side by side (one GPU, 16 cores), whole processes.
+tests_limit=${TESTS_LIMIT:-240}
+t0=$SECONDS
+for t in beamcast_gl_tests beamcast_stability_tests beamcast_server_tests; do
+  if [ ! -x "$bin/$t" ]; then
+    echo "$t: missing" >>"$log"
+    continue
+  fi
+  (
+    timeout --kill-after=5 "$tests_limit" "$bin/$t" --gtest_shuffle --gtest_repeat=2 \
+      >"$out/$t.log" 2>&1
+    echo "$t: rc $?, $((SECONDS - t0)) s (limit $tests_limit): --gtest_shuffle --gtest_repeat=2" \
+      >>"$log"
+  ) &
+done
+wait
+{
+  for t in beamcast_gl_tests beamcast_stability_tests beamcast_server_tests; do
+    [ -f "$out/$t.log" ] || continue
+    echo "== $t"
+    grep -E "^\[  (PASSED|FAILED|SKIPPED) +\]|tests? from .* ran|^Note: Randomizing|^Repeating all tests|Segmentation|Aborted|KHR_debug" \
+      "$out/$t.log" | sort | uniq -c
+  done
+} >"$out/tests.txt"
+tar czf "$out.tgz" -C "$(dirname "$out")" "$(basename "$out")" 2>/dev/null
 
 slim_pairs=()
 slim_args=()

@@ -8,7 +8,8 @@ struct BeamData {
   vec4 axis_length;  // xyz: unit axis p0 -> p1; w: length (0 for a sphere)
   vec4 color_layer;  // rgb: color * intensity; w: table layer of the density
   vec4 caps_kind;    // x: cap at p0, y: cap at p1 (1 or 0); z: 0 sphere, 1 capsule
-  vec4 density;      // x: DensityKind, y: gaussian sigma
+  vec4 density;      // x: DensityKind, y: gaussian sigma, z: 1 full-screen (the
+                     // eye inside or near the box: beam_proxy_full_screen)
 };
 layout(std430, binding = 1) readonly buffer Beams { BeamData beams[]; };
 
@@ -29,6 +30,15 @@ void main() {
   index += u_view * u_view_beams;
 #endif
   BeamData b = beams[index];
+  v_beam = index;
+  if (b.density.z > 0.5) {
+    // One clockwise triangle over the whole viewport (front faces are
+    // culled), the other 11 collapsed to a point.
+    vec2 corner = gl_VertexID == 1 ? vec2(-1.0, 3.0) : gl_VertexID == 2 ? vec2(3.0, -1.0)
+                                                                        : vec2(-1.0);
+    gl_Position = vec4(corner, 0.5, 1.0);
+    return;
+  }
   int ci = kCubeIndex[gl_VertexID];
   vec3 c = vec3((ci & 1) != 0 ? 1.0 : -1.0, (ci & 2) != 0 ? 1.0 : -1.0, (ci & 4) != 0 ? 1.0 : -1.0);
   float r = b.p0_radius.w;
@@ -46,6 +56,5 @@ void main() {
     float along = mix(lo, hi, 0.5 * (c.z + 1.0));
     pos = b.p0_radius.xyz + along * w + r * (c.x * u1 + c.y * u2);
   }
-  v_beam = index;
   gl_Position = cam.view_proj * vec4(pos, 1.0);
 }

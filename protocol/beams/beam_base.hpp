@@ -29,6 +29,13 @@ struct BeamGpu {
   Vec3 caps_kind{0.0, 0.0, 0.0};  // cap0, cap1 (0/1), kind (0 sphere, 1 capsule)
 };
 
+// The distance from the eye (the origin of g's camera-relative frame) to the
+// box that shaders/beam.vert draws around the beam (0 when the eye is inside),
+// in double. A capsule's box has a square cross-section of half-width r whose
+// rotation about the axis the shader picks; this takes its circumscribed
+// cylinder (radius r sqrt 2), so it never exceeds the true distance.
+double proxy_box_distance(const BeamGpu& g, double radius);
+
 // The CPU reference works about the centre C of the beam's bounding sphere, in
 // units of the radius r (render/reference.cpp): `bound2` is the squared
 // bounding radius in those units.

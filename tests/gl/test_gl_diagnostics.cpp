@@ -6,6 +6,7 @@
 
 #include <cstdlib>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "render/egl_context.hpp"
@@ -16,16 +17,27 @@
 namespace beamcast {
 namespace {
 
-// A debug context on this thread, whatever the build's default.
-std::unique_ptr<EglContext> debug_context() {
-  setenv("BEAMCAST_GL_DEBUG", "1", 1);
+// A context with BEAMCAST_GL_DEBUG set to `value` while it is created (the
+// variable put back as it was: the test main sets it for the whole binary).
+std::unique_ptr<EglContext> context_with_debug(const char* value) {
+  const char* was = std::getenv("BEAMCAST_GL_DEBUG");
+  const std::string saved = was ? was : "";
+  setenv("BEAMCAST_GL_DEBUG", value, 1);
   auto ctx = EglContext::create();
-  unsetenv("BEAMCAST_GL_DEBUG");
+  if (was) {
+    setenv("BEAMCAST_GL_DEBUG", saved.c_str(), 1);
+  } else {
+    unsetenv("BEAMCAST_GL_DEBUG");
+  }
   return ctx;
 }
 
+// A debug context, whatever the build's default.
+std::unique_ptr<EglContext> debug_context() { return context_with_debug("1"); }
+
 TEST(GlDiagnostics, DebugContextReportsMisuseToTheSink) {
   auto ctx = debug_context();
+  const EglContext::Current current(*ctx);
   ASSERT_TRUE(ctx->gl_debug()) << "no debug context with KHR_debug on " << ctx->description();
   std::vector<GlDebugMessage> got;
   auto previous = set_gl_debug_sink([&](const GlDebugMessage& m) { got.push_back(m); });
@@ -49,9 +61,8 @@ TEST(GlDiagnostics, DebugContextReportsMisuseToTheSink) {
 }
 
 TEST(GlDiagnostics, PlainContextWithoutDebugOutput) {
-  setenv("BEAMCAST_GL_DEBUG", "0", 1);
-  auto ctx = EglContext::create();
-  unsetenv("BEAMCAST_GL_DEBUG");
+  auto ctx = context_with_debug("0");
+  const EglContext::Current current(*ctx);
   EXPECT_FALSE(ctx->gl_debug());
   glEnable(0xDEAD);
   EXPECT_EQ(take_gl_debug_errors(), "");
@@ -60,6 +71,7 @@ TEST(GlDiagnostics, PlainContextWithoutDebugOutput) {
 
 TEST(GlDiagnostics, ShaderCompileErrorNamesFileAndLine) {
   auto ctx = debug_context();
+  const EglContext::Current current(*ctx);
   auto previous = set_gl_debug_sink([](const GlDebugMessage&) {});  // expected errors
   const std::string vert = assemble_shader({"common.glsl", "fullscreen.vert"});
   const std::string frag = assemble_shader_text(
@@ -75,8 +87,11 @@ TEST(GlDiagnostics, ShaderCompileErrorNamesFileAndLine) {
   take_gl_debug_errors();
   EXPECT_NE(what.find("compiling fragment shader of program 'broken' failed"), std::string::npos)
       << what;
-  // Mesa's log "1:3(11): error: ..." becomes "broken.frag:3(11): error: ...".
-  EXPECT_NE(what.find("broken.frag:3("), std::string::npos) << what;
+  // Mesa's log "1:3(11): error: ..." becomes "broken.frag:3(11): error: ...";
+  // NVIDIA's "1(3) : error C1503: ..." becomes "broken.frag(3) : error ...".
+  EXPECT_TRUE(what.find("broken.frag:3(") != std::string::npos ||
+              what.find("broken.frag(3)") != std::string::npos)
+      << what;
   EXPECT_NE(what.find("broken.frag:   3 |   o = vec4(undefined_name);"), std::string::npos) << what;
   EXPECT_NE(what.find("common.glsl:   1 | "), std::string::npos) << what;
 }

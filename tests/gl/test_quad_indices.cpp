@@ -63,6 +63,7 @@ std::vector<float> draw_quads(GLsizei first, GLsizei count) {
 
 TEST(QuadIndices, EveryQuadOfEveryChunkReachesItsIndex) {
   auto ctx = EglContext::create();
+  const EglContext::Current current(*ctx);
   // Two chunks and part of a third, starting past the first quad: the
   // base vertex of each chunk carries both the chunk and `first`.
   const GLsizei first = 37;
@@ -80,6 +81,7 @@ TEST(QuadIndices, EveryQuadOfEveryChunkReachesItsIndex) {
 
 TEST(QuadIndices, NoQuadsDrawNothing) {
   auto ctx = EglContext::create();
+  const EglContext::Current current(*ctx);
   const std::vector<float> pixels = draw_quads(5, 0);
   for (const float v : pixels) ASSERT_EQ(v, 0.0f);
 }

@@ -36,6 +36,7 @@
 #include "render/lut.hpp"
 #include "render/reference.hpp"
 #include "render/renderer.hpp"
+#include "render/scene_resources.hpp"
 
 namespace beamcast {
 namespace {
@@ -751,6 +752,34 @@ TEST(StabilitySweep, GroupBiasCatchesAUniformGain) {
       EXPECT_EQ(std::abs(g.bias()) > kGroupBias, gain != 1.0) << kGroupNames[group];
     }
   }
+}
+
+// Configuration 55288 of seed 20261122: a perspective camera of fov 178.4 deg
+// and near 1e-4 inside a capsule's proxy box, one pixel. Its box's faces are
+// clipped behind the eye and NVIDIA's rasterizer dropped the one sample (GPU
+// 0 against the reference's 0.3076); llvmpipe covered it. The beam takes
+// the full-screen path now (beam_proxy_full_screen), on every driver.
+TEST(StabilitySweep, Configuration55288EyeInsideProxyAtExtremeFov) {
+  constexpr std::uint64_t kConfig = 55288;
+  const Batch b = make_batch(20261122, kConfig / kCamerasPerScene);
+  const Camera& cam = b.draw.scene.cameras[kConfig % kCamerasPerScene];
+  ASSERT_EQ(cam.width, 1);
+  ASSERT_GT(cam.fov_y_deg, 178.0);
+  const CameraBasis basis = camera_basis(cam);
+  int full_screen = 0;
+  for (const Beam& beam : b.draw.scene.beams) {
+    const BeamGpu g = std::visit([&](const auto& shape) { return shape.gpu(basis.eye); }, beam.shape);
+    full_screen += beam_proxy_full_screen(g, beam.radius, cam, basis) ? 1 : 0;
+  }
+  EXPECT_GE(full_screen, 1) << "the eye is inside a proxy box: that beam must be full-screen";
+  static Renderer renderer;
+  const std::vector<FrameResult> frames =
+      renderer.render(b.draw.scene, {cam}, FrameOptions{.read_hdr = true});
+  const HdrImage ref = render_reference(b.draw.scene, cam, ReferenceOptions{.threads = 1});
+  ASSERT_GT(ref.rgb[0] + ref.rgb[1] + ref.rgb[2], 0.0f);
+  const Verdict v = check_config(b.draw.scene, cam, frames[0].hdr, ref, energy_scale(b.draw.scene));
+  EXPECT_EQ(v.nonfinite, 0);
+  EXPECT_EQ(v.bad_pixel, -1) << "gpu " << v.bad_gpu << " reference " << v.bad_ref;
 }
 
 TEST(StabilitySweep, RandomConfigurations) {

@@ -1,0 +1,313 @@
+// Each renderer issues its GL calls in its own context (EglContext::Current),
+// shadow cube maps filter across faces, draw validation names what is wrong,
+// and beams whose proxy box holds the eye are drawn full-screen.
+#define GL_GLEXT_PROTOTYPES
+#include <EGL/egl.h>
+#include <GL/glcorearb.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "protocol/camera.hpp"
+#include "protocol/scene_json.hpp"
+#include "render/egl_context.hpp"
+#include "render/gl_debug.hpp"
+#include "render/gl_util.hpp"
+#include "render/gl_validate.hpp"
+#include "render/renderer.hpp"
+#include "render/scene_resources.hpp"
+
+namespace beamcast {
+namespace {
+
+namespace fs = std::filesystem;
+
+Scene small_example(const std::string& name, int size) {
+  const fs::path dir = fs::path(BEAMCAST_SOURCE_DIR) / "examples";
+  SceneLoadOptions opts;
+  opts.assets_dir = dir;
+  Scene scene = load_scene_file(dir / (name + ".json"), opts);
+  scene.cameras.resize(1);
+  scene.cameras[0].width = scene.cameras[0].height = size;
+  return scene;
+}
+
+std::vector<std::uint16_t> frame(Renderer& r, const Scene& scene) {
+  return r.render(scene).at(0).image.rgb;
+}
+
+// Two renderers on one thread, frames interleaved, a bare context created
+// and destroyed between them, one renderer destroyed: every frame equals
+// that renderer's first. Before each renderer made its own context current,
+// A's second frame threw GL_INVALID_OPERATION (its names looked up in B's
+// context), and after B was gone A rendered with no context at all.
+TEST(Contexts, TwoRenderersInterleavedEqualTheirFramesAlone) {
+  const Scene beams = small_example("paper_1set", 48);
+  const Scene lit = small_example("cornell_box", 48);
+  auto a = std::make_unique<Renderer>();
+  const auto a_alone = frame(*a, beams);
+  auto b = std::make_unique<Renderer>();
+  const auto b_alone = frame(*b, lit);
+  for (int round = 0; round < 2; ++round) {
+    EXPECT_EQ(frame(*a, beams), a_alone) << "round " << round;
+    { auto bare = EglContext::create(); }
+    EXPECT_EQ(frame(*b, lit), b_alone) << "round " << round;
+    auto bare = EglContext::create();
+    EXPECT_EQ(frame(*a, beams), a_alone) << "round " << round << ", a bare context alive";
+  }
+  b.reset();
+  EXPECT_EQ(frame(*a, beams), a_alone) << "after the other renderer was destroyed";
+}
+
+// A context the caller has current stays current across a render, and a
+// renderer made elsewhere renders right beside it.
+TEST(Contexts, RenderRestoresTheCallersContext) {
+  const Scene beams = small_example("paper_1set", 32);
+  Renderer r;
+  const auto alone = frame(r, beams);
+  auto mine = EglContext::create();
+  EXPECT_FALSE(mine->is_current()) << "create() leaves the thread's context as it was";
+  const EglContext::Current current(*mine);
+  EXPECT_TRUE(mine->is_current());
+  EXPECT_EQ(frame(r, beams), alone);
+  EXPECT_TRUE(mine->is_current()) << "the render put the caller's context back";
+  EXPECT_EQ(EglContext::guarded(), mine.get());
+}
+
+// gl_check names the fault when the context current is not the one the
+// innermost guard made current (switched behind its back), or when none is.
+TEST(Contexts, GlCheckRefusesAForeignOrMissingContext) {
+  ASSERT_FALSE(EglContext::any_current()) << "a test left a context current";
+  EXPECT_THROW(gl_check("nothing current"), GlError);
+  auto owner = EglContext::create();
+  auto other = EglContext::create();
+  EGLContext other_handle = EGL_NO_CONTEXT;
+  {
+    const EglContext::Current inner(*other);
+    other_handle = eglGetCurrentContext();
+  }
+  const EglContext::Current current(*owner);
+  gl_check("owner current");
+  EGLContext owner_handle = eglGetCurrentContext();
+  EGLDisplay display = eglGetCurrentDisplay();
+  ASSERT_TRUE(eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, other_handle));
+  try {
+    gl_check("behind the guard's back");
+    ADD_FAILURE() << "gl_check did not notice the foreign context";
+  } catch (const GlError& e) {
+    EXPECT_NE(std::string(e.what()).find("another context"), std::string::npos) << e.what();
+  }
+  ASSERT_TRUE(eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, owner_handle));
+  gl_check("owner current again");
+}
+
+// A 1-cube shadow array, +X face at depth 0, +Y face at depth 1, looked up
+// at the +X face's edge toward +Y with reference 0.5: a seamless filter
+// gives the +Y texels about half the weight (0.498 at t = 0.0005 of a
+// 4-texel face), so about half the samples pass; without it the +X face's
+// own edge texels (clamped, or the far edge under GL_REPEAT) all fail: 0.
+TEST(ShadowCubes, FilteringAcrossAFaceSeamUsesTheNeighbouringFace) {
+  auto ctx = EglContext::create();
+  const EglContext::Current current(*ctx);
+  constexpr GLsizei kSize = 4;
+  GlTexture cubes = make_shadow_cube_array(kSize, 1);
+  for (int face = 0; face < 6; ++face) {
+    const std::vector<float> depth(kSize * kSize, face == 2 ? 1.0f : 0.0f);  // 2: +Y
+    glTextureSubImage3D(cubes.get(), 0, 0, 0, face, kSize, kSize, 1, GL_DEPTH_COMPONENT, GL_FLOAT,
+                        depth.data());
+  }
+  const std::string src = R"(#version 450 core
+layout(local_size_x = 1) in;
+layout(binding = 0) uniform samplerCubeArrayShadow u_cubes;
+layout(std430, binding = 0) buffer Out { float result[]; };
+uniform vec4 u_dir_ref;
+void main() { result[0] = texture(u_cubes, vec4(u_dir_ref.xyz, 0.0), u_dir_ref.w); }
+)";
+  GlProgram program = build_compute_program("cube_seam_test", src);
+  GlBuffer out = make_buffer(sizeof(float), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glUseProgram(program.get());
+  glBindTextureUnit(0, cubes.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, out.get());
+  auto lookup = [&](float x, float y, float z) {
+    glUniform4f(glGetUniformLocation(program.get(), "u_dir_ref"), x, y, z, 0.5f);
+    dispatch_compute(1, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    float v = -1.0f;
+    glGetNamedBufferSubData(out.get(), 0, sizeof v, &v);
+    gl_check("cube seam lookup");
+    return v;
+  };
+  EXPECT_EQ(lookup(1.0f, 0.0f, 0.0f), 0.0f) << "the +X face's middle";
+  EXPECT_EQ(lookup(0.0f, 1.0f, 0.0f), 1.0f) << "the +Y face's middle";
+  const float seam = lookup(1.0f, 0.999f, 0.0f);
+  EXPECT_GT(seam, 0.25f) << "the +Y face's texels take no part: seamless filtering is off";
+  EXPECT_LT(seam, 0.75f);
+}
+
+// Draw validation on planted defects: each throws naming the pass and unit
+// (or the framebuffer) before the draw reaches the driver.
+class Validation : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ctx_ = EglContext::create();
+    current_ = std::make_unique<EglContext::Current>(*ctx_);
+    was_ = gl_validation_enabled();
+    set_gl_validation(true);
+    target_ = make_texture_2d(GL_R32F, 4, 4);
+    GLuint id = 0;
+    glCreateFramebuffers(1, &id);
+    fbo_ = GlFramebuffer(id);
+    glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, target_.get(), 0);
+    glCreateVertexArrays(1, &id);
+    vao_ = GlVertexArray(id);
+    const std::string vert = R"(#version 450 core
+void main() { gl_Position = vec4(vec2(gl_VertexID & 1, gl_VertexID >> 1) * 4.0 - 1.0, 0.0, 1.0); }
+)";
+    const std::string frag = R"(#version 450 core
+layout(binding = 3) uniform sampler2D u_input;
+layout(location = 0) out float o;
+void main() { o = texture(u_input, vec2(0.5)).r; }
+)";
+    program_ = build_program("validation_test", vert, frag);
+    glUseProgram(program_.get());
+    glBindVertexArray(vao_.get());
+    glViewport(0, 0, 4, 4);
+  }
+  void TearDown() override {
+    set_gl_validation(was_);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    take_gl_debug_errors();
+  }
+  // The message of the GlError the draw threw ("" if none).
+  std::string draw_error() {
+    const GlPassLabel label(pass_);
+    try {
+      draw_arrays(GL_TRIANGLES, 0, 3);
+    } catch (const GlError& e) {
+      return e.what();
+    }
+    return "";
+  }
+  std::unique_ptr<EglContext> ctx_;
+  std::unique_ptr<EglContext::Current> current_;
+  bool was_ = false;
+  const std::string pass_ = "planted";
+  GlTexture target_;
+  GlFramebuffer fbo_;
+  GlVertexArray vao_;
+  GlProgram program_;
+};
+
+TEST_F(Validation, ACompleteDrawPasses) {
+  GlTexture input = make_texture_2d(GL_R32F, 1, 1);
+  glBindTextureUnit(3, input.get());
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
+  EXPECT_EQ(draw_error(), "");
+  gl_check("complete draw");
+}
+
+TEST_F(Validation, ASamplerLeftUnboundNamesPassProgramAndUnit) {
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
+  const std::string e = draw_error();
+  EXPECT_NE(e.find("planted pass"), std::string::npos) << e;
+  EXPECT_NE(e.find("program 'validation_test'"), std::string::npos) << e;
+  EXPECT_NE(e.find("unit 3 (sampler2D u_input): no texture"), std::string::npos) << e;
+}
+
+TEST_F(Validation, AStaleNameFromAnotherContextLeavesTheUnitEmpty) {
+  GLuint stale = 0;
+  {
+    auto other = EglContext::create();
+    const EglContext::Current inner(*other);
+    GlTexture foreign = make_texture_2d(GL_R32F, 1, 1);
+    stale = foreign.get() + 100;  // a name this context never made
+  }
+  std::vector<GlDebugMessage> seen;
+  auto previous = set_gl_debug_sink([&](const GlDebugMessage& m) { seen.push_back(m); });
+  glBindTextureUnit(3, stale);
+  set_gl_debug_sink(previous);
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_INVALID_OPERATION));
+  take_gl_debug_errors();
+  if (ctx_->gl_debug()) {
+    ASSERT_FALSE(seen.empty());
+    EXPECT_EQ(seen.front().type, "error");
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
+  const std::string e = draw_error();
+  EXPECT_NE(e.find("planted pass"), std::string::npos) << e;
+  EXPECT_NE(e.find("unit 3"), std::string::npos) << e;
+}
+
+TEST_F(Validation, AnIncompleteFramebufferNamesPassAndStatus) {
+  GlTexture input = make_texture_2d(GL_R32F, 1, 1);
+  glBindTextureUnit(3, input.get());
+  GLuint id = 0;
+  glCreateFramebuffers(1, &id);
+  GlFramebuffer empty(id);  // no attachment
+  glBindFramebuffer(GL_FRAMEBUFFER, id);
+  const std::string e = draw_error();
+  EXPECT_NE(e.find("planted pass"), std::string::npos) << e;
+  EXPECT_NE(e.find("is not complete"), std::string::npos) << e;
+}
+
+TEST_F(Validation, AShadowSamplerNeedsDepthComparison) {
+  const std::string vert = R"(#version 450 core
+void main() { gl_Position = vec4(vec2(gl_VertexID & 1, gl_VertexID >> 1) * 4.0 - 1.0, 0.0, 1.0); }
+)";
+  const std::string frag = R"(#version 450 core
+layout(binding = 5) uniform sampler2DShadow u_depth;
+layout(location = 0) out float o;
+void main() { o = texture(u_depth, vec3(0.5, 0.5, 0.5)); }
+)";
+  GlProgram shadow = build_program("shadow_validation_test", vert, frag);
+  glUseProgram(shadow.get());
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &id);
+  GlTexture depth(id);
+  glTextureStorage2D(id, 1, GL_DEPTH_COMPONENT32F, 1, 1);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glBindTextureUnit(5, id);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
+  const std::string e = draw_error();
+  EXPECT_NE(e.find("unit 5 (sampler2DShadow u_depth): texture"), std::string::npos) << e;
+  EXPECT_NE(e.find("no depth comparison"), std::string::npos) << e;
+}
+
+// The full-screen rule in double: a perspective eye inside a proxy box or
+// within twice the near plane's corner distance of it; never orthographic.
+TEST(BeamProxy, EyeInsideOrNearTheBoxTakesTheFullScreenPath) {
+  Camera cam;
+  cam.width = cam.height = 8;
+  cam.fov_y_deg = 60.0;
+  cam.near_plane = 0.01;
+  const CameraBasis basis = camera_basis(cam);
+  BeamGpu sphere;  // centre at p0 (camera-relative), radius 1
+  sphere.p0 = {0.5, -0.5, 0.2};
+  EXPECT_TRUE(beam_proxy_full_screen(sphere, 1.0, cam, basis)) << "inside";
+  sphere.p0 = {0.0, 0.0, -1.01};  // the box's face 0.01 away
+  EXPECT_TRUE(beam_proxy_full_screen(sphere, 1.0, cam, basis)) << "within the near distance";
+  sphere.p0 = {0.0, 0.0, -3.0};
+  EXPECT_FALSE(beam_proxy_full_screen(sphere, 1.0, cam, basis)) << "2 radii away";
+  BeamGpu capsule;  // axis from p0 along +x, length 10, caps at both ends
+  capsule.p0 = {-5.0, 0.3, 0.0};
+  capsule.axis = {1.0, 0.0, 0.0};
+  capsule.length = 10.0;
+  capsule.caps_kind = {1.0, 1.0, 1.0};
+  EXPECT_TRUE(beam_proxy_full_screen(capsule, 0.5, cam, basis)) << "inside, off the axis";
+  capsule.p0 = {-5.0, 2.0, 0.0};
+  EXPECT_FALSE(beam_proxy_full_screen(capsule, 0.5, cam, basis)) << "beside it";
+  capsule.p0 = {0.6, 0.0, 0.0};  // the eye 0.1 past the p0 cap's end
+  EXPECT_FALSE(beam_proxy_full_screen(capsule, 0.5, cam, basis)) << "past the cap";
+  capsule.p0 = {0.5, 0.0, 0.0};
+  EXPECT_TRUE(beam_proxy_full_screen(capsule, 0.5, cam, basis)) << "on the cap's end";
+  Camera ortho = cam;
+  ortho.projection = Projection::kOrthographic;
+  sphere.p0 = {0.0, 0.0, 0.0};
+  EXPECT_FALSE(beam_proxy_full_screen(sphere, 1.0, ortho, camera_basis(ortho)));
+}
+
+}  // namespace
+}  // namespace beamcast
