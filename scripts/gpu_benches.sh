@@ -20,7 +20,8 @@
 # binaries; default build/bin; scripts/gpu_pack.sh packs one with its
 # libraries for a machine without this project's packages), DEADLINE (seconds for the whole run; default 3600),
 # BEAMCAST_PYTHON (the Python with numpy and matplotlib; default
-# /usr/bin/python3). A step over its limit is stopped (exit 124 in log.txt)
+# /usr/bin/python3), ONLY (space-separated names of the bench steps to run;
+# default all). A step over its limit is stopped (exit 124 in log.txt)
 # and the next one runs; `tar` of OUT after each step keeps OUT.tgz current.
 set -uo pipefail
 
@@ -42,6 +43,9 @@ log=$out/log.txt
 step() {
   local name=$1 limit=$2
   shift 2
+  if [ -n "${ONLY:-}" ] && [[ " $ONLY " != *" $name "* ]]; then
+    return
+  fi
   local left=$((deadline - SECONDS - 5))
   if [ "$left" -lt 15 ]; then
     echo "$name: skipped (deadline)" >>"$log"
@@ -52,7 +56,14 @@ step() {
   timeout --kill-after=5 "$limit" "$@" >"$out/$name.log" 2>&1
   local rc=$?
   echo "$name: rc $rc, $((SECONDS - t0)) s (limit $limit): $*" >>"$log"
-  tar czf "$out.tgz" -C "$(dirname "$out")" "$(basename "$out")" 2>/dev/null
+  pack
+}
+
+# OUT.tgz: text and plots, not the raw float images the benches keep
+# (*.rgb32f, work/ folders: tens of MB), so it can be brought back.
+pack() {
+  tar czf "$out.tgz" --exclude='*.rgb32f' --exclude='*/work/*' -C "$(dirname "$out")" \
+    "$(basename "$out")" 2>/dev/null
 }
 
 have() { [ -n "$data" ] && [ -f "$data/$1" ]; }
@@ -89,7 +100,7 @@ wait
       "$out/$t.log" | sort | uniq -c
   done
 } >"$out/tests.txt"
-tar czf "$out.tgz" -C "$(dirname "$out")" "$(basename "$out")" 2>/dev/null
+pack
 
 slim_pairs=()
 slim_args=()
@@ -121,5 +132,5 @@ step volumes_2048 90 "$bin/beamcast" bench volumes --size 2048 --reference-spv 2
   --out "$out/volumes_2048" "${skull_args[@]}"
 step medium_512 60 "$bin/beamcast" bench medium --size 512 --out "$out/medium_512"
 echo "done: $((SECONDS)) s" >>"$log"
-tar czf "$out.tgz" -C "$(dirname "$out")" "$(basename "$out")" 2>/dev/null
+pack
 exit 0

@@ -7,9 +7,12 @@
 #
 #   scripts/gpu_pack.sh DIR [BUILD]      (BUILD: default build)
 #
-# There: LD_LIBRARY_PATH=DIR/lib BIN=DIR/bin scripts/gpu_benches.sh OUT.
-# The test binaries read examples/ and protocol/ from the source folder they
-# were built in (BEAMCAST_SOURCE_DIR): link that path to the checkout there.
+# There, in the checkout: LD_LIBRARY_PATH=DIR/lib BEAMCAST_DATA_DIR=$PWD
+# BIN=DIR/bin scripts/gpu_benches.sh OUT (the benches find examples/ and
+# bench/ through BEAMCAST_DATA_DIR). The test binaries read examples/ and
+# protocol/ from the source folder they were built in (BEAMCAST_SOURCE_DIR):
+# link that path to the checkout there. docs/data/gpu-2026-11-27/README.md
+# has the whole command of a run.
 set -euo pipefail
 if [ $# -lt 1 ] || [ $# -gt 2 ]; then
   echo "usage: $0 DIR [BUILD]" >&2

@@ -104,39 +104,54 @@ TEST(Contexts, GlCheckRefusesAForeignOrMissingContext) {
   gl_check("owner current again");
 }
 
-// A 1-cube shadow array, +X face at depth 0, +Y face at depth 1, looked up
-// at the +X face's edge toward +Y with reference 0.5: a seamless filter
-// gives the +Y texels about half the weight (0.498 at t = 0.0005 of a
-// 4-texel face), so about half the samples pass; without it the +X face's
-// own edge texels (clamped, or the far edge under GL_REPEAT) all fail: 0.
+// A 1-cube shadow array, +X face at depth 0, +Y face at depth 1 (written
+// the way the direct pass writes its maps: a framebuffer clear of each
+// layer-face), looked up in a fragment shader at the +X face's edge toward
+// +Y with reference 0.5: a seamless filter gives the +Y texels about half
+// the weight (0.498 at t = 0.0005 of a 4-texel face), so about half the
+// samples pass; without it the +X face's own edge texels (clamped, or the
+// far edge under GL_REPEAT) all fail: 0.
 TEST(ShadowCubes, FilteringAcrossAFaceSeamUsesTheNeighbouringFace) {
   auto ctx = EglContext::create();
   const EglContext::Current current(*ctx);
   constexpr GLsizei kSize = 4;
   GlTexture cubes = make_shadow_cube_array(kSize, 1);
+  GLuint id = 0;
+  glCreateFramebuffers(1, &id);
+  GlFramebuffer depth_fbo(id);
+  glNamedFramebufferDrawBuffer(id, GL_NONE);
   for (int face = 0; face < 6; ++face) {
-    const std::vector<float> depth(kSize * kSize, face == 2 ? 1.0f : 0.0f);  // 2: +Y
-    glTextureSubImage3D(cubes.get(), 0, 0, 0, face, kSize, kSize, 1, GL_DEPTH_COMPONENT, GL_FLOAT,
-                        depth.data());
+    const float depth = face == 2 ? 1.0f : 0.0f;  // face 2: +Y
+    glNamedFramebufferTextureLayer(id, GL_DEPTH_ATTACHMENT, cubes.get(), 0, face);
+    glClearNamedFramebufferfv(id, GL_DEPTH, 0, &depth);
   }
-  const std::string src = R"(#version 450 core
-layout(local_size_x = 1) in;
-layout(binding = 0) uniform samplerCubeArrayShadow u_cubes;
-layout(std430, binding = 0) buffer Out { float result[]; };
-uniform vec4 u_dir_ref;
-void main() { result[0] = texture(u_cubes, vec4(u_dir_ref.xyz, 0.0), u_dir_ref.w); }
+  GlTexture result = make_texture_2d(GL_R32F, 1, 1);
+  glCreateFramebuffers(1, &id);
+  GlFramebuffer fbo(id);
+  glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, result.get(), 0);
+  const std::string vert = R"(#version 450 core
+void main() { gl_Position = vec4(vec2(gl_VertexID & 1, gl_VertexID >> 1) * 4.0 - 1.0, 0.0, 1.0); }
 )";
-  GlProgram program = build_compute_program("cube_seam_test", src);
-  GlBuffer out = make_buffer(sizeof(float), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  const std::string frag = R"(#version 450 core
+layout(binding = 0) uniform samplerCubeArrayShadow u_cubes;
+uniform vec3 u_dir;
+layout(location = 0) out float o;
+void main() { o = texture(u_cubes, vec4(u_dir, 0.0), 0.5); }
+)";
+  GlProgram program = build_program("cube_seam_test", vert, frag);
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  GlVertexArray empty(vao);
   glUseProgram(program.get());
+  glBindVertexArray(vao);
   glBindTextureUnit(0, cubes.get());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, out.get());
+  glBindFramebuffer(GL_FRAMEBUFFER, id);
+  glViewport(0, 0, 1, 1);
   auto lookup = [&](float x, float y, float z) {
-    glUniform4f(glGetUniformLocation(program.get(), "u_dir_ref"), x, y, z, 0.5f);
-    dispatch_compute(1, 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glUniform3f(glGetUniformLocation(program.get(), "u_dir"), x, y, z);
+    draw_arrays(GL_TRIANGLES, 0, 3);
     float v = -1.0f;
-    glGetNamedBufferSubData(out.get(), 0, sizeof v, &v);
+    glGetTextureImage(result.get(), 0, GL_RED, GL_FLOAT, sizeof v, &v);
     gl_check("cube seam lookup");
     return v;
   };
@@ -145,6 +160,7 @@ void main() { result[0] = texture(u_cubes, vec4(u_dir_ref.xyz, 0.0), u_dir_ref.w
   const float seam = lookup(1.0f, 0.999f, 0.0f);
   EXPECT_GT(seam, 0.25f) << "the +Y face's texels take no part: seamless filtering is off";
   EXPECT_LT(seam, 0.75f);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 // Draw validation on planted defects: each throws naming the pass and unit

@@ -614,7 +614,10 @@ TEST(Gi, ASharesDiskOverAQuadLightCountsNoPhotonsThere) {
 
 TEST(Gi, ACameraOnlyChangeTracesNoPhotons) {
   json j = furnace(0.5, 1.0, 5000, "box");
-  j["gi"]["seed"] = 12345;  // maps no other test has cached
+  // Maps no other test, nor an earlier repetition of this one
+  // (--gtest_repeat: the renderer and its photon cache live on), has cached.
+  static int run = 0;
+  j["gi"]["seed"] = 12345 + 1000 * run++;
   const Scene first = parse_scene(j, {});
   const auto a = renderer().render(first);
   EXPECT_GT(a[0].photon_trace_ms, 0.0);
@@ -639,7 +642,8 @@ TEST(Gi, AShareOfTheCachedPhotonsTracesNothingAndStaysUnbiased) {
   constexpr double kRho = 0.5, kPhi = 10.0;
   const double expected = kRho * kPhi / (4.0 * std::numbers::pi * std::numbers::pi * (1.0 - kRho));
   json j = furnace(kRho, kPhi, 200000, "epanechnikov");
-  j["gi"]["seed"] = 4242;  // maps no other test has cached
+  static int run = 0;  // a seed of its own per repetition, as above
+  j["gi"]["seed"] = 4242 + 1000 * run++;
   Scene scene = parse_scene(j, {});
   const auto full = renderer().render(scene, FrameOptions{.read_hdr = true});
   EXPECT_GT(full[0].photon_trace_ms, 0.0);
