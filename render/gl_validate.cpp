@@ -4,8 +4,13 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
+#include <mutex>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "render/egl_context.hpp"
 #include "render/gl_util.hpp"
 
 namespace beamcast {
@@ -139,6 +144,49 @@ std::string texture_fault(GLuint tex, const SamplerKind& k, GLuint sampler) {
   return "";
 }
 
+// A program's active samplers (one entry per array element), listed once
+// per program and context: enumerating every uniform at each draw doubled
+// the stability sweep's time on llvmpipe. delete_program forgets an entry,
+// so a name the driver hands out again is listed again.
+struct SamplerSlot {
+  const SamplerKind* kind;
+  GLint location;
+  std::string name;
+};
+std::mutex g_programs_mutex;
+std::map<std::pair<const void*, GLuint>, std::vector<SamplerSlot>> g_programs;
+
+std::vector<SamplerSlot> list_samplers(GLuint prog) {
+  std::vector<SamplerSlot> slots;
+  GLint count = 0;
+  glGetProgramiv(prog, GL_ACTIVE_UNIFORMS, &count);
+  for (GLint i = 0; i < count; ++i) {
+    char name[256];
+    GLsizei len = 0;
+    GLint size = 0;
+    GLenum type = 0;
+    glGetActiveUniform(prog, static_cast<GLuint>(i), sizeof name, &len, &size, &type, name);
+    const SamplerKind* k = sampler_kind(type);
+    if (!k) continue;
+    std::string base(name, static_cast<std::size_t>(len));
+    if (base.size() > 3 && base.compare(base.size() - 3, 3, "[0]") == 0) base.resize(base.size() - 3);
+    for (GLint e = 0; e < size; ++e) {
+      std::string element = size > 1 ? base + "[" + std::to_string(e) + "]" : base;
+      const GLint location = glGetUniformLocation(prog, element.c_str());
+      slots.push_back({k, location, std::move(element)});
+    }
+  }
+  return slots;
+}
+
+const std::vector<SamplerSlot>& samplers_of(GLuint prog) {
+  const std::pair<const void*, GLuint> key{EglContext::guarded(), prog};
+  std::lock_guard lock(g_programs_mutex);
+  auto it = g_programs.find(key);
+  if (it == g_programs.end()) it = g_programs.emplace(key, list_samplers(prog)).first;
+  return it->second;  // std::map: stays valid while other entries come and go
+}
+
 [[noreturn]] void fail(GLuint program, const std::string& what) {
   const std::string pass = t_pass ? *t_pass + " pass" : "(no pass)";
   throw GlError(pass + ", program '" + program_label(program) + "': " + what);
@@ -157,6 +205,11 @@ bool gl_validation_enabled() {
 }
 
 void set_gl_validation(bool on) { g_validation.store(on ? 1 : 0); }
+
+void forget_program(GLuint program) {
+  std::lock_guard lock(g_programs_mutex);
+  g_programs.erase({EglContext::guarded(), program});
+}
 
 GlPassLabel::GlPassLabel(const std::string& pass) : outer_(t_pass) { t_pass = &pass; }
 GlPassLabel::~GlPassLabel() { t_pass = outer_; }
@@ -184,36 +237,24 @@ void validate_draw_state(bool compute) {
   }
   GLint active_texture = GL_TEXTURE0;
   glGetIntegerv(GL_ACTIVE_TEXTURE, &active_texture);
-  GLint count = 0;
-  glGetProgramiv(prog, GL_ACTIVE_UNIFORMS, &count);
   std::string fault;
-  for (GLint i = 0; i < count && fault.empty(); ++i) {
-    char name[256];
-    GLsizei len = 0;
-    GLint size = 0;
-    GLenum type = 0;
-    glGetActiveUniform(prog, static_cast<GLuint>(i), sizeof name, &len, &size, &type, name);
-    const SamplerKind* k = sampler_kind(type);
-    if (!k) continue;
-    std::string base(name, static_cast<std::size_t>(len));
-    if (base.size() > 3 && base.compare(base.size() - 3, 3, "[0]") == 0) base.resize(base.size() - 3);
-    for (GLint e = 0; e < size && fault.empty(); ++e) {
-      const std::string element = size > 1 ? base + "[" + std::to_string(e) + "]" : base;
-      GLint unit = 0;
-      glGetUniformiv(prog, glGetUniformLocation(prog, element.c_str()), &unit);
-      glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(unit));
-      GLint tex = 0, sampler = 0;
-      glGetIntegerv(k->binding, &tex);
-      glGetIntegerv(GL_SAMPLER_BINDING, &sampler);
-      const std::string where = "unit " + std::to_string(unit) + " (" + k->glsl + " " + element + ")";
-      if (tex == 0) {
-        fault = where + ": no texture of the sampler's target bound";
-      } else if (std::string why =
-                     texture_fault(static_cast<GLuint>(tex), *k, static_cast<GLuint>(sampler));
-                 !why.empty()) {
-        fault = where + ": " + why;
-      }
+  for (const SamplerSlot& slot : samplers_of(prog)) {
+    GLint unit = 0;
+    glGetUniformiv(prog, slot.location, &unit);
+    glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(unit));
+    GLint tex = 0, sampler = 0;
+    glGetIntegerv(slot.kind->binding, &tex);
+    glGetIntegerv(GL_SAMPLER_BINDING, &sampler);
+    const std::string where =
+        "unit " + std::to_string(unit) + " (" + slot.kind->glsl + " " + slot.name + ")";
+    if (tex == 0) {
+      fault = where + ": no texture of the sampler's target bound";
+    } else if (std::string why = texture_fault(static_cast<GLuint>(tex), *slot.kind,
+                                               static_cast<GLuint>(sampler));
+               !why.empty()) {
+      fault = where + ": " + why;
     }
+    if (!fault.empty()) break;
   }
   glActiveTexture(static_cast<GLenum>(active_texture));
   if (!fault.empty()) fail(prog, fault);

@@ -17,6 +17,10 @@ namespace beamcast {
 bool gl_validation_enabled();
 void set_gl_validation(bool on);
 
+// Drops what validation remembers of `program` in the current context (its
+// samplers): called when the program is deleted (delete_program).
+void forget_program(GLuint program);
+
 // The pass whose draws follow on this thread (for the messages); nests.
 class GlPassLabel {
  public:
