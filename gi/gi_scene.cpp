@@ -132,7 +132,7 @@ bool embree_ray_valid(const RTCRay& r) {
   for (const float x : {r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z}) {
     if (!(std::abs(x) <= kLarge)) return false;
   }
-  return !std::isnan(r.tnear) && !std::isnan(r.tfar) && r.tnear >= 0.0f;
+  return !std::isnan(r.tnear) && !std::isnan(r.tfar);
 }
 
 }  // namespace
