@@ -73,7 +73,11 @@ class Tracer {
         if (event) {
           if (t < t_min) break;
           const Vec3 x = o + t * v;
-          beta = (medium.sigma_s(x) / medium.sigma_t(x)) * beta;
+          // sigma_t(x) is 0 only where x rounds to just outside a region
+          // (a measure-zero event at its boundary): absorbed there, as the
+          // photon tracer does, rather than a NaN weight.
+          const double sigma_t = medium.sigma_t(x);
+          beta = (sigma_t > 0.0 ? medium.sigma_s(x) / sigma_t : 0.0) * beta;
           const double k = medium.k(x);
           L = L + mul(beta, in_scattered(x, v, k, rng));
           v = schlick_sample_direction(k, v, uniform(rng), uniform(rng));
