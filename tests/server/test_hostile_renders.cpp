@@ -147,12 +147,14 @@ TEST(HostileRenders, FogPhotonEventsAreBounded) {
   const double before = rss_mib();
   c.send_text(kFogRequest);
   const Reply r = c.recv();
+  ASSERT_TRUE(r.json.contains("error")) << "rendered: the events were not bounded";
   EXPECT_EQ(r.json["error"]["code"], "limit_exceeded") << r.json.dump();
   EXPECT_NE(r.json["error"]["message"].get<std::string>().find("max_photon_events = 400000"),
             std::string::npos)
       << r.json.dump();
   EXPECT_EQ(r.json["error"]["path"], "/params/scene/gi/photons") << r.json.dump();
   const Reply s = put_then_render(c, kFogRequest, "fog");
+  ASSERT_TRUE(s.json.contains("error")) << s.json.dump();
   EXPECT_EQ(s.json["error"]["code"], "limit_exceeded") << s.json.dump();
   EXPECT_EQ(s.json["error"]["path"], "/params/scene_id") << s.json.dump();
   expect_alive(c);
