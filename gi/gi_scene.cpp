@@ -2,6 +2,8 @@
 
 #include <embree3/rtcore.h>
 
+#include "protocol/check.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -123,6 +125,16 @@ void user_occluded(const RTCOccludedFunctionNArguments* args) {
   if (user_hit(*u->element, *c, c->t_min, c->t_max)) ray->tfar = -std::numeric_limits<float>::infinity();
 }
 
+// What Embree's Ray::valid() asserts: origin and direction within
+// FLT_LARGE (1.844e18) and not NaN, tnear and tfar not NaN.
+bool embree_ray_valid(const RTCRay& r) {
+  constexpr float kLarge = 1.844e18f;
+  for (const float x : {r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z}) {
+    if (!(std::abs(x) <= kLarge)) return false;
+  }
+  return !std::isnan(r.tnear) && !std::isnan(r.tfar);
+}
+
 }  // namespace
 
 struct GiScene::Impl {
@@ -240,6 +252,11 @@ std::optional<SurfaceHit> GiScene::intersect(const Vec3& o, const Vec3& v, doubl
     rh.ray.tfar = static_cast<float>(std::min(t_max, 1e30));
     rh.ray.mask = 0xFFFFFFFFu;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    // Embree asserts (aborts) on a ray it deems invalid: a NaN, or a
+    // coordinate past FLT_LARGE. Parsing keeps every client number away from
+    // that (issue 43), so one here is a bug: an internal error for this
+    // request, not the end of the server.
+    BEAMCAST_CHECK(embree_ray_valid(rh.ray), "a finite ray within Embree's range");
     rtcIntersect1(impl_->rtc, &c.rtc, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
     const Element& e = impl_->elements[rh.hit.geomID];
@@ -250,6 +267,9 @@ std::optional<SurfaceHit> GiScene::intersect(const Vec3& o, const Vec3& v, doubl
     if (!e.tris.empty()) {
       const Triangle& tri = e.tris[rh.hit.primID];
       n = normalize(cross(tri.b - tri.a, tri.c - tri.a));
+      if (!std::isfinite(n[0] + n[1] + n[2])) {  // degenerate in double: Embree's float normal
+        n = normalize(Vec3{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z});
+      }
       const double denom = dot(v, n);
       h.t = denom != 0.0 ? dot(tri.a - o, n) / denom : static_cast<double>(rh.ray.tfar);
       if (!(h.t > t_min)) h.t = static_cast<double>(rh.ray.tfar);  // grazing: keep Embree's

@@ -2,12 +2,22 @@
 // is free takes the next), for the CPU renderers and tracers: the result of
 // an item must not depend on which thread runs it, so outputs are the same
 // for any thread count.
+//
+// The caller's cancel token (protocol/cancel.hpp) is installed on every
+// worker and checked before each item; the first exception an item throws
+// (Cancelled, a failed check) stops the other workers at their next item and
+// is rethrown on the caller's thread once all have joined, so no exception
+// ever leaves a std::thread (which would end the process).
 #pragma once
 
 #include <algorithm>
 #include <atomic>
+#include <exception>
+#include <mutex>
 #include <thread>
 #include <vector>
+
+#include "protocol/cancel.hpp"
 
 namespace beamcast {
 
@@ -16,18 +26,34 @@ template <class Body>
 void parallel_items(int count, int threads, Body&& body) {
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int n = std::min(count, threads > 0 ? threads : hw);
+  const CancelToken* token = current_cancel_token();
   std::atomic<int> next{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr first_error;
+  std::mutex error_mu;
   auto worker = [&] {
-    for (int i = next.fetch_add(1); i < count; i = next.fetch_add(1)) body(i);
+    const CancelScope scope(token);
+    try {
+      for (int i = next.fetch_add(1); i < count && !failed.load(std::memory_order_relaxed);
+           i = next.fetch_add(1)) {
+        check_cancel();
+        body(i);
+      }
+    } catch (...) {
+      std::lock_guard lock(error_mu);
+      if (!first_error) first_error = std::current_exception();
+      failed.store(true);
+    }
   };
   if (n <= 1) {
     worker();
-    return;
+  } else {
+    std::vector<std::thread> pool;
+    pool.reserve(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
   }
-  std::vector<std::thread> pool;
-  pool.reserve(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
+  if (first_error) std::rethrow_exception(first_error);
 }
 
 }  // namespace beamcast

@@ -13,6 +13,7 @@
 #include "gi/parallel.hpp"
 #include "gi/phase.hpp"
 #include "protocol/camera.hpp"
+#include "protocol/cancel.hpp"
 #include "protocol/check.hpp"
 #include "protocol/lights/sampling.hpp"
 
@@ -63,25 +64,20 @@ class Tracer {
       if (!medium.empty()) {
         // Free flight from o (the eye for the camera ray: the medium lies
         // before the near plane too, but what scatters there is not seen),
-        // by delta tracking against the majorant (every tentative event is
-        // real in a homogeneous medium). An event's weight is the albedo
-        // sigma_s / sigma_t there; a surface reached first has weight 1.
+        // sampled exactly against the local extinction (MediumField::
+        // free_path). An event's weight is the albedo sigma_s / sigma_t
+        // there; a surface reached first has weight 1.
         const double t_hit = std::min(hit ? hit->t : kInf, medium.last_exit(o, v));
-        double t = 0.0;
-        bool event = false;
-        for (;;) {
-          t += -std::log1p(-uniform(rng)) / medium.majorant();
-          if (!(t < t_hit)) break;
-          if (medium.homogeneous() ||
-              uniform(rng) * medium.majorant() < medium.sigma_t(o + t * v)) {
-            event = true;
-            break;
-          }
-        }
+        const double t = medium.free_path(o, v, t_hit, -std::log1p(-uniform(rng)));
+        const bool event = t < t_hit;
         if (event) {
           if (t < t_min) break;
           const Vec3 x = o + t * v;
-          beta = (medium.sigma_s(x) / medium.sigma_t(x)) * beta;
+          // sigma_t(x) is 0 only where x rounds to just outside a region
+          // (a measure-zero event at its boundary): absorbed there, as the
+          // photon tracer does, rather than a NaN weight.
+          const double sigma_t = medium.sigma_t(x);
+          beta = (sigma_t > 0.0 ? medium.sigma_s(x) / sigma_t : 0.0) * beta;
           const double k = medium.k(x);
           L = L + mul(beta, in_scattered(x, v, k, rng));
           v = schlick_sample_direction(k, v, uniform(rng), uniform(rng));
@@ -241,6 +237,7 @@ std::vector<Color> path_trace(const GiScene& gi, const Camera& cam, const PathTr
   auto trace_row = [&](int y) {
     const int py = h - 1 - y;  // camera rows count from the bottom
     for (int x = 0; x < w; ++x) {
+      check_cancel();  // a pixel is spp paths: a row can take long
       const std::size_t index = static_cast<std::size_t>(y) * w + x;
       std::mt19937_64 rng(mix64(seed_key ^ index));
       Color sum{0.0, 0.0, 0.0};

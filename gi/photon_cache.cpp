@@ -152,9 +152,14 @@ std::shared_ptr<const PhotonMaps> PhotonCache::get(const Scene& scene, bool* tra
   if (traced) *traced = true;
   const std::size_t bytes =
       (maps->global.size() + maps->caustic.size() + maps->volume.size()) * sizeof(Photon);
+  // Maps over the whole budget are used for this render and freed after it,
+  // not kept (issue 43: fog in a closed sphere stayed resident at 2.7 GB);
+  // a later render of the scene traces them again.
+  if (bytes > max_bytes_) return maps;
   entries_.push_front({key, maps, bytes, {}, {}});
   bytes_ += bytes;
-  // Evict the least recently used, but keep the one just traced.
+  // Evict the least recently used, but keep the one just traced (its
+  // gather trees and disks, added later, may still take it over the budget).
   while (bytes_ > max_bytes_ && entries_.size() > 1) {
     bytes_ -= entries_.back().bytes;
     entries_.pop_back();

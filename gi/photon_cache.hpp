@@ -1,7 +1,8 @@
 // Photon maps kept across renders (issue 14, item 2): keyed by everything the
 // tracing depends on (occluder geometry and materials, lights, gi settings)
 // and nothing else, so a render that changes only cameras, output or beams
-// re-traces nothing. Bounded in bytes; least recently used maps go first.
+// re-traces nothing. Bounded in bytes; least recently used maps go first,
+// and maps larger than the whole budget are not kept at all.
 // One per renderer (render thread); not thread-safe.
 #pragma once
 

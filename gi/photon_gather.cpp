@@ -257,6 +257,7 @@ HdrImage gather_image(const Scene& scene, const GiScene& surfaces, const PhotonG
   auto row = [&](int y) {
     const int py = cam.height - 1 - y;  // GL pixel rows count from the bottom
     for (int x = 0; x < cam.width; ++x) {
+      check_cancel();  // a pixel's gather follows specular paths: rows can take long
       const Ray ray = camera_ray(cam, basis, x, py);
       const Color c = shading.trace(ray.origin, ray.dir, ray.t_min, ray.t_max);
       float* px = img.at(x, y);

@@ -7,12 +7,14 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <string>
 #include <thread>
 #include <variant>
 
 #include "gi/optics.hpp"
 #include "gi/parallel.hpp"
 #include "gi/phase.hpp"
+#include "protocol/cancel.hpp"
 #include "protocol/lights/sampling.hpp"
 #include "protocol/scene_bounds.hpp"
 
@@ -111,21 +113,13 @@ void trace_one(const Scene& scene, const GiScene& surfaces, const LightChoice& l
   for (int depth = 0; depth < scene.gi.max_depth; ++depth) {
     const auto hit = surfaces.intersect(o, d, eps, std::numeric_limits<double>::infinity());
     if (!medium.empty()) {
-      // Free path by delta tracking against the majorant (exact for the
-      // homogeneous medium, where every tentative event is real): the
-      // medium fills space, so a photon that meets no surface meets it.
+      // A free path sampled exactly against the local extinction
+      // (MediumField::free_path): the medium fills space, so a photon that
+      // meets no surface meets it, up to the medium's finite extent.
       const double t_hit = std::min(hit ? hit->t : std::numeric_limits<double>::infinity(),
                                     medium.last_exit(o, d));
-      double t = 0.0;
-      bool event = false;
-      for (;;) {
-        t += -std::log1p(-rng.next()) / medium.majorant();
-        if (!(t < t_hit)) break;
-        if (medium.homogeneous() || rng.next() * medium.majorant() < medium.sigma_t(o + t * d)) {
-          event = true;
-          break;
-        }
-      }
+      const double t = medium.free_path(o, d, t_hit, -std::log1p(-rng.next()));
+      const bool event = t < t_hit;
       if (event) {
         if (map == MapKind::kCaustic) return;
         const Vec3 x = o + t * d;
@@ -183,30 +177,46 @@ void trace_one(const Scene& scene, const GiScene& surfaces, const LightChoice& l
   }
 }
 
-// The chunks' photons in chunk order.
-std::vector<Photon> concatenate(const std::vector<std::vector<Photon>>& parts) {
+// The chunks' photons in chunk order, each part freed once copied (the
+// peak is the maps plus one chunk's part, not twice the maps).
+std::vector<Photon> concatenate(std::vector<std::vector<Photon>>& parts) {
   std::size_t total = 0;
   for (const auto& p : parts) total += p.size();
   std::vector<Photon> all;
   all.reserve(total);
-  for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
+  for (auto& p : parts) {
+    all.insert(all.end(), p.begin(), p.end());
+    std::vector<Photon>().swap(p);
+  }
   return all;
 }
 
+// Photons between checks of the cancel token within a chunk: in a dense
+// medium a photon stores up to gi.max_depth events, so a 4096-photon chunk
+// can take a while.
+constexpr std::int64_t kCancelEvery = 64;
+
 std::vector<Photon> trace_map(const Scene& scene, const GiScene& surfaces, std::int64_t count,
                               MapKind map, bool global_skips_caustics, int threads,
-                              std::vector<Photon>* volume) {
+                              std::vector<Photon>* volume, std::atomic<std::int64_t>* stored) {
   const LightChoice lights(scene);
   const std::int64_t chunks = (count + kChunk - 1) / kChunk;
   std::vector<std::vector<Photon>> parts(static_cast<std::size_t>(chunks));
   std::vector<std::vector<Photon>> volume_parts(static_cast<std::size_t>(chunks));
+  const std::int64_t cap = scene.gi.max_photon_events;
   parallel_items(static_cast<int>(chunks), threads, [&](int c) {
     Random rng(scene.gi.seed, static_cast<std::uint32_t>(map), static_cast<std::uint64_t>(c));
     const std::int64_t n = std::min(kChunk, count - c * kChunk);
     std::vector<Photon>& out = parts[static_cast<std::size_t>(c)];
     std::vector<Photon>& vol = volume_parts[static_cast<std::size_t>(c)];
     for (std::int64_t i = 0; i < n; ++i) {
+      if (i % kCancelEvery == kCancelEvery - 1) check_cancel();
+      const std::size_t before = out.size() + vol.size();
       trace_one(scene, surfaces, lights, count, map, global_skips_caustics, rng, &out, &vol);
+      const auto added = static_cast<std::int64_t>(out.size() + vol.size() - before);
+      if (added > 0 && stored->fetch_add(added) + added > cap) {
+        throw PhotonEventLimit(cap, c * kChunk + i + 1);
+      }
     }
   });
   if (volume) *volume = concatenate(volume_parts);
@@ -230,15 +240,16 @@ PhotonMaps trace_photons(const Scene& scene, const GiScene& surfaces,
                                     : static_cast<int>(std::thread::hardware_concurrency());
   threads = std::max(1, threads);
   const bool caustics = has_specular(scene) && scene.gi.caustic_photons > 0;
+  std::atomic<std::int64_t> stored{0};  // events of both maps, against gi.max_photon_events
   maps.emitted_global = scene.gi.photons;
   if (maps.emitted_global > 0) {
     maps.global = trace_map(scene, surfaces, maps.emitted_global, MapKind::kGlobal, caustics,
-                            threads, &maps.volume);
+                            threads, &maps.volume, &stored);
   }
   if (caustics) {
     maps.emitted_caustic = scene.gi.caustic_photons;
     maps.caustic = trace_map(scene, surfaces, maps.emitted_caustic, MapKind::kCaustic, true,
-                             threads, nullptr);
+                             threads, nullptr, &stored);
   }
   maps.trace_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -9,11 +9,15 @@
 // are absorbed with probability 1 - sigma_s / sigma_t at each, else scatter
 // by Schlick's phase function and are stored in the volume map; the caustic
 // map's paths end at their first scattering. Multi-threaded; for one seed
-// the maps are identical whatever the thread count.
+// the maps are identical whatever the thread count. Cancellable
+// (protocol/cancel.hpp: checked every 64 photons) and bounded in the
+// events stored (gi.max_photon_events, PhotonEventLimit).
 #pragma once
 
 #include <algorithm>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "gi/gi_scene.hpp"
@@ -42,6 +46,23 @@ struct PhotonMaps {
   std::int64_t emitted_global = 0;   // photons sent into the scene for each map
   std::int64_t emitted_caustic = 0;
   double trace_ms = 0.0;             // wall time of tracing both
+};
+
+// Thrown by trace_photons when the maps would store more than
+// gi.max_photon_events events (SceneLimits::max_photon_events): tracing
+// stops there and what was stored is freed.
+class PhotonEventLimit : public std::runtime_error {
+ public:
+  PhotonEventLimit(std::int64_t limit, std::int64_t photons_traced)
+      : std::runtime_error("photon tracing stored more than max_photon_events = " +
+                           std::to_string(limit) + " events (surface hits and medium "
+                           "scatterings) by photon " + std::to_string(photons_traced) +
+                           " of a map: lower gi.photons or gi.max_depth, or thin the medium"),
+        limit_(limit) {}
+  std::int64_t limit() const { return limit_; }
+
+ private:
+  std::int64_t limit_;
 };
 
 struct PhotonTraceOptions {

@@ -1,5 +1,6 @@
 #include "protocol/camera.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -7,7 +8,16 @@ namespace beamcast {
 
 double length(const Vec3& a) { return std::hypot(a[0], a[1], a[2]); }
 
-Vec3 normalize(const Vec3& a) { return (1.0 / length(a)) * a; }
+Vec3 normalize(const Vec3& a) {
+  const double len = length(a);  // hypot: no overflow or underflow in the squares
+  if (len >= 1e-300 && len <= 1e300) return (1.0 / len) * a;
+  // Scale-free for the rest (1 / len would overflow for a subnormal length):
+  // divide by the largest component first. Zero stays NaN, as before.
+  const double m = std::max({std::abs(a[0]), std::abs(a[1]), std::abs(a[2])});
+  if (!(m > 0.0) || !std::isfinite(m)) return (1.0 / len) * a;
+  const Vec3 s{a[0] / m, a[1] / m, a[2] / m};
+  return (1.0 / length(s)) * s;
+}
 
 Vec3 rotate(const std::array<double, 4>& q, const Vec3& v) {
   // v' = v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 namespace beamcast::json_read {
 
@@ -131,6 +132,14 @@ double read_number(const Node& n) {
   const double v = n.json().get<double>();
   if (!std::isfinite(v)) {
     fail("not_finite", n.path, n.name() + " must be a finite number, got " + format_number(v));
+  }
+  // Subnormal numbers (0 < |v| < 2.2e-308) overflow when inverted and lose
+  // their digits in any product: no scene quantity needs one (issue 43).
+  if (v != 0.0 && std::fpclassify(v) == FP_SUBNORMAL) {
+    fail("out_of_range", n.path,
+         n.name() + " must be 0 or of magnitude >= " +
+             format_number(std::numeric_limits<double>::min()) +
+             " (subnormal numbers are refused), got " + format_number(v));
   }
   return v;
 }

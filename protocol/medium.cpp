@@ -345,6 +345,63 @@ double MediumRegion::exit(const Vec3& o, const Vec3& v) const {
   return last > 0.0 ? last : -1.0;
 }
 
+void MediumRegion::crossings(const Vec3& o, const Vec3& v, double t_end,
+                             std::vector<double>* out) const {
+  double a = 0.0, b = t_end;
+  clip(o, v, &a, &b);  // a mesh: its bounds
+  if (!(b > a)) return;
+  if (shape != Shape::kMesh) {
+    if (a > 0.0) out->push_back(a);
+    if (b < t_end) out->push_back(b);
+    return;
+  }
+  mesh_crossings(triangles, o, v, [&](double t, int) {
+    if (t > 0.0 && t < t_end) out->push_back(t);
+  });
+}
+
+namespace {
+
+// Where o + t v (t >= 0) leaves the cube |x_i| <= kMediumExtent; 0 if o is outside it.
+double extent_exit(const Vec3& o, const Vec3& v) {
+  double t = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!(std::abs(o[i]) <= kMediumExtent)) return 0.0;
+    if (v[i] != 0.0) t = std::min(t, ((v[i] > 0.0 ? kMediumExtent : -kMediumExtent) - o[i]) / v[i]);
+  }
+  return t;
+}
+
+}  // namespace
+
+double MediumField::free_path(const Vec3& o, const Vec3& v, double t_end, double tau) const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  t_end = std::min(t_end, extent_exit(o, v));
+  if (!(t_end > 0.0) || !(tau >= 0.0)) return kInf;
+  if (regions_->empty()) {
+    // Homogeneous: t = tau / sigma_t (the same numbers as delta tracking,
+    // every tentative event of which is real here).
+    const double sigma = global_ ? global_->sigma_t() : 0.0;
+    if (!(sigma > 0.0)) return kInf;
+    const double t = tau / sigma;
+    return t < t_end ? t : kInf;
+  }
+  std::vector<double> cuts;
+  for (const MediumRegion& r : *regions_) r.crossings(o, v, t_end, &cuts);
+  cuts.push_back(t_end);
+  std::sort(cuts.begin(), cuts.end());
+  double t0 = 0.0;
+  for (const double t1 : cuts) {
+    if (!(t1 > t0)) continue;
+    // Exact on [t0, t1], where the extinction is constant: depth / (t1 - t0).
+    const double depth = optical_depth(o, v, t0, t1);
+    if (depth > 0.0 && depth >= tau) return t0 + (t1 - t0) * (tau / depth);
+    tau -= depth;
+    t0 = t1;
+  }
+  return kInf;
+}
+
 double MediumField::last_exit(const Vec3& o, const Vec3& v) const {
   if (global_) return std::numeric_limits<double>::infinity();
   double t = -1.0;

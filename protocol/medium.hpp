@@ -112,6 +112,9 @@ struct MediumRegion {
   // The ray parameter where o + t v (t >= 0) last leaves the region; -1 if
   // it never is inside.
   double exit(const Vec3& o, const Vec3& v) const;
+  // Appends the ray parameters in (0, t_end) where o + t v crosses the
+  // region's boundary (a box or sphere: where it enters and leaves).
+  void crossings(const Vec3& o, const Vec3& v, double t_end, std::vector<double>* out) const;
 
  private:
   // [a, b]: the part of [t0, t1] inside (empty if b <= a).
@@ -141,6 +144,16 @@ class MediumField {
   double k(const Vec3& x) const;
   double optical_depth(const Vec3& o, const Vec3& v, double t0, double t1) const;
   double majorant() const { return majorant_; }
+  // A free path from o along v (|v| = 1): the t at which the optical depth
+  // from o reaches `tau` (an exponential sample, -log(1 - u)), or +inf if
+  // that is not before t_end. Sampled exactly, segment by segment between
+  // the regions' boundaries (the field is constant on each), so the cost
+  // is bounded by the boundaries crossed (at most 2 per box or sphere and
+  // the crossings of each mesh), never by the ratio of the majorant to the
+  // local extinction (delta tracking's rejection loop, which a region of
+  // sigma 1e6 in fog of 1e-300 made endless: issue 43). The scene-wide
+  // medium ends at kMediumExtent: a path that reaches it has left.
+  double free_path(const Vec3& o, const Vec3& v, double t_end, double tau) const;
   // Beyond this ray parameter o + t v meets no medium: infinite with the
   // scene-wide medium, else the last exit from a region (-1: none).
   double last_exit(const Vec3& o, const Vec3& v) const;
@@ -150,6 +163,11 @@ class MediumField {
   const std::vector<MediumRegion>* regions_;
   double majorant_ = 0.0;
 };
+
+// Where the scene-wide medium ends for photons and paths: the cube |x_i| <=
+// 1e12 (the default max_abs_coordinate), so every free path ends at a
+// finite point that Embree (floats, |x| <= 1.8e18) can still take.
+inline constexpr double kMediumExtent = 1e12;
 
 // The most sub-pieces a beam's piece is split into; with optical depth
 // beyond kMaxBeamSubPieces x beam_step the rest of the piece is attenuated by

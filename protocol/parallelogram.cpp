@@ -2,6 +2,8 @@
 
 #include "protocol/scene_readers.hpp"
 
+#include <utility>
+
 namespace beamcast {
 
 using namespace json_read;
@@ -10,14 +12,30 @@ Parallelogram Parallelogram::read(const ObjectReader& fields, const SceneLimits&
                                   const char* what) {
   Parallelogram q;
   q.corner = read_point(fields.required("corner"), limits);
-  q.edge_u = read_point(fields.required("edge_u"), limits);
+  const Node u = fields.required("edge_u");
+  q.edge_u = read_point(u, limits);
   const Node v = fields.required("edge_v");
   q.edge_v = read_point(v, limits);
-  const double area = length(q.normal_unnormalized());
-  if (!(area > 1e-9 * length(q.edge_u) * length(q.edge_v))) {
+  for (const auto& [node, edge] : {std::pair{&u, q.edge_u}, std::pair{&v, q.edge_v}}) {
+    if (!(length(edge) >= kMinLength)) {
+      fail("invalid_value", node->path,
+           node->name() + " must be at least " + format_number(kMinLength) + " long (the " +
+               what + "'s edge), got length " + format_number(length(edge)));
+    }
+  }
+  // Scale-free: the sine of the angle between the unit edges (1e-9 * |u| *
+  // |v| underflowed for tiny edges: issue 43).
+  if (!(length(cross(normalize(q.edge_u), normalize(q.edge_v))) > 1e-9)) {
     fail("invalid_value", v.path,
-         std::string("edge_v must not be zero or parallel to edge_u (the ") + what +
+         std::string("edge_v must not be parallel to edge_u (the ") + what +
              " would have no area)");
+  }
+  // Its area's square (hit()'s n . n) and the GPU's float cross product stay normal numbers.
+  const double area = q.area();
+  if (!(area >= kMinLength * kMinLength)) {
+    fail("invalid_value", v.path,
+         std::string("the ") + what + "'s area |edge_u x edge_v| must be at least " +
+             format_number(kMinLength * kMinLength) + ", got " + format_number(area));
   }
   return q;
 }

@@ -16,13 +16,17 @@ struct Parallelogram {
   Vec3 edge_u{1.0, 0.0, 0.0};
   Vec3 edge_v{0.0, 0.0, 1.0};
 
-  // "corner", "edge_u", "edge_v" of `fields`; parallel or zero edges (sin of
-  // the angle between them below 1e-9: no area, no normal, far from any
-  // surface a scene means and far above double rounding) are refused at
-  // edge_v, naming `what` ("quad", "light").
+  // "corner", "edge_u", "edge_v" of `fields`; parallel edges (sin of the
+  // angle between the unit edges below 1e-9: no normal, far from any
+  // surface a scene means and far above double rounding), an edge shorter
+  // than kMinLength or an area below kMinLength^2 are refused, naming
+  // `what` ("quad", "light").
   static Parallelogram read(const json_read::ObjectReader& fields, const SceneLimits& limits,
                             const char* what);
   Vec3 normal_unnormalized() const { return cross(edge_u, edge_v); }
+  double area() const { return length(normal_unnormalized()); }
+  // Unit, towards cross(edge_u, edge_v).
+  Vec3 unit_normal() const { return normalize(normal_unnormalized()); }
   Aabb bounds() const;
   // t of o + t v where it crosses the parallelogram, t in [t_min, t_max];
   // front_only: only against its normal cross(edge_u, edge_v).

@@ -135,6 +135,11 @@ struct GiSettings {
   // (server/accuracy_controller.hpp): the maps stay cached, nothing is
   // traced again.
   double display_fraction = 1.0;
+  // Not in JSON: the most photon events (surface hits and medium
+  // scatterings, 52 bytes each) tracing may store for this scene, all maps
+  // together; past it tracing stops with PhotonEventLimit. Set from
+  // SceneLimits::max_photon_events when the scene is parsed.
+  std::int64_t max_photon_events = std::int64_t{1} << 26;
 };
 
 // SLIM point sampling ("slim" in JSON; issue 16): the accuracy knobs of the

@@ -225,6 +225,22 @@ Occluder parse_occluder(const Node& n, const SceneLoadOptions& opts, std::int64_
 // flux = color x power. A quad may give "radiance" instead of both.
 constexpr std::array<std::string_view, 2> kLightFields{"color", "power"};
 
+// The most flux per channel a light may have, and the most radiance a quad
+// light may have: photon powers, radiances and their products with the
+// scene's factors stay finite in the GPU's floats (3.4e38; issue 43).
+constexpr double kMaxLightValue = 1e30;
+
+void check_light_values(const Light& l, const std::string& path) {
+  const double flux = std::max({l.flux[0], l.flux[1], l.flux[2]});
+  const double radiance = std::visit([](const auto& k) { return k.radiance_scale(); }, l.shape) * flux;
+  if (!(flux <= kMaxLightValue) || !(radiance <= kMaxLightValue)) {
+    fail("out_of_range", path,
+         "the light's flux (" + format_number(flux) + ") and radiance (" + format_number(radiance) +
+             ") must each be at most " + format_number(kMaxLightValue) +
+             " per channel: lower its power, color, radiance or intensity, or enlarge it");
+  }
+}
+
 Light parse_gi_light(const Node& n, const SceneLimits& limits) {
   ObjectReader o(n, "a light");
   Light l;
@@ -255,11 +271,12 @@ Light parse_gi_light(const Node& n, const SceneLimits& limits) {
       l.flux = (std::numbers::pi * quad->area) * read_color(*r);
     }
   }
+  check_light_values(l, o.path());
   return l;
 }
 
 // The light of each beam with "emit": true, after the scene's own lights.
-void add_beam_lights(Scene* scene) {
+void add_beam_lights(Scene* scene, const std::string& beams_path) {
   for (std::size_t i = 0; i < scene->beams.size(); ++i) {
     const Beam& b = scene->beams[i];
     if (!b.emit) continue;
@@ -270,6 +287,7 @@ void add_beam_lights(Scene* scene) {
     for (std::size_t k = 0; k < 3; ++k) {
       l.flux[k] = 4.0 * std::numbers::pi * b.color[k] * b.intensity * m / b.radius;
     }
+    check_light_values(l, child_path(beams_path, i));
     scene->lights.push_back(std::move(l));
   }
 }
@@ -332,15 +350,18 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
     g.radius = read_number(*v);
     if (!(g.radius >= 0.0 && g.radius <= limits.max_abs_coordinate)) {
       fail("out_of_range", v->path,
-           "radius must be >= 0 (0: chosen from the scene size), got " + format_number(g.radius));
+           "radius must be in [0, " + format_number(limits.max_abs_coordinate) +
+               "] (0: chosen from the scene size; the upper bound is max_abs_coordinate), got " +
+               format_number(g.radius));
     }
   }
   if (auto v = o.optional("caustic_radius")) {
     g.caustic_radius = read_number(*v);
     if (!(g.caustic_radius >= 0.0 && g.caustic_radius <= limits.max_abs_coordinate)) {
       fail("out_of_range", v->path,
-           "caustic_radius must be >= 0 (0: from the caustic photon count), got " +
-               format_number(g.caustic_radius));
+           "caustic_radius must be in [0, " + format_number(limits.max_abs_coordinate) +
+               "] (0: from the caustic photon count; the upper bound is max_abs_coordinate), "
+               "got " + format_number(g.caustic_radius));
     }
   }
   if (auto v = o.optional("kernel")) {
@@ -892,13 +913,14 @@ Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
     scene.gi.photons = std::min(scene.gi.photons, limits.max_photons);
     scene.gi.caustic_photons = std::min(scene.gi.caustic_photons, limits.max_photons - scene.gi.photons);
   }
+  scene.gi.max_photon_events = limits.max_photon_events;
 
   if (auto v = o.optional("beams")) {
     for (const Node& b : read_array(*v, limits.max_beams, "max_beams")) {
       scene.beams.push_back(parse_beam(b, limits));
     }
   }
-  add_beam_lights(&scene);
+  add_beam_lights(&scene, o.path_of("beams"));
   check_shadow_budget(scene, limits, gi_path);
   if (auto v = o.optional("occluders")) {
     std::int64_t mesh_triangles = 0, slim_spheres = 0;

@@ -33,6 +33,11 @@ struct SceneLimits {
   double max_abs_coordinate = 1e12;  // any position or size, world units
   int max_lights = 1024;
   std::int64_t max_photons = 20000000;  // gi.photons + gi.caustic_photons
+  // Photon events (surface hits, medium scatterings) tracing may store, all
+  // maps together: a photon stores up to gi.max_depth of them (52 bytes
+  // each), so max_photons alone does not bound the maps' memory. Crossed
+  // while tracing: the render fails with limit_exceeded (issue 43).
+  std::int64_t max_photon_events = std::int64_t{1} << 26;
   // Depth texels of the direct-light pass's shadow maps: direct points
   // (one per point or spot light, about gi.direct_samples per quad light)
   // x 6 cube faces x gi.shadow_size^2; 4 bytes each.
@@ -53,6 +58,8 @@ inline constexpr SceneLimits kServerSceneLimits{.max_beams = 10000,
                                                 .max_slim_spheres = 200000,
                                                 .max_lights = 64,
                                                 .max_photons = 4000000,
+                                                // 16 Mi events: 832 MiB at most.
+                                                .max_photon_events = 16LL << 20,
                                                 .max_shadow_texels = 32LL << 20,
                                                 // 256^3: 32 MiB, built or read
                                                 // in well under a second.

@@ -2,6 +2,7 @@
 // sizes) or its conventions (directions, albedo, quaternions).
 #include "protocol/scene_readers.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "protocol/camera.hpp"
@@ -14,24 +15,28 @@ Vec3 read_point(const Node& n, const SceneLimits& limits) {
 
 double read_size(const Node& n, const SceneLimits& limits) {
   const double v = check_positive(n, read_number(n));
-  if (v > limits.max_abs_coordinate) {
+  if (v > limits.max_abs_coordinate || v < kMinLength) {
     fail("out_of_range", n.path,
-         n.name() + " must be <= " + format_number(limits.max_abs_coordinate) +
-             " (limit max_abs_coordinate), got " + format_number(v));
+         n.name() + " must be in [" + format_number(kMinLength) + ", " +
+             format_number(limits.max_abs_coordinate) +
+             "] (limit max_abs_coordinate; below 1e-15 the GPU's floats lose it), got " +
+             format_number(v));
   }
   return v;
 }
 
 bool normalizable(const Vec3& v) {
   const double len = length(v);
-  return len > 0.0 && std::isfinite(len) && std::isfinite(1.0 / len);
+  if (!(len > 0.0) || !std::isfinite(len)) return false;
+  const Vec3 u = normalize(v);
+  return std::isfinite(u[0]) && std::isfinite(u[1]) && std::isfinite(u[2]);
 }
 
 Vec3 read_direction(const Node& n) {
   const Vec3 v = read_vec3(n);
   if (!normalizable(v)) {
     fail("invalid_value", n.path,
-         n.name() + " must be a nonzero direction vector (length > 1e-300), got [" +
+         n.name() + " must be a nonzero direction vector, got [" +
              format_number(v[0]) + ", " + format_number(v[1]) + ", " + format_number(v[2]) + "]");
   }
   return v;
@@ -53,12 +58,16 @@ Color read_albedo(const Node& n) {
 
 std::array<double, 4> read_quaternion(const Node& n) {
   auto q = read_numbers<4>(n);
-  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (!(norm > 0.0) || !std::isfinite(norm)) {
+  // Scale-free: divided by its largest component first, the sum of squares
+  // neither underflows (a 1e-200-long quaternion) nor overflows.
+  double m = 0.0;
+  for (const double c : q) m = std::max(m, std::abs(c));
+  if (!(m > 0.0)) {
     fail("invalid_value", n.path,
-         n.name() + " must be a quaternion [w, x, y, z] with finite nonzero norm, got norm " +
-             format_number(norm));
+         n.name() + " must be a quaternion [w, x, y, z] with nonzero norm, got all zeros");
   }
+  for (double& c : q) c /= m;
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   for (double& c : q) c /= norm;
   return q;
 }

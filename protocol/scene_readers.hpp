@@ -13,9 +13,13 @@ namespace beamcast::json_read {
 
 // A position: finite, |component| <= max_abs_coordinate.
 Vec3 read_point(const Node& n, const SceneLimits& limits);
-// A length: > 0, finite, at most max_abs_coordinate.
+// The smallest length a scene may give (a size, an edge): the GPU computes
+// in float, whose normal numbers end at 1.2e-38, so a length's square (an
+// area, 1e-30) must still be one (issue 43).
+inline constexpr double kMinLength = 1e-15;
+// A length: in [kMinLength, max_abs_coordinate].
 double read_size(const Node& n, const SceneLimits& limits);
-// True if normalize(v) is finite: nonzero, and not so tiny (denormal) that 1/|v| overflows.
+// True if normalize(v) is finite: any nonzero finite vector (normalize is scale-free).
 bool normalizable(const Vec3& v);
 // A direction: finite, not the zero vector (need not be unit).
 Vec3 read_direction(const Node& n);
@@ -23,7 +27,8 @@ Vec3 read_direction(const Node& n);
 Color read_color(const Node& n);
 // Components in [0, 1].
 Color read_albedo(const Node& n);
-// [w, x, y, z] with finite nonzero norm, returned normalized.
+// [w, x, y, z], not all zero, returned normalized (scale-free: any nonzero
+// length is accepted).
 std::array<double, 4> read_quaternion(const Node& n);
 // A mesh's "translate", "scale" (a number or three, nonzero) and "rotation"
 // (a quaternion) from its object, as occluders and medium regions give them.

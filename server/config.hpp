@@ -74,6 +74,9 @@ struct ServerConfig {
   int read_timeout_ms = 10000;
   int write_timeout_ms = 30000;
   int drain_timeout_ms = 10000;  // on SIGINT/SIGTERM: how long in-flight work may finish
+  // Wall-clock time a render request may take from its arrival, queueing
+  // included: past it, deadline_exceeded (RenderJob::deadline).
+  int max_render_ms = 120000;
 };
 
 }  // namespace beamcast

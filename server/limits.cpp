@@ -78,6 +78,13 @@ const std::vector<LimitEntry>& limit_table() {
                      "A message must be complete this long after its first byte: timeout"),
       BEAMCAST_LIMIT("write_timeout_ms", write_timeout_ms, 1, kI32,
                      "Close a connection that has not taken a response for this long"),
+      // Issue 43: work and memory of one render.
+      BEAMCAST_LIMIT("max_render_ms", max_render_ms, 1, kI32,
+                     "Wall-clock time a render may take from its arrival (queueing included): "
+                     "deadline_exceeded, checked inside the renderer's long loops"),
+      BEAMCAST_LIMIT("max_photon_events", scene_limits.max_photon_events, 0, kI64,
+                     "Most photon events (surface hits, medium scatterings; 52 bytes each) "
+                     "tracing may store for one scene: limit_exceeded"),
   };
   return kTable;
 }

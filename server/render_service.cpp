@@ -2,7 +2,10 @@
 
 #include <boost/asio/post.hpp>
 
+#include <malloc.h>
+
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <cstdio>
 #include <iterator>
@@ -10,6 +13,8 @@
 #include <tuple>
 #include <utility>
 
+#include "gi/photon_map.hpp"
+#include "protocol/cancel.hpp"
 #include "protocol/check.hpp"
 
 #include "render/gl_util.hpp"
@@ -23,6 +28,20 @@ using Clock = std::chrono::steady_clock;
 
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// A render slower than this, or one that failed, gives the heap's free
+// pages back (malloc_trim): photon maps and frames are large, and glibc
+// would otherwise keep them resident (issue 43; server/memory.hpp).
+constexpr double kTrimAfterRenderMs = 200.0;
+
+ErrorInfo deadline_error(const RenderJob& job, const std::string& when) {
+  return {"deadline_exceeded",
+          "the render passed its deadline (max_render_ms = " +
+              std::to_string(std::llround(ms_between(job.arrived, job.deadline))) +
+              " after it arrived) " + when +
+              "; it was stopped: lower its cost (photons, cameras, pixels, supersample, samples)",
+          ""};
 }
 
 class GlFrameRenderer final : public FrameRenderer {
@@ -409,9 +428,20 @@ void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer
   std::optional<ErrorInfo> error;
   std::vector<FrameResult> frames;
   const auto start = Clock::now();
-  if (!renderer) {
+  // Merged jobs share the render: the earliest deadline holds for it.
+  Clock::time_point deadline = Clock::time_point::max();
+  for (const RenderJob& j : task.members) deadline = std::min(deadline, j.deadline);
+  const CancelToken token(deadline, &cancel_all_);
+  const RenderJob& first = task.members.front();
+  if (token.stopped()) {
+    error = ErrorInfo{"shutting_down", "the server is stopping: the render was cancelled", ""};
+  } else if (token.expired()) {
+    error = deadline_error(first, "before its slice " + std::to_string(slice + 1) + " of " +
+                                      std::to_string(task.slices.size()) + " started");
+  } else if (!renderer) {
     error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
   } else {
+    const CancelScope scope(&token);
     try {
       int inject = inject_failures_.load();
       while (inject > 0 && !inject_failures_.compare_exchange_weak(inject, inject - 1)) {
@@ -422,6 +452,25 @@ void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer
       // options (RenderJob::batch_key), so the first job's options hold for all.
       frames = renderer->render(*task.members.front().scene, cameras, task.options);
       BEAMCAST_CHECK(frames.size() == cameras.size(), "one frame per camera of a slice");
+    } catch (const Cancelled& e) {
+      // Stopped inside a CPU loop, perhaps mid-frame: the context is
+      // rebuilt before the next slice, as after a GL error, so no state of
+      // the abandoned frame reaches another (not when shutting down).
+      error = e.reason() == Cancelled::Reason::kDeadline
+                  ? deadline_error(first, "while rendering slice " + std::to_string(slice + 1) +
+                                              " of " + std::to_string(task.slices.size()))
+                  : ErrorInfo{"shutting_down", "the server is stopping: the render was cancelled",
+                              ""};
+      *gl_failed = e.reason() == Cancelled::Reason::kDeadline;
+    } catch (const PhotonEventLimit& e) {
+      error = ErrorInfo{"limit_exceeded", e.what(),
+                        first.scene_path == "/params/scene" ? "/params/scene/gi/photons"
+                                                            : first.scene_path};
+    } catch (const ProtocolError& e) {
+      ErrorInfo info = e.info();
+      info.path = first.scene_path == "/params/scene" ? first.scene_path + info.path
+                                                      : first.scene_path;
+      error = std::move(info);
     } catch (const GlError& e) {
       std::fprintf(stderr, "beamcast-server: render worker %d: GL error, rebuilding its context: %s\n",
                    index, e.what());
@@ -433,6 +482,7 @@ void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer
     }
   }
   const double render_ms = ms_between(start, Clock::now());
+  if (error || render_ms >= kTrimAfterRenderMs) malloc_trim(0);
   if (error) {
     // The job is answered with the error: its other slices are not rendered.
     std::size_t withdrawn = 0;

@@ -107,6 +107,14 @@ struct RenderJob {
   int jpeg_quality = 90;
   std::shared_ptr<const std::atomic<bool>> client_alive;
   std::chrono::steady_clock::time_point arrived;
+  // The request's wall-clock deadline (max_render_ms after `arrived`; max:
+  // none): checked between slices and, through a CancelToken
+  // (protocol/cancel.hpp), inside the renderer's long CPU loops. Past it
+  // the job is answered deadline_exceeded and the worker takes other work.
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  // The JSON pointer a scene error found while rendering is reported under:
+  // "/params/scene" (its field's path is appended) or "/params/scene_id".
+  std::string scene_path = "/params/scene";
   // Jobs with the same non-null key (one stored scene, unmodified) that arrive
   // within the batch window are rendered in one call; null: never merged.
   const void* batch_key = nullptr;
@@ -173,6 +181,10 @@ class RenderService {
   // Stops the workers; jobs still queued are dropped (their `done` is called
   // with dropped = true).
   void stop();
+  // Cancels the work in progress and all work to come (the server's drain
+  // deadline has passed): every render's long loops throw at their next
+  // check and its job is answered shutting_down.
+  void cancel_all() { cancel_all_.store(true); }
 
  private:
   struct Task;
@@ -217,6 +229,7 @@ class RenderService {
   std::atomic<std::uint64_t> slices_dropped_{0};
   std::atomic<std::uint64_t> rebuilds_{0};
   std::atomic<int> inject_failures_{0};
+  std::atomic<bool> cancel_all_{false};
   mutable std::mutex mu_;
   std::condition_variable cv_;
   std::condition_variable window_cv_;  // batch windows wait here (stop() wakes them)

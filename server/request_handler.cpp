@@ -203,6 +203,8 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   job.client_alive = session->alive_flag();
   job.atlas = rp.atlas;
   job.arrived = arrived;
+  job.deadline = arrived + std::chrono::milliseconds(core.config.max_render_ms);
+  job.scene_path = rp.scene ? "/params/scene" : "/params/scene_id";
   // Scheduling (PROTOCOL.md, "Scheduling"): the preview's frames before batch
   // work; connections of one class in turn.
   job.work_class = decision ? WorkClass::kInteractive : WorkClass::kBatch;

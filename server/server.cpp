@@ -1,5 +1,8 @@
 #include "server/server.hpp"
 
+#include <cstdlib>
+#include <thread>
+
 #include <boost/asio/post.hpp>
 #include <boost/asio/strand.hpp>
 
@@ -120,6 +123,7 @@ void Server::run(bool handle_signals) {
     signals_.async_wait([this](const boost::system::error_code& ec, int sig) {
       if (ec) return;
       std::fprintf(stderr, "beamcast-server: signal %d: shutting down\n", sig);
+      start_exit_watchdog();
       shutdown();
     });
   }
@@ -130,6 +134,23 @@ void Server::run(bool handle_signals) {
     threads.emplace_back([this] { io_.run(); });
   }
   for (auto& t : threads) t.join();
+}
+
+void Server::start_exit_watchdog() {
+  // The last resort (issue 43): whatever a render worker is stuck in, the
+  // process ends kExitGraceMs after the drain deadline; the cancel tokens
+  // normally end every loop long before.
+  constexpr int kExitGraceMs = 2000;
+  const auto wait = std::chrono::milliseconds(core_.config.drain_timeout_ms + kExitGraceMs);
+  std::thread([wait] {
+    std::this_thread::sleep_for(wait);
+    std::fprintf(stderr,
+                 "beamcast-server: still running %lld ms after the shutdown signal (drain "
+                 "deadline + %d ms): exiting now\n",
+                 static_cast<long long>(wait.count()), kExitGraceMs);
+    std::fflush(stderr);
+    std::_Exit(2);
+  }).detach();
 }
 
 void Server::shutdown() {
@@ -153,8 +174,11 @@ void Server::drain_step(std::chrono::steady_clock::time_point deadline) {
     return;
   }
   if (core_.renders->inflight() > 0) {
-    std::fprintf(stderr, "beamcast-server: drain deadline passed with %d renders in flight\n",
+    std::fprintf(stderr,
+                 "beamcast-server: drain deadline passed with %d renders in flight: cancelling "
+                 "them\n",
                  core_.renders->inflight());
+    core_.renders->cancel_all();
   }
   // Let the last responses reach their sockets, then close everything.
   drain_timer_.expires_after(std::chrono::milliseconds(50));

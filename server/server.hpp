@@ -44,6 +44,10 @@ class Server {
  private:
   void do_accept();
   void drain_step(std::chrono::steady_clock::time_point deadline);
+  // After a shutdown signal (run with handle_signals only): a detached
+  // thread that ends the process drain_timeout_ms + 2 s later, stuck
+  // worker or not.
+  void start_exit_watchdog();
 
   ServerCore core_;
   RendererFactory factory_;

@@ -45,7 +45,7 @@ BeamGpu CapsuleBeam::gpu(const Vec3& eye) const {
   const double len = length(axis);
   BeamGpu g;
   g.p0 = p0 - eye;
-  g.axis = (1.0 / len) * axis;
+  g.axis = normalize(axis);
   g.length = len;
   g.caps_kind = {cap0 ? 1.0 : 0.0, cap1 ? 1.0 : 0.0, 1.0};
   return g;
@@ -55,7 +55,7 @@ void CapsuleBeam::reference_axis(double radius, Vec3* w, double* half_len) const
   const Vec3 axis = p1 - p0;
   const double len = length(axis);
   *w = {0.0, 0.0, 1.0};
-  if (len > 0.0) *w = (1.0 / len) * axis;  // else: degenerate, any axis will do
+  if (len > 0.0) *w = normalize(axis);  // else: degenerate, any axis will do
   *half_len = 0.5 * len * (1.0 / radius);
 }
 

@@ -18,9 +18,8 @@ QuadLight QuadLight::parse(const LightParse& in) {
   q.corner = p.corner;
   q.edge_u = p.edge_u;
   q.edge_v = p.edge_v;
-  const Vec3 n = p.normal_unnormalized();
-  q.area = length(n);
-  q.normal = (1.0 / q.area) * n;
+  q.area = p.area();
+  q.normal = p.unit_normal();
   return q;
 }
 

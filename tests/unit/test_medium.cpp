@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "protocol/errors.hpp"
@@ -123,6 +125,39 @@ TEST(Medium, RegionsParseAndTheirOpticalDepthIsExact) {
   EXPECT_NEAR(field.optical_depth(o, v, 0.0, len), sum * len / n, 1e-4);
   EXPECT_GT(field.optical_depth(o, v, 0.0, len), 1.0);
   EXPECT_DOUBLE_EQ(field.last_exit(o, v) > 3.0, true);
+}
+
+// MediumField::free_path inverts the optical depth exactly, segment by
+// segment, whatever the ratio of the regions' extinction to the fog's
+// (issue 43: delta tracking against a majorant of 1 in fog of 1e-300 never
+// ended), and every free path ends before the medium's extent.
+TEST(Medium, FreePathInvertsTheOpticalDepthAndEnds) {
+  json j = fogged({{"sigma_s", 1e-300}});
+  j["media"] = {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1.0}, {"sigma_s", 1.0}},
+                {{"type", "box"}, {"min", {2, -1, -1}}, {"max", {3, 1, 1}}, {"sigma_s", 1e6}}};
+  const Scene s = parse_scene(j, {});
+  const MediumField field = s.medium_field();
+  const Vec3 o{-2.0, 0.1, 0.0};
+  const Vec3 v = normalize(Vec3{1.0, 0.0, 0.01});
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // tau below the sphere's chord (~2), past it into the box, and past both.
+  for (const double tau : {0.0, 0.5, 1.9, 2.5, 1e5, 3e6}) {
+    const double t = field.free_path(o, v, kInf, tau);
+    if (tau > 2.0 + 1e6) {
+      // Beyond the box only fog of 1e-300: the path ends at the extent, no event.
+      EXPECT_EQ(t, kInf) << tau;
+      continue;
+    }
+    ASSERT_TRUE(std::isfinite(t)) << tau;
+    // Relative 1e-9: the sum of a few segments' exact depths in double.
+    EXPECT_NEAR(field.optical_depth(o, v, 0.0, t), tau, 1e-9 * std::max(1.0, tau)) << tau;
+  }
+  // Not before t_end: no event.
+  EXPECT_EQ(field.free_path(o, v, 0.5, 2.5), kInf);
+  // Fog alone: t = tau / sigma_t, the same numbers as before; none past the extent.
+  const Scene fog = parse_scene(fogged({{"sigma_s", 0.25}}), {});
+  EXPECT_DOUBLE_EQ(fog.medium_field().free_path(o, v, kInf, 2.0), 8.0);
+  EXPECT_EQ(fog.medium_field().free_path(o, v, kInf, 1e12), kInf);
 }
 
 TEST(Medium, BadFieldsAreRefusedWithTheirPath) {

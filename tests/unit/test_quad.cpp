@@ -62,7 +62,10 @@ TEST(Quad, BadFieldsNameTheirPointer) {
   const std::vector<Bad> cases = {
       {no_corner, "missing_field", "/occluders/0/corner"},
       {with_field("edge_v", {4, 0, 0}), "invalid_value", "/occluders/0/edge_v"},
-      {with_field("edge_u", {0, 0, 0}), "invalid_value", "/occluders/0/edge_v"},
+      {with_field("edge_u", {0, 0, 0}), "invalid_value", "/occluders/0/edge_u"},
+      // Issue 43: a subnormal edge, and edges whose area underflows.
+      {with_field("edge_u", {1e-310, 0, 0}), "out_of_range", "/occluders/0/edge_u/0"},
+      {with_field("edge_u", {1e-16, 0, 0}), "invalid_value", "/occluders/0/edge_u"},
       {with_field("sides", 3), "invalid_value", "/occluders/0/sides"},
       {with_field("sides", "one"), "wrong_type", "/occluders/0/sides"},
       {with_field("edge_u", {1e300, 0, 0}), "out_of_range",

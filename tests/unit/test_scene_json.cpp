@@ -537,11 +537,15 @@ TEST(SceneJsonReject, DegenerateCameraVectors) {
                   "/cameras/0/target");
   EXPECT_REJECTED(with(base(), "/cameras/0/up", {0, 0, 0}), SceneLoadOptions{}, "invalid_value",
                   "/cameras/0/up");
-  // Denormal vectors whose normalization overflows.
+  // Subnormal components (whose normalization overflowed) are refused as
+  // numbers (issue 43); tiny normal ones are directions like any other.
   EXPECT_REJECTED(with(base(), "/cameras/0/up", {0, 1e-320, 0}), SceneLoadOptions{},
-                  "invalid_value", "/cameras/0/up");
+                  "out_of_range", "/cameras/0/up/1");
   EXPECT_REJECTED(with(base(), "/light", {{"direction", {0, -1e-320, 0}}}), SceneLoadOptions{},
-                  "invalid_value", "/light/direction");
+                  "out_of_range", "/light/direction/1");
+  EXPECT_NO_THROW(parse_scene(with(base(), "/cameras/0/up", {0, 1e-300, 0}), SceneLoadOptions{}));
+  EXPECT_NO_THROW(parse_scene(with(base(), "/light", {{"direction", {0, -1e-300, 0}}}),
+                              SceneLoadOptions{}));
   // Default up (+Y) with a target straight below.
   EXPECT_REJECTED(with(base(), "/cameras/0/target", {0, -10, 5}), SceneLoadOptions{},
                   "invalid_value", "/cameras/0/target");
