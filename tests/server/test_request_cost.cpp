@@ -3,6 +3,7 @@
 // the server's admission check for inline and stored scenes, and idle
 // connections that wait for a render (issue 43, item 4).
 #include <gtest/gtest.h>
+#include <poll.h>
 
 #include <chrono>
 #include <filesystem>
@@ -204,6 +205,33 @@ TEST(RequestCost, ThinVolumeSpacingIsRefusedAtItsField) {
   EXPECT_EQ(code(r), "limit_exceeded") << r.json;
   EXPECT_EQ(r.json["error"]["path"], "/params/scene/volumes/0/spacing");
   EXPECT_EQ(control->call_count(), 0u);
+}
+
+// Readable (a byte or the peer's close) within `ms`.
+bool readable_within(test::Conn& c, int ms) {
+  pollfd p{c.native_handle(), POLLIN, 0};
+  return ::poll(&p, 1, ms) > 0;
+}
+
+// Idle means no traffic and no work in flight: a render that takes longer
+// than idle_timeout_ms keeps its connection, which is closed as idle only
+// once the answer has gone and nothing more arrives.
+TEST(RequestCost, ARenderLongerThanTheIdleTimeoutKeepsItsConnection) {
+  auto control = std::make_shared<test::FakeRendererControl>();
+  ServerConfig cfg;
+  cfg.idle_timeout_ms = 200;
+  test::LocalServer s(cfg, test::fake_renderer_factory(control));
+  test::Conn c(s.port(), 10);
+  control->hold_call(1);
+  c.send(render_req(1, {{"scene", test::tiny_scene(16)}}));
+  // Held for 4 idle timeouts: nothing may arrive (a close would be readable).
+  EXPECT_FALSE(readable_within(c, 4 * cfg.idle_timeout_ms));
+  control->release_call(1);
+  const test::Reply r = c.recv();
+  EXPECT_TRUE(r.json["ok"]) << r.json;
+  // Then idle again: closed within the timeout plus a margin for the timer.
+  EXPECT_TRUE(readable_within(c, 5 * cfg.idle_timeout_ms));
+  EXPECT_TRUE(c.closed_by_peer());
 }
 
 }  // namespace
