@@ -45,9 +45,9 @@ struct CostWeights {
   double beam_pixel = 1.0e-6;          // per beam per rendered pixel (every beam covering the frame)
   double lit_pixel = 3.0e-4;           // per rendered pixel of a lit scene (G-buffer, splats, resolve)
   double direct_point_pixel = 1.0e-5;  // per rendered pixel per direct point (direct pass)
-  double photon_bounce = 2.0e-5;       // per photon x gi.max_depth (CPU tracing among surfaces)
+  double photon_bounce = 4.0e-5;       // per photon x gi.max_depth (CPU tracing among surfaces)
   double medium_photon_event = 2.8e-3; // per photon x gi.max_depth with a scattering medium
-  double volume_photon_view = 1.0e-3;  // per possible volume photon per 512^2 view per region
+  double volume_photon_view = 3.0e-3;  // per possible volume photon per 512^2 view per medium part
   double specular_ray = 1.8e-3;        // per pixel x specular_samples^2 x the gather factor
   double volume_sample = 1.0e-5;       // per pixel per step through a volume's diagonal
   double slim_sphere_view = 3.0e-3;    // per SLIM sphere per camera ("patch" evaluation)
