@@ -64,6 +64,10 @@ struct ServerConfig {
   // Enforced while a request's JSON is parsed (protocol/bounded_json.hpp):
   // max_json_depth (nesting) and max_json_values (values in one request).
   JsonLimits json_limits;
+  // Largest estimated cost of one render (protocol/request_cost.hpp: about
+  // milliseconds on the 2-core llvmpipe reference machine), checked before any
+  // work starts: limit_exceeded with the estimate.
+  std::int64_t max_request_cost = 120000;
   int max_inflight_per_connection = 16;
   int max_inflight_total = 64;
   int max_connections = 256;

@@ -61,6 +61,9 @@ const std::vector<LimitEntry>& limit_table() {
                      "Most mesh triangles in a scene, all meshes together"),
       BEAMCAST_LIMIT("max_slim_spheres", scene_limits.max_slim_spheres, 0, kI64,
                      "Most SLIM support spheres in a scene, all slim occluders together"),
+      BEAMCAST_LIMIT("max_request_cost", max_request_cost, 1, kI64,
+                     "Largest estimated cost of one render (about ms on the reference machine; "
+                     "PROTOCOL.md, \"Request cost\"): limit_exceeded with the estimate"),
       BEAMCAST_LIMIT("max_inflight_per_connection", max_inflight_per_connection, 1, 1 << 20,
                      "Unanswered requests one connection may have: busy"),
       BEAMCAST_LIMIT("max_inflight_total", max_inflight_total, 1, 1 << 20,

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "protocol/request.hpp"
+#include "protocol/request_cost.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/pass_plan.hpp"
 #include "server/auth.hpp"
@@ -115,6 +116,29 @@ json store_scene(ServerCore& core, const std::string& id, json scene_json, Scene
   return {{"scene_id", id}, {"bytes", bytes}, {"evicted", evicted}};
 }
 
+// max_request_cost (PROTOCOL.md, "Request cost"): the render's estimated
+// work against the limit before anything is queued, for inline and stored
+// scenes alike. The path is the dominant term's field within the request.
+void check_request_cost(const ServerCore& core, const Scene& scene,
+                        const std::vector<Camera>& cameras, const RenderParams& rp) {
+  const RequestCost cost = estimate_request_cost(scene, cameras);
+  if (cost.total <= static_cast<double>(core.config.max_request_cost)) return;
+  const CostTerm* top = cost.dominant();
+  const bool per_pixel = top->path == "/cameras";
+  std::string path = rp.scene_id ? "/params/scene_id" : "/params/scene" + top->path;
+  if (per_pixel && rp.cameras) path = "/params/cameras";
+  if (per_pixel && rp.output && rp.output->contains("supersample")) {
+    path = "/params/output/supersample";
+  }
+  char total[32];
+  std::snprintf(total, sizeof total, "%.0f", cost.total);
+  fail("limit_exceeded", path,
+       std::string("the render's estimated cost is ") + total + " (" + cost.breakdown() +
+           "), over the limit max_request_cost = " +
+           std::to_string(core.config.max_request_cost) +
+           ": fewer photons, pixels, cameras or samples (PROTOCOL.md, \"Request cost\")");
+}
+
 void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session, const json& id,
                    const json& params, Clock::time_point arrived) {
   const RenderParams rp = parse_render_params(params, core.config.scene_limits);
@@ -142,6 +166,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
                           rp.output && rp.output->contains("supersample")
                               ? "/params/output/supersample"
                               : (rp.cameras ? "/params/cameras" : "/params/scene/output/supersample"));
+  check_request_cost(core, *scene, cameras, rp);
   if (rp.atlas) {
     // The composed image is a frame too: same limits as every camera.
     std::vector<std::pair<int, int>> sizes;

@@ -177,6 +177,12 @@ void Session::on_read_deadline(const boost::system::error_code& ec) {
   if (read_timer_.expiry() > Clock::now()) return;  // re-armed since this wait began
   if (state_ == ReadState::kIdle) {
     if (!read_pending_) return;  // paused, not idle
+    // Idle is no traffic and no work in flight: a render longer than
+    // idle_timeout_ms keeps its connection (PROTOCOL.md, "Limits").
+    if (renders_in_flight() > 0) {
+      arm_read_deadline();
+      return;
+    }
     std::fprintf(stderr, "beamcast-server: closing idle connection\n");
     close_now();
     return;
@@ -251,6 +257,8 @@ void Session::on_write(const boost::system::error_code& ec, std::size_t) {
     close_now();
     return;
   }
+  // An answer is traffic: the idle time starts again once it has gone.
+  if (state_ == ReadState::kIdle && read_pending_) arm_read_deadline();
   resume_reading_if_paused();
 }
 
