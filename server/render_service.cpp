@@ -88,6 +88,7 @@ struct RenderService::Task {
   std::uint64_t client = 0;
   const void* batch_key = nullptr;
   FrameOptions options;  // the first member's: merged jobs share options by their key
+  double cost_per_camera = 0.0;  // the first member's estimate over its cameras
 
   // Guarded by the service's mu_.
   std::size_t next_slice = 0;  // slices before it have been taken by a worker
@@ -206,6 +207,7 @@ bool RenderService::submit(RenderJob job) {
   task->client = job.client;
   task->batch_key = job.on_part ? nullptr : job.batch_key;  // a streamed job renders alone
   task->options = job.options;
+  task->cost_per_camera = job.cost / static_cast<double>(std::max<std::size_t>(1, job.cameras.size()));
   task->add(std::move(job));
   task->slices = make_slices(task->cameras, task->options);
   {
@@ -291,11 +293,32 @@ std::pair<RenderService::TaskPtr, std::size_t> RenderService::pick_locked(
       }
     }
     if (q == nullptr) return {nullptr, 0};
-    const std::uint64_t client = q->turns.front();
-    q->turns.pop_front();
+    // The connection whose next slice would end first in virtual time (its
+    // start: the later of the class's virtual time and the connection's last
+    // finish); ties go by turn order, so equal costs take turns.
+    std::size_t best = 0;
+    double best_start = 0.0, best_finish = 0.0;
+    for (std::size_t i = 0; i < q->turns.size(); ++i) {
+      const auto queued = q->by_client.find(q->turns[i]);
+      BEAMCAST_CHECK(queued != q->by_client.end() && !queued->second.empty(),
+                     "a connection in the turns has queued work");
+      const Task& head = *queued->second.front();
+      const auto last = q->finish.find(q->turns[i]);
+      const double start = std::max(q->vtime, last == q->finish.end() ? 0.0 : last->second);
+      const std::size_t cameras =
+          head.next_slice < head.slices.size() ? head.slices[head.next_slice].size() : 1;
+      const double finish = start + head.cost_per_camera * static_cast<double>(cameras);
+      if (i == 0 || finish < best_finish) {
+        best = i;
+        best_start = start;
+        best_finish = finish;
+      }
+    }
+    const std::uint64_t client = q->turns[best];
+    q->turns.erase(q->turns.begin() + static_cast<std::ptrdiff_t>(best));
+    q->vtime = std::max(q->vtime, best_start);
+    q->finish[client] = best_finish;
     auto it = q->by_client.find(client);
-    BEAMCAST_CHECK(it != q->by_client.end() && !it->second.empty(),
-                   "a connection in the turns has queued work");
     TaskPtr task = it->second.front();
     if (!task->started) {
       task->started = true;
@@ -329,6 +352,7 @@ std::pair<RenderService::TaskPtr, std::size_t> RenderService::pick_locked(
     }
     if (it->second.empty()) {
       q->by_client.erase(it);
+      q->finish.erase(client);
     } else {
       q->turns.push_back(client);
     }
@@ -352,6 +376,7 @@ std::size_t RenderService::withdraw_locked(Task& task) {
   --q.tasks;
   if (mine.empty()) {
     q.by_client.erase(it);
+    q.finish.erase(task.client);
     q.turns.erase(std::find(q.turns.begin(), q.turns.end(), task.client));
   }
   return left;

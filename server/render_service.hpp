@@ -122,6 +122,9 @@ struct RenderJob {
   WorkClass work_class = WorkClass::kBatch;
   // The connection it came from: connections of one class take turns.
   std::uint64_t client = 0;
+  // Estimated cost (protocol/request_cost.hpp): turns go by it (weighted fair
+  // queueing; PROTOCOL.md, "Scheduling"), so cheap renders pass costly ones.
+  double cost = 0.0;
   // Streaming (render param "stream"): if set, called for every slice but the
   // last, in slice order, with that slice's frames (RenderOutcome::part,
   // frame_index); the last slice's frames then come to `done`. Never merged
@@ -240,6 +243,12 @@ class RenderService {
     std::map<std::uint64_t, std::deque<TaskPtr>> by_client;
     std::deque<std::uint64_t> turns;
     int tasks = 0;
+    // Weighted fair queueing by estimated cost: the class's virtual time and
+    // each connection with queued work's finish tag (where its last taken
+    // slice ends in virtual time). A connection whose queue empties starts
+    // again at the virtual time.
+    double vtime = 0.0;
+    std::map<std::uint64_t, double> finish;
   };
   std::array<ClassQueue, kWorkClasses> queues_;
   bool stopping_ = false;

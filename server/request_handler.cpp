@@ -119,10 +119,10 @@ json store_scene(ServerCore& core, const std::string& id, json scene_json, Scene
 // max_request_cost (PROTOCOL.md, "Request cost"): the render's estimated
 // work against the limit before anything is queued, for inline and stored
 // scenes alike. The path is the dominant term's field within the request.
-void check_request_cost(const ServerCore& core, const Scene& scene,
-                        const std::vector<Camera>& cameras, const RenderParams& rp) {
+double check_request_cost(const ServerCore& core, const Scene& scene,
+                          const std::vector<Camera>& cameras, const RenderParams& rp) {
   const RequestCost cost = estimate_request_cost(scene, cameras);
-  if (cost.total <= static_cast<double>(core.config.max_request_cost)) return;
+  if (cost.total <= static_cast<double>(core.config.max_request_cost)) return cost.total;
   const CostTerm* top = cost.dominant();
   const bool per_pixel = top->path == "/cameras";
   std::string path = rp.scene_id ? "/params/scene_id" : "/params/scene" + top->path;
@@ -166,7 +166,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
                           rp.output && rp.output->contains("supersample")
                               ? "/params/output/supersample"
                               : (rp.cameras ? "/params/cameras" : "/params/scene/output/supersample"));
-  check_request_cost(core, *scene, cameras, rp);
+  const double estimated_cost = check_request_cost(core, *scene, cameras, rp);
   if (rp.atlas) {
     // The composed image is a frame too: same limits as every camera.
     std::vector<std::pair<int, int>> sizes;
@@ -234,6 +234,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   // work; connections of one class in turn.
   job.work_class = decision ? WorkClass::kInteractive : WorkClass::kBatch;
   job.client = session->id();
+  job.cost = estimated_cost;
   job.options.max_batch_views = core.config.slice_views;
   job.options.max_batch_pixels = core.config.slice_pixels;
   if (decision) {

@@ -207,6 +207,40 @@ TEST(RequestCost, ThinVolumeSpacingIsRefusedAtItsField) {
   EXPECT_EQ(control->call_count(), 0u);
 }
 
+// A scene of one camera named `name` at size x size (its cost grows with the pixels).
+json named_scene(const std::string& name, int size) {
+  json sc = test::tiny_scene(size);
+  sc["cameras"][0]["name"] = name;
+  return sc;
+}
+
+// Turns by estimated cost (PROTOCOL.md, "Scheduling"): behind a costly
+// render in progress, a cheap render from a third connection goes before a
+// costly one queued earlier by a second; one-camera renders, so each is one
+// slice. Round robin by request rendered the costly one first.
+TEST(RequestCost, ACheapRenderPassesAQueuedCostlyOne) {
+  auto control = std::make_shared<test::FakeRendererControl>();
+  test::LocalServer s({}, test::fake_renderer_factory(control));
+  test::Conn a(s.port(), 30), b(s.port(), 30), c(s.port(), 30);
+  control->hold_call(1);
+  a.send(render_req(1, {{"scene", named_scene("a", 1024)}}));
+  const auto until = [](const std::function<bool()>& cond) {
+    for (int i = 0; i < 2000 && !cond(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    return cond();
+  };
+  ASSERT_TRUE(until([&] { return control->call_count() == 1; }));
+  b.send(render_req(2, {{"scene", named_scene("b", 1024)}}));
+  ASSERT_TRUE(until([&] { return s.core().renders->queued() == 1; }));
+  c.send(render_req(3, {{"scene", named_scene("c", 16)}}));
+  ASSERT_TRUE(until([&] { return s.core().renders->queued() == 2; }));
+  control->release_call(1);
+  for (test::Conn* conn : {&a, &b, &c}) EXPECT_TRUE(conn->recv().json["ok"]);
+  const auto log = control->call_log();
+  ASSERT_EQ(log.size(), 3u);
+  EXPECT_EQ(log[1], std::vector<std::string>{"c"});
+  EXPECT_EQ(log[2], std::vector<std::string>{"b"});
+}
+
 // Readable (a byte or the peer's close) within `ms`.
 bool readable_within(test::Conn& c, int ms) {
   pollfd p{c.native_handle(), POLLIN, 0};
