@@ -1,59 +1,154 @@
 #!/usr/bin/env python3
-"""Server RSS around a burst of large legal requests (issue 12, item 9; issue 19).
+"""Server RSS after bursts of large legal requests (issue 12, item 9; issue 19;
+issue 43, items 6 and 7).
 
-    python3 bench/memory_burst.py build/bin/beamcast-server
+    python3 bench/memory_burst.py build/bin/beamcast-server [--kinds ping,mesh,slim]
+                                  [--settle 10] [--bound 50]
 
-    python3 bench/memory_burst.py build/bin/beamcast-server 900000
+For each kind, a fresh server (--no-demo, --assets a temporary directory with
+the generated files) answers one small request of that kind (so what a first
+request allocates for good, the GL context and shader programs included, is in
+the baseline), then 4 requests of the kind sent at once on 4 connections, all
+within today's limits so that every one is admitted and answered `ok`:
 
-Starts the server (--no-demo), sends one ping whose params hold 1.1 M small
-keys (13.2 MB; over max_json_values, so refused after parsing 1 M values) or
-the number of keys given (900 000: 10.7 MB, accepted and echoed), then 12 of
-them at once, and prints the settled RSS after each, how far it is above the
-baseline, the peak (VmHWM), and how many answers of each kind came back. Run
-it on an old and a new binary back to back to compare (docs/performance.md,
-"Memory after large requests").
+  ping  params of 250 000 small keys (3.0 MB; 4 x 40 x 3.0 MB fits the default
+        max_request_memory_bytes, 640 MiB, so none is refused `busy`; under
+        max_json_values, 1 000 000)
+  mesh  a 64 x 64 render of a scene whose occluder is a 405 000-triangle OBJ
+        grid (14 MB; max_mesh_triangles is 1 000 000)
+  slim  a 64 x 64 render of a scene whose occluder is a SLIM JSON file of
+        100 000 spheres (8 MB; max_slim_spheres is 200 000)
+
+and prints, per kind, the baseline RSS (lowest sample over 2 s), the RSS
+--settle seconds after the last answer (lowest over the last second), the
+peak (VmHWM) and the answers. Exits 1 if any kind's RSS after stays more than
+--bound MiB (default 50, the issue's bound) above its baseline, or if any
+answer is not `ok`. Run it on an old and a new binary back to back to compare
+(docs/performance.md, "Memory after large requests").
 """
+import argparse
 import collections
+import json
 import os
+import shutil
 import sys
+import tempfile
 import threading
+import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "python"))
 import test_hostile as th  # noqa: E402
 
+CAMERA = {"name": "c", "position": [0, 2, 6], "target": [0, 0, 0], "width": 64, "height": 64}
+BEAM = {"type": "sphere", "center": [0, 0.5, 0], "radius": 1, "density": "linear"}
+
+
+def write_grid_obj(path, n):
+    """An n x n grid of quads in y = -1, as 2 n^2 triangles."""
+    with open(path, "w") as f:
+        for i in range(n + 1):
+            f.write("".join(f"v {-2 + 4 * j / n:.5f} -1 {-2 + 4 * i / n:.5f}\n" for j in range(n + 1)))
+        for i in range(n):
+            row = []
+            for j in range(n):
+                a = i * (n + 1) + j + 1
+                b, c, d = a + 1, a + n + 2, a + n + 1
+                row.append(f"f {a} {b} {c}\nf {a} {c} {d}\n")
+            f.write("".join(row))
+
+
+def write_slim_json(path, count):
+    """count flat patches of radius 0.02 on a grid in y = -1."""
+    side = int(count ** 0.5) + 1
+    spheres = []
+    for k in range(count):
+        i, j = divmod(k, side)
+        spheres.append('{"center":[%.4f,-1,%.4f],"radius":0.02,"coefficients":[0,0,0,0,0,0]}'
+                       % (-2 + 4 * j / side, -2 + 4 * i / side))
+    with open(path, "w") as f:
+        f.write('{"format":"beamcast-slim","version":1,"spheres":[' + ",".join(spheres) + "]}")
+
+
+def render_text(rid, occluder):
+    scene = {"beams": [BEAM], "occluders": [occluder], "cameras": [CAMERA]}
+    return json.dumps({"id": rid, "method": "render", "params": {"scene": scene}})
+
+
+def ping_text(rid, keys):
+    return '{"id":"%s","method":"ping","params":{%s}}' % (
+        rid, ",".join(f'"k{i}":{i % 10}' for i in range(keys)))
+
+
+KINDS = {
+    # kind: (file writer or None, request text for an id and "small"/"large")
+    "ping": (None, lambda rid, size: ping_text(rid, 10 if size == "small" else 250_000)),
+    "mesh": (lambda d: (write_grid_obj(os.path.join(d, "small.obj"), 4),
+                        write_grid_obj(os.path.join(d, "large.obj"), 450)),
+             lambda rid, size: render_text(rid, {"type": "mesh", "file": size + ".obj"})),
+    "slim": (lambda d: (write_slim_json(os.path.join(d, "small.json"), 4),
+                        write_slim_json(os.path.join(d, "large.json"), 100_000)),
+             lambda rid, size: render_text(rid, {"type": "slim", "file": size + ".json"})),
+}
+
+
+def answer(port, text, out):
+    try:
+        c = th.Bcp(port, timeout=300)
+        c.send_text(text.encode())
+        r = c.recv()[0]
+        c.close()
+        out.append("ok" if r.get("ok") else r["error"]["code"] + ": " + r["error"]["message"][:120])
+    except OSError as e:
+        out.append(type(e).__name__)
+
+
+def run_kind(kind, settle):
+    write, request = KINDS[kind]
+    assets = tempfile.mkdtemp(prefix="beamcast_burst_")
+    try:
+        if write:
+            write(assets)
+        with th.Server("--no-demo", "--assets", assets) as srv:
+            warm = []
+            answer(srv.port, request("warm", "small"), warm)
+            base = th.settle_rss(srv, 2.0)
+            burst = []
+            threads = [threading.Thread(target=answer, args=(srv.port, request(f"b{i}", "large"), burst))
+                       for i in range(4)]
+            t0 = time.time()
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join()
+            took = time.time() - t0
+            time.sleep(max(0.0, settle - 1.0))
+            after = th.settle_rss(srv, 1.0)
+            peak = srv.status_mib("VmHWM")
+            return {"kind": kind, "base": base, "after": after, "peak": peak, "took": took,
+                    "answers": dict(collections.Counter(warm + burst))}
+    finally:
+        shutil.rmtree(assets, ignore_errors=True)
+
 
 def main():
-    th.SERVER = sys.argv[1]
-    n = int(sys.argv[2]) if len(sys.argv) > 2 else 1_100_000
-    keys = ",".join(f'"k{i}":{i % 10}' for i in range(n))
-    text = ('{"id":1,"method":"ping","params":{' + keys + "}}").encode()
-    print(f"request: {len(text)} bytes")
-    with th.Server("--no-demo") as srv:
-        def one(out):
-            try:
-                c = th.Bcp(srv.port, timeout=120)
-                c.send_text(text)
-                r = c.recv()[0]
-                c.close()
-                out.append(r["error"]["code"] if not r.get("ok") else "ok")
-            except OSError as e:  # the server closed the connection (timeout)
-                out.append(type(e).__name__)
-
-        base = th.settle_rss(srv, 1.0)
-        first = []
-        one(first)
-        after1, peak1 = th.settle_rss(srv, 3.0), srv.status_mib("VmHWM")
-        burst = []
-        threads = [threading.Thread(target=one, args=(burst,)) for _ in range(12)]
-        for t in threads:
-            t.start()
-        for t in threads:
-            t.join()
-        after12, peak12 = th.settle_rss(srv, 3.0), srv.status_mib("VmHWM")
-        print(f"baseline {base:.1f} MiB")
-        print(f"after 1: {after1:.1f} MiB (+{after1 - base:.1f}), peak {peak1:.1f} MiB, answer {first[0]}")
-        print(f"after 12 concurrent: {after12:.1f} MiB (+{after12 - base:.1f}), peak {peak12:.1f} MiB, "
-              f"answers {dict(collections.Counter(burst))}")
+    ap = argparse.ArgumentParser()
+    ap.add_argument("server")
+    ap.add_argument("--kinds", default="ping,mesh,slim")
+    ap.add_argument("--settle", type=float, default=10.0)
+    ap.add_argument("--bound", type=float, default=50.0)
+    args = ap.parse_args()
+    th.SERVER = args.server
+    failed = False
+    print("| kind | baseline MiB | RSS %.0f s after 4 | growth | peak | burst s | answers |" % args.settle)
+    print("|---|---|---|---|---|---|---|")
+    for kind in args.kinds.split(","):
+        r = run_kind(kind, args.settle)
+        grew = r["after"] - r["base"]
+        bad = grew > args.bound or set(r["answers"]) != {"ok"}
+        failed |= bad
+        print(f"| {kind} | {r['base']:.1f} | {r['after']:.1f} | +{grew:.1f} | {r['peak']:.1f} | "
+              f"{r['took']:.1f} | {r['answers']} |{' FAIL' if bad else ''}", flush=True)
+    sys.exit(1 if failed else 0)
 
 
 if __name__ == "__main__":

@@ -102,7 +102,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
     std::ostringstream bytes;
     bytes << in.rdbuf();
     models.push_back({path.stem().string(),
-                      parse_slim_file_bytes(bytes.str(), path.string(), "/", 10000000, 1e12), {}});
+                      parse_slim_file_bytes(bytes.str(), path.string(), "/", {10000000, 10000000}, 1e12), {}});
   }
   for (std::size_t i = 0; i < opts.meshes.size() && i < opts.models.size(); ++i) {
     models[models.size() - opts.models.size() + i].mesh = opts.meshes[i];

@@ -1,7 +1,7 @@
-// libFuzzer target: OBJ text through mesh_from_obj_text (tinyobjloader, compiled
-// into the fuzz build so it is instrumented too, then triangulation, index checks
-// and the world transform). A mesh that loads has in-range indices and finite,
-// bounded vertices; a refusal is a ProtocolError with a serializable message.
+// libFuzzer target: OBJ text through mesh_from_obj_text (the streaming reader's
+// number and index parsing, triangulation, limits and the world transform). A
+// mesh that loads has in-range indices and finite, bounded vertices; a refusal
+// is a ProtocolError with a serializable message.
 #include <cmath>
 #include <cstdint>
 #include <string>

@@ -1,12 +1,12 @@
 #include "protocol/mesh_obj.hpp"
 
-#include <tiny_obj_loader.h>
-
+#include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <fstream>
-#include <iterator>
-#include <sstream>
-#include <system_error>
+#include <cstdlib>
+#include <limits>
+#include <string_view>
+#include <vector>
 
 #include "protocol/camera.hpp"
 #include "protocol/errors.hpp"
@@ -17,46 +17,168 @@ namespace fs = std::filesystem;
 
 namespace {
 
-[[noreturn]] void fail(const char* code, const std::string& path, std::string message) {
-  throw ProtocolError(ErrorInfo{code, std::move(message), path});
+constexpr std::int64_t kI64Max = std::numeric_limits<std::int64_t>::max();
+
+std::int64_t saturating_mul(std::int64_t a, std::int64_t b) {
+  return a > 0 && b > kI64Max / a ? kI64Max : a * b;
 }
 
-// True if `p` equals `root` or lies below it (both already canonical).
-bool is_within(const fs::path& root, const fs::path& p) {
-  auto r = root.begin();
-  auto q = p.begin();
-  for (; r != root.end(); ++r, ++q) {
-    if (r->empty()) continue;  // trailing "" element of a path ending in '/'
-    if (q == p.end() || *r != *q) return false;
+std::string clip(std::string_view s) {
+  return s.size() <= 40 ? std::string(s) : std::string(s.substr(0, 40)) + "...";
+}
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+// Splits a line into whitespace-separated tokens (views into the line).
+void split(std::string_view line, std::vector<std::string_view>* out) {
+  out->clear();
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && is_space(line[i])) ++i;
+    const std::size_t b = i;
+    while (i < line.size() && !is_space(line[i])) ++i;
+    if (i > b) out->push_back(line.substr(b, i - b));
   }
-  return true;
 }
 
-// tinyobjloader parses "vw" (per-vertex joint weights, its own extension) and
-// converts the joint id with int(float), undefined behaviour for huge values
-// (found by fuzz_obj, docs/fuzzing.md). Occluders use positions and faces only,
-// so those lines are blanked (kept as empty lines: error line numbers stay right).
-std::string without_vertex_weights(const std::string& text) {
-  std::string out = text;
-  std::size_t pos = 0;
-  while (pos < out.size()) {
-    std::size_t eol = out.find('\n', pos);
-    if (eol == std::string::npos) eol = out.size();
-    std::size_t p = pos;
-    while (p < eol && (out[p] == ' ' || out[p] == '\t')) ++p;
-    if (eol - p >= 3 && out[p] == 'v' && out[p + 1] == 'w' && (out[p + 2] == ' ' || out[p + 2] == '\t')) {
-      out.erase(pos, eol - pos);
-      eol = pos;
+// Reads an OBJ one line at a time, counting vertices and triangles as it goes
+// and failing at the first line over a limit, so a file far over them costs
+// no more than the lines up to that one.
+class ObjReader {
+ public:
+  ObjReader(const std::string& file, const MeshTransform& xf, const MeshLoadLimits& limits,
+            const std::string& json_path)
+      : file_(file),
+        xf_(xf),
+        limits_(limits),
+        json_path_(json_path),
+        // Indices are 32-bit: no more vertices than they can name.
+        max_vertices_(std::min<std::int64_t>(
+            saturating_mul(3, std::max<std::int64_t>(0, limits.max_triangles - limits.triangles_before)),
+            std::numeric_limits<std::uint32_t>::max())) {
+    mesh_.file = file;
+  }
+
+  void line(std::string_view text) {
+    ++line_no_;
+    split(text, &tokens_);
+    if (tokens_.empty() || tokens_[0].front() == '#') return;
+    if (tokens_[0] == "v") {
+      vertex();
+    } else if (tokens_[0] == "f") {
+      face();
     }
-    pos = eol + 1;
+    // Everything else (vn, vt, vp, l, p, o, g, s, usemtl, mtllib, vw, ...) is
+    // not needed for an occluder and is skipped unread.
   }
-  return out;
-}
 
-std::string first_line(const std::string& s) {
-  const auto nl = s.find('\n');
-  return nl == std::string::npos ? s : s.substr(0, nl);
-}
+  MeshOccluder finish() {
+    if (mesh_.triangles.empty()) {
+      throw ProtocolError(
+          ErrorInfo{"bad_mesh", "mesh file \"" + file_ + "\" contains no triangles", json_path_});
+    }
+    return std::move(mesh_);
+  }
+
+ private:
+  [[noreturn]] void fail(const char* code, const std::string& what) const {
+    throw ProtocolError(ErrorInfo{
+        code, "mesh file \"" + file_ + "\", line " + std::to_string(line_no_) + ": " + what,
+        json_path_});
+  }
+
+  double number(std::string_view t) const {
+    std::string_view s = t;
+    if (s.size() > 1 && s[0] == '+') s.remove_prefix(1);  // from_chars takes no '+'
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (end != s.data() + s.size() || (ec != std::errc() && ec != std::errc::result_out_of_range)) {
+      fail("bad_mesh", "\"" + clip(t) + "\" is not a number");
+    }
+    if (ec == std::errc::result_out_of_range) {
+      v = std::strtod(std::string(s).c_str(), nullptr);  // an underflow is a fine 0 or denormal
+    }
+    if (!std::isfinite(v)) fail("bad_mesh", "coordinate \"" + clip(t) + "\" is not a finite number");
+    return v;
+  }
+
+  void vertex() {
+    if (tokens_.size() < 4) fail("bad_mesh", "a vertex (\"v\") needs x, y and z");
+    const Vec3 v{number(tokens_[1]), number(tokens_[2]), number(tokens_[3])};
+    if (static_cast<std::int64_t>(mesh_.vertices.size()) >= max_vertices_) {
+      fail("limit_exceeded",
+           "more than " + std::to_string(max_vertices_) +
+               " vertices, 3 for each triangle the limit max_mesh_triangles = " +
+               std::to_string(limits_.max_triangles) + " leaves room for");
+    }
+    const Vec3 w = xf_.apply(v);
+    for (double c : w) {
+      if (!(std::abs(c) <= limits_.max_abs_coordinate)) {
+        fail("out_of_range", "vertex " + std::to_string(mesh_.vertices.size() + 1) +
+                                 " lies beyond max_abs_coordinate after the transform");
+      }
+    }
+    mesh_.vertices.push_back(w);
+  }
+
+  // A face corner "i", "i/t", "i//n" or "i/t/n": the position index, 1-based,
+  // negative counting back from the last vertex defined so far.
+  std::uint32_t corner(std::string_view t) const {
+    const std::string_view s = t.substr(0, t.find('/'));
+    std::int64_t k = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), k);
+    const auto n = static_cast<std::int64_t>(mesh_.vertices.size());
+    if (s.empty() || end != s.data() + s.size() || ec != std::errc()) {
+      fail("bad_mesh", "face index \"" + clip(t) + "\" is not an integer in range");
+    }
+    if (k == 0) fail("bad_mesh", "face index 0 (OBJ indices start at 1; negative ones count back)");
+    const std::int64_t i = k > 0 ? k - 1 : n + k;
+    if (i < 0 || i >= n) {
+      fail("bad_mesh", "face index " + std::to_string(k) + " is out of range: " +
+                           std::to_string(n) + " vertices are defined before this line");
+    }
+    return static_cast<std::uint32_t>(i);
+  }
+
+  void face() {
+    const std::size_t fv = tokens_.size() - 1;
+    if (fv < 3) fail("bad_mesh", "a face needs at least 3 vertices, got " + std::to_string(fv));
+    idx_.clear();
+    for (std::size_t k = 1; k <= fv; ++k) idx_.push_back(corner(tokens_[k]));
+    if (static_cast<std::int64_t>(fv - 2) > limits_.max_triangles - triangles_total()) {
+      fail("limit_exceeded", "the mesh brings the scene over the limit max_mesh_triangles = " +
+                                 std::to_string(limits_.max_triangles) + " triangles");
+    }
+    auto& t = mesh_.triangles;
+    if (fv == 4) {
+      // Along the shorter diagonal, as tinyobjloader (the earlier reader) did.
+      const auto& v = mesh_.vertices;
+      if (length(v[idx_[2]] - v[idx_[0]]) < length(v[idx_[3]] - v[idx_[1]])) {
+        t.push_back({idx_[0], idx_[1], idx_[2]});
+        t.push_back({idx_[0], idx_[2], idx_[3]});
+      } else {
+        t.push_back({idx_[0], idx_[1], idx_[3]});
+        t.push_back({idx_[1], idx_[2], idx_[3]});
+      }
+      return;
+    }
+    for (std::size_t k = 1; k + 1 < fv; ++k) t.push_back({idx_[0], idx_[k], idx_[k + 1]});
+  }
+
+  std::int64_t triangles_total() const {
+    return limits_.triangles_before + static_cast<std::int64_t>(mesh_.triangles.size());
+  }
+
+  const std::string& file_;
+  const MeshTransform& xf_;
+  const MeshLoadLimits& limits_;
+  const std::string& json_path_;
+  const std::int64_t max_vertices_;
+  MeshOccluder mesh_;
+  std::size_t line_no_ = 0;
+  std::vector<std::string_view> tokens_;
+  std::vector<std::uint32_t> idx_;
+};
 
 }  // namespace
 
@@ -64,132 +186,36 @@ Vec3 MeshTransform::apply(const Vec3& v) const {
   return translate + rotate(rotation, Vec3{scale[0] * v[0], scale[1] * v[1], scale[2] * v[2]});
 }
 
-fs::path resolve_asset_path(const fs::path& assets_dir, const std::string& file,
-                            const std::string& json_path, std::string_view what) {
-  const std::string kind(what);
-  if (assets_dir.empty()) {
-    fail("forbidden_path", json_path,
-         kind + " files are disabled here (no assets directory configured), cannot load \"" +
-             file + "\"");
-  }
-  if (file.find('\0') != std::string::npos) {
-    fail("forbidden_path", json_path, kind + " path must not contain NUL characters");
-  }
-  const fs::path rel(file);
-  if (rel.is_absolute() || rel.has_root_name() || rel.has_root_directory()) {
-    fail("forbidden_path", json_path,
-         kind + " path must be relative to the assets directory, got absolute path \"" + file +
-             "\"");
-  }
-  for (const auto& part : rel) {
-    if (part == "..") {
-      fail("forbidden_path", json_path,
-           kind + " path must not contain \"..\" components, got \"" + file + "\"");
-    }
-  }
-  const fs::path full = assets_dir / rel;
-  std::error_code ec;
-  if (!fs::is_regular_file(full, ec)) {
-    fail("file_not_found", json_path,
-         kind + " file \"" + file + "\" was not found in the assets directory");
-  }
-  // Symlinks inside the assets directory must not lead out of it.
-  const fs::path root = fs::canonical(assets_dir, ec);
-  const fs::path target = ec ? fs::path() : fs::canonical(full, ec);
-  if (ec || !is_within(root, target)) {
-    fail("forbidden_path", json_path,
-         kind + " path \"" + file + "\" resolves to a file outside the assets directory");
-  }
-  return full;
-}
-
 MeshOccluder mesh_from_obj_text(const std::string& obj_text, const std::string& file,
                                 const MeshTransform& xf, const MeshLoadLimits& limits,
                                 const std::string& json_path) {
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = true;
-  config.vertex_color = false;
-  tinyobj::ObjReader reader;
-  // Parsing from a string (not a file) keeps "mtllib" from opening other files.
-  if (!reader.ParseFromString(without_vertex_weights(obj_text), std::string(), config)) {
-    fail("bad_mesh", json_path,
-         "mesh file \"" + file + "\" is not a valid OBJ file: " + first_line(reader.Error()));
+  ObjReader reader(file, xf, limits, json_path);
+  const std::string_view text(obj_text);
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    std::size_t eol = text.find('\n', pos);
+    if (eol == std::string_view::npos) eol = text.size();
+    reader.line(text.substr(pos, eol - pos));
+    pos = eol + 1;
   }
-  const auto& positions = reader.GetAttrib().vertices;
-  const std::size_t vertex_count = positions.size() / 3;
-
-  MeshOccluder mesh;
-  mesh.file = file;
-  mesh.vertices.reserve(vertex_count);
-  for (std::size_t i = 0; i < vertex_count; ++i) {
-    const Vec3 v{static_cast<double>(positions[3 * i]), static_cast<double>(positions[3 * i + 1]),
-                 static_cast<double>(positions[3 * i + 2])};
-    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
-      fail("bad_mesh", json_path,
-           "mesh file \"" + file + "\" has a non-finite coordinate in vertex " +
-               std::to_string(i + 1));
-    }
-    const Vec3 w = xf.apply(v);
-    for (double c : w) {
-      if (!(std::abs(c) <= limits.max_abs_coordinate)) {
-        fail("out_of_range", json_path,
-             "mesh file \"" + file + "\" vertex " + std::to_string(i + 1) +
-                 " lies beyond max_abs_coordinate after the transform");
-      }
-    }
-    mesh.vertices.push_back(w);
-  }
-
-  std::int64_t total = limits.triangles_before;
-  for (const auto& shape : reader.GetShapes()) {
-    std::size_t offset = 0;
-    for (const unsigned char fv_raw : shape.mesh.num_face_vertices) {
-      const std::size_t fv = fv_raw;
-      if (offset + fv > shape.mesh.indices.size()) {
-        fail("bad_mesh", json_path, "mesh file \"" + file + "\" has inconsistent face data");
-      }
-      std::array<std::uint32_t, 256> idx{};  // fv is an unsigned char
-      for (std::size_t k = 0; k < fv; ++k) {
-        const int vi = shape.mesh.indices[offset + k].vertex_index;
-        if (vi < 0 || static_cast<std::size_t>(vi) >= vertex_count) {
-          fail("bad_mesh", json_path,
-               "mesh file \"" + file + "\" has a face index out of range (" +
-                   std::to_string(vi + 1) + " of " + std::to_string(vertex_count) + " vertices)");
-        }
-        idx[k] = static_cast<std::uint32_t>(vi);
-      }
-      // tinyobjloader already triangulates; fan anything it left as a polygon.
-      for (std::size_t k = 1; k + 1 < fv; ++k) {
-        if (++total > limits.max_triangles) {
-          fail("limit_exceeded", json_path,
-               "mesh file \"" + file + "\" brings the scene over the limit max_mesh_triangles = " +
-                   std::to_string(limits.max_triangles) + " triangles");
-        }
-        mesh.triangles.push_back({idx[0], idx[k], idx[k + 1]});
-      }
-      offset += fv;
-    }
-  }
-  if (mesh.triangles.empty()) {
-    fail("bad_mesh", json_path, "mesh file \"" + file + "\" contains no triangles");
-  }
-  return mesh;
+  return reader.finish();
 }
 
 MeshOccluder load_obj_mesh(const fs::path& assets_dir, const std::string& file,
                            const MeshTransform& xf, const MeshLoadLimits& limits,
                            const std::string& json_path) {
-  const fs::path full = resolve_asset_path(assets_dir, file, json_path);
-  std::ifstream in(full, std::ios::binary);
-  if (!in) {
-    fail("file_not_found", json_path, "mesh file \"" + file + "\" could not be opened");
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) {
-    fail("file_not_found", json_path, "mesh file \"" + file + "\" could not be read");
-  }
-  return mesh_from_obj_text(text.str(), file, xf, limits, json_path);
+  const std::int64_t room = limits.max_triangles - limits.triangles_before;
+  const auto max_bytes = static_cast<std::uint64_t>(
+      std::min(kI64Max - static_cast<std::int64_t>(kObjBaseBytes),
+               saturating_mul(static_cast<std::int64_t>(kObjBytesPerTriangle), room)) +
+      static_cast<std::int64_t>(kObjBaseBytes));
+  AssetFile in(assets_dir, file, json_path, "mesh", max_bytes,
+               "max_mesh_triangles = " + std::to_string(limits.max_triangles) + " allows (" +
+                   std::to_string(kObjBytesPerTriangle) + " a triangle left + 1 MiB)");
+  ObjReader reader(file, xf, limits, json_path);
+  std::string line;
+  while (in.read_line(&line, kObjMaxLineBytes, "bad_mesh")) reader.line(line);
+  return reader.finish();
 }
 
 }  // namespace beamcast

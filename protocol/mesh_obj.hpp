@@ -1,6 +1,7 @@
-// Wavefront OBJ meshes as occluders: safe path resolution below an assets
-// directory, parsing with tinyobjloader, triangulation and the object-to-world
-// transform. Errors are ProtocolError with the JSON pointer given by the caller.
+// Wavefront OBJ meshes as occluders: a streaming reader that counts as it goes
+// (positions and faces; every other statement is ignored), triangulation and
+// the object-to-world transform. Errors are ProtocolError with the JSON pointer
+// given by the caller; messages about the file's contents name its line.
 #pragma once
 
 #include <array>
@@ -9,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "protocol/asset_files.hpp"
 #include "protocol/scene.hpp"
 
 namespace beamcast {
@@ -28,24 +30,31 @@ struct MeshLoadLimits {
   double max_abs_coordinate = 1e12;      // bound on every world-space vertex coordinate
 };
 
-// The file named `file` (as written in the scene) below `assets_dir`. Refuses
-// (code "forbidden_path") an empty assets_dir, absolute paths, ".." components
-// and paths that leave assets_dir through a symlink; "file_not_found" if it is
-// not a readable regular file. `json_path` is the pointer reported in errors;
-// `what` names the kind of file in messages ("mesh", "volume").
-std::filesystem::path resolve_asset_path(const std::filesystem::path& assets_dir,
-                                         const std::string& file, const std::string& json_path,
-                                         std::string_view what = "mesh");
+// Bytes an OBJ file may have per triangle the scene still has room for, plus
+// kObjBaseBytes: a face with normals and texture coordinates and its share of
+// the v/vn/vt lines take about 120, so 256 is twice that; the size is checked
+// before a byte is read.
+inline constexpr std::uint64_t kObjBytesPerTriangle = 256;
+inline constexpr std::uint64_t kObjBaseBytes = 1u << 20;
+// Longest line read (a face of a few thousand vertices).
+inline constexpr std::size_t kObjMaxLineBytes = 1u << 16;
 
-// Parses OBJ text (materials and "mtllib" are ignored), triangulates polygons,
-// transforms vertices to world space. Throws "bad_mesh" (parse error, index
-// out of range, no triangles, non-finite vertex), "limit_exceeded"
-// (max_mesh_triangles) or "out_of_range" (a world vertex beyond max_abs_coordinate).
+// Parses OBJ text ("v" and "f" lines; normals, texture coordinates, groups,
+// materials and "mtllib" are ignored), triangulates polygons (a quad along its
+// shorter diagonal, larger ones as a fan), transforms vertices to world space.
+// Throws, at the first line that breaks a rule, "bad_mesh" (a malformed or
+// non-finite number, an index that is 0, not an integer, or not one of the
+// vertices defined before it, a face of fewer than 3 vertices; no triangles at
+// all), "limit_exceeded" (max_mesh_triangles, or more than 3 vertices per
+// triangle it allows) or "out_of_range" (a world vertex beyond
+// max_abs_coordinate); messages name the file and line.
 MeshOccluder mesh_from_obj_text(const std::string& obj_text, const std::string& file,
                                 const MeshTransform& xf, const MeshLoadLimits& limits,
                                 const std::string& json_path);
 
-// resolve_asset_path + read + mesh_from_obj_text.
+// The same, streamed from the file below `assets_dir` (AssetFile's rules; at
+// most kObjBaseBytes + kObjBytesPerTriangle per triangle left, checked before
+// reading), stopping at the first limit crossed.
 MeshOccluder load_obj_mesh(const std::filesystem::path& assets_dir, const std::string& file,
                            const MeshTransform& xf, const MeshLoadLimits& limits,
                            const std::string& json_path);

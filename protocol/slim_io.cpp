@@ -1,11 +1,15 @@
 #include "protocol/slim_io.hpp"
 
+#include <algorithm>
 #include <bit>
+#include <cstdio>
+#include <limits>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
 
+#include "protocol/asset_files.hpp"
 #include "protocol/json_reader.hpp"
 #include "protocol/scene_readers.hpp"
 
@@ -84,9 +88,15 @@ void store(std::string& out, T v) {
   out.append(b, sizeof v);
 }
 
+std::string over_limit_message(const std::string& file, const std::string& count,
+                               SlimCount limit) {
+  return "SLIM file \"" + file + "\" has " + count + " spheres, over the " +
+         std::to_string(limit.left) + " the limit max_slim_spheres = " +
+         std::to_string(limit.limit) + " leaves for it";
+}
+
 std::vector<SlimSphere> parse_binary(const std::string& bytes, const std::string& file,
-                                     const std::string& path, std::int64_t max_spheres,
-                                     double max_abs) {
+                                     const std::string& path, SlimCount limit, double max_abs) {
   auto bad = [&](const std::string& why) {
     fail("bad_slim", path, "SLIM file \"" + file + "\" " + why);
   };
@@ -96,10 +106,8 @@ std::vector<SlimSphere> parse_binary(const std::string& bytes, const std::string
     bad("has version " + std::to_string(version) + "; this server reads version 1");
   }
   const auto count = load<std::uint32_t>(bytes.data() + 8);
-  if (static_cast<std::int64_t>(count) > max_spheres) {
-    fail("limit_exceeded", path,
-         "SLIM file \"" + file + "\" has " + std::to_string(count) +
-             " spheres, over the limit max_slim_spheres = " + std::to_string(max_spheres));
+  if (static_cast<std::int64_t>(count) > limit.left) {
+    fail("limit_exceeded", path, over_limit_message(file, std::to_string(count), limit));
   }
   const std::size_t want = kHeaderBytes + static_cast<std::size_t>(count) * kRecordBytes;
   if (bytes.size() != want) {
@@ -138,38 +146,67 @@ std::vector<SlimSphere> parse_binary(const std::string& bytes, const std::string
   return out;
 }
 
-}  // namespace
-
-std::vector<SlimSphere> parse_slim_spheres(const nlohmann::json& array, const std::string& path,
-                                           std::int64_t max_spheres, double max_abs_coordinate) {
-  const Node n{&array, path};
-  std::vector<SlimSphere> out;
-  for (const Node& s : json_read::read_array(n, max_spheres, "max_slim_spheres")) {
-    out.push_back(parse_sphere(s, max_abs_coordinate));
-  }
-  if (out.empty()) fail("invalid_value", path, "a SLIM surface needs at least one sphere");
-  return out;
-}
-
-std::vector<SlimSphere> parse_slim_file_bytes(const std::string& bytes, const std::string& file,
-                                              const std::string& json_path,
-                                              std::int64_t max_spheres,
-                                              double max_abs_coordinate) {
-  if (bytes.size() >= 4 && std::memcmp(bytes.data(), kMagic, 4) == 0) {
-    return parse_binary(bytes, file, json_path, max_spheres, max_abs_coordinate);
-  }
-  nlohmann::json j;
+// The JSON form read as a stream (nlohmann's callback parser): each element
+// of "spheres" is parsed into a SlimSphere when it closes and dropped from the
+// document, so what is kept is the spheres, not their JSON. `input` is a
+// string or a C stream.
+template <class Input>
+std::vector<SlimSphere> parse_json_model(Input&& input, const std::string& file,
+                                         const std::string& json_path, SlimCount count,
+                                         double max_abs) {
+  using json = nlohmann::json;
+  using Event = json::parse_event_t;
+  std::vector<SlimSphere> spheres;
+  bool in_spheres = false;  // inside the root's "spheres" array
+  std::string key;          // the root member being read
+  int values = 0;           // in the current sphere, or outside "spheres"
+  const auto too_many = [&](const std::string& where, int limit) {
+    fail("bad_slim", where, "has more than " + std::to_string(limit) + " JSON values");
+  };
+  // Depths (nlohmann's): the root object 0, its members 1, a sphere 2.
+  const json::parser_callback_t callback = [&](int depth, Event event, json& parsed) {
+    const bool opens = event == Event::object_start || event == Event::array_start;
+    if (depth == 1 && event == Event::key) {
+      key = parsed.get<std::string>();
+    } else if (depth == 1 && event == Event::array_start && key == "spheres") {
+      in_spheres = true;
+    } else if (depth == 1 && event == Event::array_end && in_spheres) {
+      in_spheres = false;
+    } else if (in_spheres && depth == 2 && (opens || event == Event::value)) {
+      if (static_cast<std::int64_t>(spheres.size()) >= count.left) {
+        fail("limit_exceeded", "/spheres",
+             over_limit_message(file, "more than " + std::to_string(count.left), count));
+      }
+      values = 0;
+    }
+    if (opens || event == Event::value) {
+      const bool sphere_part = in_spheres && depth >= 2;
+      const int limit = sphere_part ? kSlimMaxSphereValues : kSlimMaxOtherValues;
+      if (++values > limit) {
+        too_many(sphere_part ? "/spheres/" + std::to_string(spheres.size()) : "/", limit);
+      }
+    }
+    const bool sphere_done = in_spheres && depth == 2 &&
+                             (event == Event::object_end || event == Event::array_end ||
+                              event == Event::value);
+    if (!sphere_done) return true;
+    const std::string path = "/spheres/" + std::to_string(spheres.size());
+    spheres.push_back(parse_sphere(Node{&parsed, path}, max_abs));
+    values = 0;
+    return false;  // dropped from the document
+  };
   try {
-    j = nlohmann::json::parse(bytes);
-  } catch (const nlohmann::json::exception& e) {
-    fail("bad_slim", json_path,
-         "SLIM file \"" + file + "\" is neither the binary form (\"BSLM\") nor valid JSON: " +
-             e.what());
-  }
-  // Errors inside the file name the field inside it, after the scene's path.
-  try {
-    const Node root{&j, ""};
-    ObjectReader o(root, "a SLIM model");
+    json root;
+    try {
+      root = json::parse(std::forward<Input>(input), callback);
+    } catch (const json::exception& e) {
+      fail("bad_slim", json_path,
+           "SLIM file \"" + file +
+               "\" is neither the binary form (\"BSLM\") nor valid JSON: " + e.what());
+    }
+    // Errors inside the file name the field inside it, after the scene's path.
+    const Node n{&root, ""};
+    ObjectReader o(n, "a SLIM model");
     o.allow_only({"format", "version", "spheres"});
     if (auto f = o.optional("format")) {
       if (json_read::read_string(*f) != "beamcast-slim") {
@@ -180,13 +217,64 @@ std::vector<SlimSphere> parse_slim_file_bytes(const std::string& bytes, const st
       if (json_read::read_integer(*v) != 1) fail("invalid_value", v->path, "version must be 1");
     }
     const Node s = o.required("spheres");
-    return parse_slim_spheres(s.json(), s.path, max_spheres, max_abs_coordinate);
+    (void)json_read::read_array(s);  // an array (its elements were read above)
+    if (spheres.empty()) fail("invalid_value", s.path, "a SLIM surface needs at least one sphere");
   } catch (const ProtocolError& e) {
+    if (e.info().path == json_path) throw;  // already about the file as a whole
     const std::string code = e.info().code == "limit_exceeded" ? "limit_exceeded" : "bad_slim";
+    const std::string& m = e.info().message;
     fail(code, json_path,
-         "SLIM file \"" + file + "\" at " + (e.info().path.empty() ? "/" : e.info().path) + ": " +
-             e.info().message);
+         m.starts_with("SLIM file") ? m
+                                    : "SLIM file \"" + file + "\" at " +
+                                          (e.info().path.empty() ? "/" : e.info().path) + ": " + m);
   }
+  return spheres;
+}
+
+}  // namespace
+
+std::vector<SlimSphere> parse_slim_spheres(const nlohmann::json& array, const std::string& path,
+                                           SlimCount count, double max_abs_coordinate) {
+  const Node n{&array, path};
+  const std::vector<Node> items = json_read::read_array(n);
+  if (static_cast<std::int64_t>(items.size()) > count.left) {
+    fail("limit_exceeded", path,
+         "spheres has " + std::to_string(items.size()) + " entries, over the " +
+             std::to_string(count.left) + " the limit max_slim_spheres = " +
+             std::to_string(count.limit) + " leaves for them");
+  }
+  std::vector<SlimSphere> out;
+  for (const Node& s : items) out.push_back(parse_sphere(s, max_abs_coordinate));
+  if (out.empty()) fail("invalid_value", path, "a SLIM surface needs at least one sphere");
+  return out;
+}
+
+std::vector<SlimSphere> parse_slim_file_bytes(const std::string& bytes, const std::string& file,
+                                              const std::string& json_path, SlimCount count,
+                                              double max_abs_coordinate) {
+  if (bytes.size() >= 4 && std::memcmp(bytes.data(), kMagic, 4) == 0) {
+    return parse_binary(bytes, file, json_path, count, max_abs_coordinate);
+  }
+  return parse_json_model(bytes, file, json_path, count, max_abs_coordinate);
+}
+
+std::vector<SlimSphere> load_slim_file(const std::filesystem::path& assets_dir,
+                                       const std::string& file, const std::string& json_path,
+                                       SlimCount count, double max_abs_coordinate) {
+  const std::int64_t left = std::max<std::int64_t>(0, count.left);
+  const std::int64_t max_bytes =
+      left > (std::numeric_limits<std::int64_t>::max() - kSlimFileHeaderBytes) / kSlimMaxJsonBytesPerSphere
+          ? std::numeric_limits<std::int64_t>::max()
+          : kSlimFileHeaderBytes + kSlimMaxJsonBytesPerSphere * left;
+  AssetFile in(assets_dir, file, json_path, "SLIM", static_cast<std::uint64_t>(max_bytes),
+               "max_slim_spheres = " + std::to_string(count.limit) + " allows (" +
+                   std::to_string(left) + " spheres left, 1 KiB each)");
+  char magic[4] = {};
+  const bool binary = std::fread(magic, 1, 4, in.stream()) == 4 && std::memcmp(magic, kMagic, 4) == 0;
+  std::rewind(in.stream());
+  // The binary form's size is exact and checked against its header: read whole.
+  if (binary) return parse_binary(in.read_all(), file, json_path, count, max_abs_coordinate);
+  return parse_json_model(in.stream(), file, json_path, count, max_abs_coordinate);
 }
 
 nlohmann::json slim_to_json(const std::vector<SlimSphere>& spheres) {

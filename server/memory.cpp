@@ -2,12 +2,40 @@
 
 #include <malloc.h>
 
+#include <chrono>
+#include <memory>
 #include <string>
+
+#include <boost/asio/steady_timer.hpp>
 
 namespace beamcast {
 
 void release_large_message_memory(std::size_t message_bytes) {
   if (message_bytes >= kTrimAfterMessageBytes) malloc_trim(0);
+}
+
+std::size_t trim_free_heap(std::size_t threshold) {
+  const struct mallinfo2 info = mallinfo2();
+  if (info.fordblks > threshold) malloc_trim(0);
+  return info.fordblks;
+}
+
+namespace {
+
+// The pending wait holds the timer, as a session's handlers hold the session.
+void arm_trim(std::shared_ptr<boost::asio::steady_timer> timer, const std::atomic<bool>& stop) {
+  timer->expires_after(std::chrono::milliseconds(kTrimPeriodMs));
+  timer->async_wait([timer, &stop](const boost::system::error_code& ec) {
+    if (ec || stop.load()) return;
+    trim_free_heap();
+    arm_trim(timer, stop);
+  });
+}
+
+}  // namespace
+
+void start_heap_trimmer(boost::asio::io_context& io, const std::atomic<bool>& stop) {
+  arm_trim(std::make_shared<boost::asio::steady_timer>(io), stop);
 }
 
 void configure_allocator() {

@@ -2,11 +2,11 @@
 // over the WebSocket with the ordinary requests).
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "protocol/asset_files.hpp"
+#include "protocol/errors.hpp"
 #include "server/http_server.hpp"
 #include "server/preview_assets.hpp"
 #include "server/server_core.hpp"
@@ -25,17 +25,43 @@ HttpReply json_reply(const nlohmann::json& j, int status = 200) {
   return {status, "application/json", j.dump()};
 }
 
-// Example scenes: the *.json files of the assets directory (examples/).
+// Example scenes: the *.json files of the assets directory (examples/) that
+// the rules for scene files (resolve_asset_path) let a scene load: no link
+// out of the directory, no FIFO or device.
 std::vector<std::string> example_names(const std::filesystem::path& dir) {
   std::vector<std::string> names;
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
-    if (e.is_regular_file() && e.path().extension() == ".json") {
-      names.push_back(e.path().filename().string());
+    const std::string name = e.path().filename().string();
+    if (e.path().extension() != ".json") continue;
+    try {
+      resolve_asset_path(dir, name, "", "example");
+      names.push_back(name);
+    } catch (const ProtocolError&) {
+      // not servable: left out of the list
     }
   }
   std::sort(names.begin(), names.end());
   return names;
+}
+
+// One example's text, read under the same rules as a scene's files and at
+// most max_message_bytes (larger could not be sent back as a request).
+HttpReply example_reply(const ServerCore& core, std::string_view name) {
+  const std::string file(name);
+  if (!file.ends_with(".json") || file.find('/') != std::string::npos) {
+    return json_reply({{"error", "no such example: names are the *.json files of /api/scenes"}},
+                      404);
+  }
+  try {
+    AssetFile in(core.config.assets_dir, file, "", "example", core.config.max_message_bytes,
+                 "max_message_bytes allows");
+    return HttpReply{200, "application/json", in.read_all()};
+  } catch (const ProtocolError& e) {
+    const std::string& code = e.info().code;
+    const int status = code == "file_not_found" ? 404 : code == "limit_exceeded" ? 413 : 403;
+    return json_reply({{"error", e.info().message}, {"code", code}}, status);
+  }
 }
 
 }  // namespace
@@ -59,15 +85,7 @@ void register_preview_routes(HttpServer& http, ServerCore& core) {
     return json_reply(stored->json);
   });
   http.add_get_prefix("/api/examples/", [&core](std::string_view name) {
-    // Only names listed by /api/scenes: no path can leave the directory.
-    const auto names = example_names(core.config.assets_dir);
-    if (std::find(names.begin(), names.end(), name) == names.end()) {
-      return json_reply({{"error", "no such example"}}, 404);
-    }
-    std::ifstream in(core.config.assets_dir / std::string(name), std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return HttpReply{200, "application/json", text.str()};
+    return example_reply(core, name);
   });
 }
 

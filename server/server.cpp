@@ -71,6 +71,7 @@ unsigned short Server::start() {
   acceptor_.bind(ep);
   acceptor_.listen(asio::socket_base::max_listen_connections);
   do_accept();
+  start_heap_trimmer(io_, core_.shutting_down);
   if (c.http_port >= 0) {
     http_port_ = http_->start(c.bind, static_cast<unsigned short>(c.http_port));
   }

@@ -1,40 +1,15 @@
 #include "protocol/occluders/slim.hpp"
 
 #include <algorithm>
-#include <fstream>
-#include <iterator>
-#include <sstream>
 
-#include "protocol/mesh_obj.hpp"
+#include "protocol/check.hpp"
 #include "protocol/scene.hpp"
 #include "protocol/occluders/occluder_parse.hpp"
 #include "protocol/slim_io.hpp"
 
 namespace beamcast {
 
-namespace {
-
 using namespace json_read;
-
-// The bytes of a model file below the assets directory, at most `max_bytes`.
-std::string read_model_file(const SceneLoadOptions& opts, const std::string& name,
-                            const std::string& path, std::int64_t max_bytes) {
-  const std::filesystem::path file = resolve_asset_path(opts.assets_dir, name, path);
-  std::ifstream in(file, std::ios::binary);
-  if (!in) fail("file_not_found", path, "SLIM file \"" + name + "\" cannot be read");
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(file, ec);
-  if (ec || static_cast<std::int64_t>(size) > max_bytes) {
-    fail("limit_exceeded", path,
-         "SLIM file \"" + name + "\" is larger than max_slim_spheres allows (" +
-             std::to_string(max_bytes) + " bytes)");
-  }
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-}  // namespace
 
 SlimSurface::SlimSurface(std::vector<SlimSphere> s)
     : spheres(std::move(s)), box(slim_bounds(spheres)), field(&spheres) {}
@@ -56,7 +31,7 @@ SlimOccluder SlimOccluder::from_spheres(std::vector<SlimSphere> spheres) {
 SlimOccluder SlimOccluder::parse(const OccluderParse& in) {
   in.allow({"spheres", "file", "translate", "scale", "rotation"});
   const SceneLimits& limits = in.limits();
-  const std::int64_t left = limits.max_slim_spheres - *in.slim_spheres;
+  const SlimCount count{limits.max_slim_spheres - *in.slim_spheres, limits.max_slim_spheres};
   const auto inline_spheres = in.fields.optional("spheres");
   const auto file = in.fields.optional("file");
   if (inline_spheres.has_value() == file.has_value()) {
@@ -67,21 +42,16 @@ SlimOccluder SlimOccluder::parse(const OccluderParse& in) {
   std::vector<SlimSphere> spheres;
   std::string name;
   if (inline_spheres) {
-    spheres = parse_slim_spheres(inline_spheres->json(), inline_spheres->path, left,
+    spheres = parse_slim_spheres(inline_spheres->json(), inline_spheres->path, count,
                                  limits.max_abs_coordinate);
   } else {
     name = read_string(*file);
     if (name.empty()) fail("invalid_value", file->path, "file must be a non-empty relative path");
-    // JSON takes more than the binary form's 84 bytes a sphere; 1 KiB each
-    // bounds what a file may make the server read.
-    const std::string bytes = read_model_file(in.opts, name, file->path, 16 + 1024 * left);
-    spheres = parse_slim_file_bytes(bytes, name, file->path, left, limits.max_abs_coordinate);
+    spheres = load_slim_file(in.opts.assets_dir, name, file->path, count,
+                             limits.max_abs_coordinate);
   }
-  if (static_cast<std::int64_t>(spheres.size()) > left) {
-    fail("limit_exceeded", (inline_spheres ? *inline_spheres : *file).path,
-         "the scene's SLIM surfaces exceed the limit max_slim_spheres = " +
-             std::to_string(limits.max_slim_spheres));
-  }
+  BEAMCAST_CHECK(static_cast<std::int64_t>(spheres.size()) <= count.left,
+                 "the SLIM readers stop at the spheres left");
   *in.slim_spheres += static_cast<std::int64_t>(spheres.size());
 
   Vec3 translate{0.0, 0.0, 0.0};

@@ -19,7 +19,7 @@ class LocalServer {
  public:
   explicit LocalServer(ServerConfig c = {}, RendererFactory renderers = gl_renderer_factory({})) {
     c.port = 0;
-    c.assets_dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
+    if (c.assets_dir.empty()) c.assets_dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
     server_ = std::make_unique<Server>(c, std::move(renderers));
     port_ = server_->start();
     thread_ = std::thread([this] { server_->run(false); });

@@ -10,8 +10,8 @@ namespace beamcast {
 namespace {
 
 TEST(FuzzRegressions, ObjVertexWeightLinesAreIgnored) {
-  // fuzz_obj: tinyobjloader converted a huge "vw" joint id to int (UB). Such
-  // lines are blanked before parsing; the mesh itself is unaffected.
+  // fuzz_obj: tinyobjloader (the earlier reader) converted a huge "vw" joint
+  // id to int (UB). The reader skips such lines unread; the mesh is unaffected.
   const std::string obj =
       "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
       "vw 1 18888888888888888888888 0.45 0 0.45\n"
@@ -24,13 +24,14 @@ TEST(FuzzRegressions, ObjVertexWeightLinesAreIgnored) {
 }
 
 TEST(FuzzRegressions, ObjErrorLineNumbersSurviveTheFilter) {
-  // Blanked lines stay as empty lines, so a later error still names its line.
+  // Skipped lines still count, so a later error names its line.
   const std::string obj = "v 0 0 0\nvw 1 2 3\nv 1 0 0\nf 1 2 7\n";
   try {
     mesh_from_obj_text(obj, "w.obj", {}, {}, "/occluders/0/file");
     FAIL() << "index 7 of 2 vertices must be refused";
   } catch (const ProtocolError& e) {
     EXPECT_EQ(e.info().code, "bad_mesh");
+    EXPECT_NE(e.info().message.find("line 4"), std::string::npos) << e.info().message;
   }
 }
 

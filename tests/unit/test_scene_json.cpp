@@ -306,7 +306,8 @@ TEST(SceneJsonMesh, ForbiddenSymlinkOutOfAssets) {
 
 TEST(SceneJsonMesh, FileNotFound) {
   EXPECT_REJECTED(mesh_scene("missing.obj"), data_opts(), "file_not_found", "/occluders/0/file");
-  EXPECT_REJECTED(mesh_scene("."), data_opts(), "file_not_found", "/occluders/0/file");
+  // A directory is there but is not a regular file.
+  EXPECT_REJECTED(mesh_scene("."), data_opts(), "forbidden_path", "/occluders/0/file");
 }
 
 TEST(SceneJsonMesh, BadMesh) {

@@ -368,7 +368,7 @@ TEST(SlimFit, ErrorsAreAtSizeTenAndSpheresInTheMeshsUnits) {
   std::ifstream in(dir / "t.json");
   std::stringstream text;
   text << in.rdbuf();
-  EXPECT_EQ(parse_slim_file_bytes(text.str(), "t.json", "", 1 << 20, 1e12).size(),
+  EXPECT_EQ(parse_slim_file_bytes(text.str(), "t.json", "", {1 << 20, 1 << 20}, 1e12).size(),
             fa.fit.spheres.size());
   fs::remove_all(dir);
 }
