@@ -1,5 +1,5 @@
 // Triangle meshes read for the SLIM fitter (issue 16): OFF, OBJ (through
-// protocol/mesh_obj, i.e. tinyobjloader) and PLY (ascii and
+// protocol/mesh_obj's streaming reader) and PLY (ascii and
 // binary_little_endian). Polygons are triangulated as fans. Errors are
 // std::runtime_error naming the file and the line (text) or the element
 // (binary) that is wrong.
