@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   cmake ninja-build g++ pkg-config
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri   # EGL + OpenGL (llvmpipe without a GPU)
-  libglm-dev nlohmann-json3-dev libpng-dev libtinyobjloader-dev libcli11-dev
+  libglm-dev nlohmann-json3-dev libpng-dev libcli11-dev
   libturbojpeg0-dev                                   # JPEG frames of the interactive preview
   zlib1g-dev                                          # gzip-compressed volume files (NRRD, .inr.gz)
   libembree-dev                                       # photon tracing and the path-traced reference (gi/)
