@@ -6,7 +6,6 @@
 #include <GL/glcorearb.h>
 #include <gtest/gtest.h>
 
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,21 +18,16 @@
 #include "render/gl_validate.hpp"
 #include "render/renderer.hpp"
 #include "render/scene_resources.hpp"
+#include "tests/common/examples.hpp"
 
 namespace beamcast {
 namespace {
 
-namespace fs = std::filesystem;
+// One triangle over the whole viewport (the draws of these tests).
+const char* const kCoverVert = R"(#version 450 core
+void main() { gl_Position = vec4(vec2(gl_VertexID & 1, gl_VertexID >> 1) * 4.0 - 1.0, 0.0, 1.0); }
+)";
 
-Scene small_example(const std::string& name, int size) {
-  const fs::path dir = fs::path(BEAMCAST_SOURCE_DIR) / "examples";
-  SceneLoadOptions opts;
-  opts.assets_dir = dir;
-  Scene scene = load_scene_file(dir / (name + ".json"), opts);
-  scene.cameras.resize(1);
-  scene.cameras[0].width = scene.cameras[0].height = size;
-  return scene;
-}
 
 std::vector<std::uint16_t> frame(Renderer& r, const Scene& scene) {
   return r.render(scene).at(0).image.rgb;
@@ -129,16 +123,13 @@ TEST(ShadowCubes, FilteringAcrossAFaceSeamUsesTheNeighbouringFace) {
   glCreateFramebuffers(1, &id);
   GlFramebuffer fbo(id);
   glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, result.get(), 0);
-  const std::string vert = R"(#version 450 core
-void main() { gl_Position = vec4(vec2(gl_VertexID & 1, gl_VertexID >> 1) * 4.0 - 1.0, 0.0, 1.0); }
-)";
   const std::string frag = R"(#version 450 core
 layout(binding = 0) uniform samplerCubeArrayShadow u_cubes;
 uniform vec3 u_dir;
 layout(location = 0) out float o;
 void main() { o = texture(u_cubes, vec4(u_dir, 0.0), 0.5); }
 )";
-  GlProgram program = build_program("cube_seam_test", vert, frag);
+  GlProgram program = build_program("cube_seam_test", kCoverVert, frag);
   GLuint vao = 0;
   glCreateVertexArrays(1, &vao);
   GlVertexArray empty(vao);
@@ -179,15 +170,12 @@ class Validation : public ::testing::Test {
     glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, target_.get(), 0);
     glCreateVertexArrays(1, &id);
     vao_ = GlVertexArray(id);
-    const std::string vert = R"(#version 450 core
-void main() { gl_Position = vec4(vec2(gl_VertexID & 1, gl_VertexID >> 1) * 4.0 - 1.0, 0.0, 1.0); }
-)";
-    const std::string frag = R"(#version 450 core
+      const std::string frag = R"(#version 450 core
 layout(binding = 3) uniform sampler2D u_input;
 layout(location = 0) out float o;
 void main() { o = texture(u_input, vec2(0.5)).r; }
 )";
-    program_ = build_program("validation_test", vert, frag);
+    program_ = build_program("validation_test", kCoverVert, frag);
     glUseProgram(program_.get());
     glBindVertexArray(vao_.get());
     glViewport(0, 0, 4, 4);
@@ -270,15 +258,12 @@ TEST_F(Validation, AnIncompleteFramebufferNamesPassAndStatus) {
 }
 
 TEST_F(Validation, AShadowSamplerNeedsDepthComparison) {
-  const std::string vert = R"(#version 450 core
-void main() { gl_Position = vec4(vec2(gl_VertexID & 1, gl_VertexID >> 1) * 4.0 - 1.0, 0.0, 1.0); }
-)";
   const std::string frag = R"(#version 450 core
 layout(binding = 5) uniform sampler2DShadow u_depth;
 layout(location = 0) out float o;
 void main() { o = texture(u_depth, vec3(0.5, 0.5, 0.5)); }
 )";
-  GlProgram shadow = build_program("shadow_validation_test", vert, frag);
+  GlProgram shadow = build_program("shadow_validation_test", kCoverVert, frag);
   glUseProgram(shadow.get());
   GLuint id = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &id);

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "protocol/scene_json.hpp"
+#include "tests/common/examples.hpp"
 #include "render/image.hpp"
 #include "render/reference.hpp"
 #include "render/renderer.hpp"
@@ -18,15 +19,7 @@ Renderer& renderer() {
   return r;
 }
 
-Scene example(const std::string& name, int size) {
-  const auto dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
-  SceneLoadOptions opts;
-  opts.assets_dir = dir;
-  Scene s = load_scene_file(dir / (name + ".json"), opts);
-  s.cameras.resize(1);
-  s.cameras[0].width = s.cameras[0].height = size;
-  return s;
-}
+Scene example(const std::string& name, int size) { return small_example(name, size); }
 
 double rel_l1(Scene scene, const RenderSettings& settings) {
   const HdrImage ref = render_reference(scene, scene.cameras[0]);
