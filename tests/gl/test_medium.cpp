@@ -276,12 +276,22 @@ TEST(Medium, EmittingBeamsLightTheFogAroundThem) {
 
 // examples/ground_fog.json (the seed's fig 5.9: a dense layer of fog on the
 // floor of the stage) against the path tracer, as the stage above: the
-// image's mean within 5% (measured 0.6% at 128x128, docs/media.md).
+// image's mean within 5% (measured 0.6% at 128x128, docs/media.md). At
+// 48x48 one photon map's mean varies by about 2% from seed to seed (0.631
+// to 0.662 over four gi.seed values, 2026-11-27) and the 1024-spp reference
+// by about 1.5%: the frame is the mean of four photon seeds (about 1.1%),
+// so the bound is some 2.7 standard deviations of their difference. One map
+// alone left 2 sigma: it passed or failed with the photon tracer's random
+// stream (0.984 before the exact free paths of issue 43, 0.947 after).
 TEST(Medium, TheGroundFogMatchesThePathTracer) {
-  const Scene scene = example_at("ground_fog.json", 48);
+  Scene scene = example_at("ground_fog.json", 48);
   const double want = image_mean(path_traced(scene));
-  const double got =
-      image_mean(renderer().render(scene, FrameOptions{.read_hdr = true})[0].hdr);
+  double got = 0.0;
+  constexpr int kSeeds = 4;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    scene.gi.seed = static_cast<std::uint64_t>(seed);
+    got += image_mean(renderer().render(scene, FrameOptions{.read_hdr = true})[0].hdr) / kSeeds;
+  }
   std::printf("ground fog: mean ratio %.4f\n", got / want);
   EXPECT_NEAR(got / want, 1.0, 0.05);
 }
