@@ -29,6 +29,12 @@ class GlDebugFailures : public ::testing::EmptyTestEventListener {
       seen_.push_back(format_gl_debug_message(m));
     });
   }
+  // gtest deletes its listeners at exit, perhaps before static renderers
+  // free their GL objects: the sink must not outlive this object.
+  ~GlDebugFailures() override { set_gl_debug_sink({}); }
+  GlDebugFailures(const GlDebugFailures&) = delete;
+  GlDebugFailures& operator=(const GlDebugFailures&) = delete;
+
   void OnTestEnd(const ::testing::TestInfo& /*info*/) override {
     std::vector<std::string> seen;
     {
