@@ -155,9 +155,14 @@ void expect_quick_bounded_refusal(const Refusal& r, const std::string& words) {
   EXPECT_EQ(r.reply["error"]["path"], "/params/scene/occluders/0/file") << r.reply;
   EXPECT_NE(r.reply["error"]["message"].get<std::string>().find(words), std::string::npos)
       << r.reply;
+#if !defined(__SANITIZE_ADDRESS__)
+  // Not in the Debug + sanitizer build: its JSON parsing runs some 10x
+  // slower (the SLIM refusal took 948 ms there, about what the old reader
+  // took in the optimized build), so time tells nothing; and ASan's
+  // quarantine keeps freed blocks resident. What it checks there: the
+  // refusal, its code, path and message, and no memory error.
   EXPECT_LT(r.ms, kMaxMs);
   EXPECT_LT(r.ping_ms, kMaxMs);
-#if !defined(__SANITIZE_ADDRESS__)  // ASan's quarantine keeps freed blocks resident
   EXPECT_LT(r.peak_mib, kMaxPeakMib);
 #endif
   std::printf("refused in %.1f ms, ping beside it %.1f ms, peak +%.1f MiB\n", r.ms, r.ping_ms,
