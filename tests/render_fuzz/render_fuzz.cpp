@@ -234,6 +234,7 @@ std::string judge_reply(const json& request, const test::Reply& r, bool stored, 
 struct CaseResult {
   std::string outcome;
   std::string error_path;  // of an error outcome
+  std::vector<std::pair<std::string, std::string>> each;  // every request's outcome and error path
   std::vector<std::string> findings;
   double ms = 0.0;
 };
@@ -287,6 +288,8 @@ class Runner {
       const double ms = std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
       if (!why.empty()) out.findings.push_back(req.value("method", "") + ": " + why);
       const bool ok = reply.json.value("ok", false);
+      out.each.emplace_back(ok ? "ok" : reply.json["error"].value("code", "?"),
+                            ok ? "" : reply.json["error"].value("path", ""));
       if (req.value("method", "") == "scene.put" && ok) stored.push_back(req["params"]["scene_id"]);
       if (k + 1 == requests.size()) {
         out.outcome = ok ? "ok" : reply.json["error"].value("code", "?");
@@ -345,17 +348,30 @@ int replay(Runner& runner, const Options& o) {
     const json doc = json::parse(in);
     const std::vector<json> requests = doc.at("requests").get<std::vector<json>>();
     CaseResult r = runner.run(file, requests);
-    const json expect = doc.value("expect", json::object());
-    if (expect.contains("code")) {
-      if (r.outcome != expect["code"]) r.findings.push_back("expected " + expect["code"].dump() + ", got " + r.outcome);
-    } else if (expect.value("ok", false) && r.outcome != "ok") {
-      r.findings.push_back("expected frames, got " + r.outcome);
+    // "expect": {"code": C, "path": P} or {"ok": true} for the last request,
+    // or an array of them, one per request.
+    json expect = doc.value("expect", json::object());
+    if (!expect.is_array()) {
+      json each = json::array();
+      for (std::size_t k = 0; k + 1 < requests.size(); ++k) each.push_back(json::object());
+      each.push_back(expect);
+      expect = each;
+    }
+    for (std::size_t k = 0; k < expect.size() && k < r.each.size(); ++k) {
+      const json& e = expect[k];
+      const auto& [got, path] = r.each[k];
+      const std::string want = e.value("ok", false) ? "ok" : e.value("code", got);
+      if (got != want || (e.contains("path") && path != e["path"])) {
+        r.findings.push_back("request " + std::to_string(k) + ": expected " + e.dump() + ", got " + got +
+                             (path.empty() ? "" : " at " + path));
+      }
     }
     if (!r.findings.empty()) {
       report(file, requests, r, o.artifacts);
       ++failed;
     } else {
-      std::cout << "ok " << file << " (" << r.outcome << ", " << static_cast<int>(r.ms) << " ms)\n";
+      std::cout << "ok " << file << " (" << r.outcome << (r.error_path.empty() ? "" : " at " + r.error_path)
+                << ", " << static_cast<int>(r.ms) << " ms)\n";
     }
   }
   const std::string dead = runner.alive();
