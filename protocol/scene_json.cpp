@@ -138,6 +138,19 @@ Density parse_density(const Node& n, const SceneLimits& limits) {
   return d;
 }
 
+// A colour times a factor (intensity, a density's peak) at most
+// kMaxRadiometric per channel, or out_of_range at `path`.
+void check_radiometric_product(double factor, const Color& color, const std::string& path,
+                               const char* what) {
+  for (const double c : color) {
+    if (!(c * factor <= kMaxRadiometric)) {
+      fail("out_of_range", path,
+           std::string(what) + " must be at most " + format_number(kMaxRadiometric) +
+               " per channel (the GPU adds light in float), got " + format_number(c * factor));
+    }
+  }
+}
+
 // The fields every beam has; the kind's own (protocol/beams/) come after
 // "type" in the allowed list and are read by its parse function.
 constexpr std::array<std::string_view, 5> kBeamFields{"radius", "color", "intensity", "density",
@@ -151,11 +164,13 @@ Beam parse_beam(const Node& n, const SceneLimits& limits) {
     o.allow_only(kind_keys<Kind>(kBeamFields));
     b.radius = read_size(o.required("radius"), limits);
     if (auto c = o.optional("color")) b.color = read_color(*c);
-    if (auto i = o.optional("intensity")) b.intensity = check_non_negative(*i, read_number(*i));
+    if (auto i = o.optional("intensity")) b.intensity = read_radiometric(*i);
     if (auto d = o.optional("density")) b.density = parse_density(*d, limits);
     if (auto e = o.optional("emit")) b.emit = read_bool(*e);
     return Kind::parse(BeamParse{o, limits, b.radius});
   });
+  check_radiometric_product(b.intensity * b.density.max_value(), b.color, o.path(),
+                            "color x intensity x the density's peak");
   return b;
 }
 
@@ -228,7 +243,7 @@ constexpr std::array<std::string_view, 2> kLightFields{"color", "power"};
 // The most flux per channel a light may have, and the most radiance a quad
 // light may have: photon powers, radiances and their products with the
 // scene's factors stay finite in the GPU's floats (3.4e38; issue 43).
-constexpr double kMaxLightValue = 1e30;
+constexpr double kMaxLightValue = kMaxRadiometric;
 
 void check_light_values(const Light& l, const std::string& path) {
   const double flux = std::max({l.flux[0], l.flux[1], l.flux[2]});
@@ -419,8 +434,9 @@ DirectionalLight parse_light(const Node& n) {
   DirectionalLight l;
   if (auto d = o.optional("direction")) l.direction = read_direction(*d);
   if (auto c = o.optional("color")) l.color = read_color(*c);
-  if (auto i = o.optional("intensity")) l.intensity = check_non_negative(*i, read_number(*i));
+  if (auto i = o.optional("intensity")) l.intensity = read_radiometric(*i);
   if (auto a = o.optional("ambient")) l.ambient = check_closed(*a, read_number(*a), 0.0, 1.0);
+  check_radiometric_product(l.intensity, l.color, n.path, "color x intensity");
   return l;
 }
 
@@ -495,7 +511,8 @@ RenderSettings parse_render(const Node& n, const SceneLimits& limits) {
       r.table_d = r.table_s = read_int_limited(*t, limits.min_table, limits.max_table, "max_table");
     }
   }
-  if (auto f = o.optional("f_table")) r.f_table = read_int_in(*f, 16, 65536);
+  // 4096: what the renderer's table (render/lut.cpp) and its 1D texture take.
+  if (auto f = o.optional("f_table")) r.f_table = read_int_in(*f, 16, 4096);
   return r;
 }
 

@@ -42,10 +42,12 @@ Vec3 read_direction(const Node& n) {
   return v;
 }
 
+double read_radiometric(const Node& n) { return check_closed(n, read_number(n), 0.0, kMaxRadiometric); }
+
 Color read_color(const Node& n) {
   Color c = read_vec3(n);
   for (std::size_t i = 0; i < 3; ++i)
-    check_non_negative(Node{&n.json()[i], child_path(n.path, i)}, c[i]);
+    check_closed(Node{&n.json()[i], child_path(n.path, i)}, c[i], 0.0, kMaxRadiometric);
   return c;
 }
 

@@ -23,7 +23,14 @@ double read_size(const Node& n, const SceneLimits& limits);
 bool normalizable(const Vec3& v);
 // A direction: finite, not the zero vector (need not be unit).
 Vec3 read_direction(const Node& n);
-// Non-negative components.
+// The largest radiometric number a scene may give (a colour channel, an
+// intensity) and the largest product of them (with a density's peak) a
+// pixel may gain from one element: the GPU adds light in float (3.4e38), and a
+// background of 1e39 was an infinite pixel (render fuzzer, issue 43).
+inline constexpr double kMaxRadiometric = 1e30;
+// A radiometric number: in [0, kMaxRadiometric].
+double read_radiometric(const Node& n);
+// Components in [0, kMaxRadiometric].
 Color read_color(const Node& n);
 // Components in [0, 1].
 Color read_albedo(const Node& n);

@@ -163,7 +163,7 @@ TransferFunction read_transfer(const Node& n, const SceneLimits& limits, double 
       const Node value = at(0);
       tp.value = check_closed(value, read_number(value), 0.0, 1.0);
       for (std::size_t c = 0; c < 3; ++c) {
-        tp.color[c] = check_non_negative(at(c + 1), read_number(at(c + 1)));
+        tp.color[c] = read_radiometric(at(c + 1));
       }
       tp.opacity = check_closed(at(4), read_number(at(4)), 0.0, 1.0);
       if (i > 0 && !(tp.value > tf.points.back().value)) {
