@@ -167,6 +167,13 @@ std::shared_ptr<const PhotonMaps> PhotonCache::get(const Scene& scene, bool* tra
   return maps;
 }
 
+void PhotonCache::shrink_to(std::size_t max_bytes) {
+  while (bytes_ > max_bytes && !entries_.empty()) {
+    bytes_ -= entries_.back().bytes;
+    entries_.pop_back();
+  }
+}
+
 std::shared_ptr<const PhotonGather> PhotonCache::gather(
     const std::shared_ptr<const PhotonMaps>& maps, bool skip_direct) {
   for (Entry& e : entries_) {

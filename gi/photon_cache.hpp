@@ -39,6 +39,9 @@ class PhotonCache {
   // nothing again.
   std::shared_ptr<const SplatDiskSet> disks(const std::shared_ptr<const PhotonMaps>& maps,
                                             const SplatDiskOptions& options);
+  // Evicts the least recently used maps until at most `max_bytes` are held
+  // (the server calls it once its renderer is idle: server/memory.hpp).
+  void shrink_to(std::size_t max_bytes);
   std::size_t bytes() const { return bytes_; }
   std::size_t entries() const { return entries_.size(); }
 

@@ -889,6 +889,22 @@ SlimSettings parse_slim_settings(const Node& n) {
   return s;
 }
 
+bool scene_reads_files(const json& j) {
+  if (!j.is_object()) return false;
+  const auto names_file = [](const json& o) { return o.is_object() && o.contains("file"); };
+  for (const auto& [key, list] : j.items()) {
+    if (!list.is_array()) continue;
+    for (const json& entry : list) {
+      if (!entry.is_object()) continue;
+      if (names_file(entry)) return true;
+      for (const auto& [member, value] : entry.items()) {
+        if (names_file(value)) return true;
+      }
+    }
+  }
+  return false;
+}
+
 Scene parse_scene(const json& j, const SceneLoadOptions& opts) {
   const SceneLimits& limits = opts.limits;
   const Node root{&j, ""};

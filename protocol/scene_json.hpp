@@ -74,6 +74,12 @@ struct SceneLoadOptions {
 
 // Throws ProtocolError.
 Scene parse_scene(const nlohmann::json& j, const SceneLoadOptions& opts);
+// Whether parse_scene(j) may read files below the assets directory: some
+// object of the scene's arrays (occluders, media, volumes), or one of their
+// members (a volume's source), has a "file" key. Looks no deeper, so it costs
+// the arrays' lengths, not the scene's size (the server parses such scenes
+// off its network threads).
+bool scene_reads_files(const nlohmann::json& j);
 // One camera object (used by requests that send only camera poses); `path` is
 // the JSON pointer of `j` for error messages.
 Camera parse_camera(const nlohmann::json& j, const std::string& path, const SceneLimits& limits);

@@ -452,6 +452,21 @@ const std::string& Renderer::description() const { return impl_->context->descri
 
 void Renderer::fail_next_render_for_test() { impl_->fail_next = true; }
 
+void Renderer::release_idle_memory(std::size_t keep_photon_bytes) {
+  Impl& m = *impl_;
+  const EglContext::Current current(*m.context);
+  m.photons.shrink_to(keep_photon_bytes);
+  m.volumes.drop_unused();
+  m.targets = FrameTargets();
+  m.layered = FrameTargets();
+  for (std::size_t i = 0; i < m.pbos.size(); ++i) {
+    m.pbos[i] = GlBuffer();
+    m.pbo_bytes[i] = 0;
+  }
+  glFinish();  // the driver frees deleted objects once no command uses them
+  gl_check("release_idle_memory");
+}
+
 std::vector<FrameResult> Renderer::render(const Scene& scene, const FrameOptions& opts) {
   return render(scene, scene.cameras, opts);
 }

@@ -145,6 +145,12 @@ class Renderer {
   // invalid GL call after uploading its scene and throws the GlError that
   // gl_check reports, as a driver fault mid-frame would.
   void fail_next_render_for_test();
+  // Gives back what the renderer keeps for the next frame beyond
+  // `keep_photon_bytes` of photon maps (least recently used first): the
+  // other photon maps, textures of volumes whose scene is gone, the frame
+  // targets and read-back buffers. The next render re-creates what it needs.
+  // For a server whose renderer has gone idle (RenderService).
+  void release_idle_memory(std::size_t keep_photon_bytes);
 
  private:
   // render() without output.supersample.

@@ -244,6 +244,10 @@ std::shared_ptr<const VolumeTextures> VolumeTextureCache::get(const Volume& volu
   return entries_.front().textures;
 }
 
+void VolumeTextureCache::drop_unused() {
+  entries_.remove_if([](const Entry& e) { return e.grid.expired(); });
+}
+
 VolumeResources::VolumeResources(const Scene& scene, VolumeTextureCache* cache) {
   for (const Volume& vol : scene.volumes) {
     Uploaded u;

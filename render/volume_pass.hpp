@@ -63,6 +63,9 @@ class VolumeTextureCache {
   // `step` (GL_RGBA32F, 2D, linear), kept for the last few (transfer
   // function, intensity, step): the preview's levels each have their own step.
   std::shared_ptr<const GlTexture> preintegration(const Volume& volume, double step);
+  // Frees the textures of volumes whose scene is gone (get() would only
+  // drop them at its next call); with the context current.
+  void drop_unused();
 
  private:
   struct Entry {

@@ -212,8 +212,24 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
       const std::string text = beast::buffers_to_string(buffer_.data());
       buffer_.consume(buffer_.size());
       buffer_.shrink_to_fit();
-      handle_message(core_, shared_from_this(), text, std::chrono::steady_clock::now());
+      // A scene that reads files is handled on a loader thread (as on TCP):
+      // the next message is read once it has been.
+      auto held = std::make_shared<MemoryBudget::Reservation>(std::move(reserved));
+      auto resume = [self = shared_from_this(), held, bytes] {
+        asio::post(self->ws_.get_executor(), [self, held, bytes] {
+          held->release();
+          self->message_handled(bytes);
+        });
+      };
+      if (!handle_message(core_, shared_from_this(), text, std::chrono::steady_clock::now(),
+                          std::move(resume))) {
+        return;
+      }
     }
+    message_handled(bytes);
+  }
+
+  void message_handled(std::size_t bytes) {
     buffer_.consume(buffer_.size());
     release_large_message_memory(bytes);
     do_read();

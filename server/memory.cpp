@@ -1,14 +1,26 @@
 #include "server/memory.hpp"
 
 #include <malloc.h>
+#include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <memory>
 #include <string>
 
 #include <boost/asio/steady_timer.hpp>
 
 namespace beamcast {
+
+std::uint64_t resident_bytes() {
+  std::FILE* f = std::fopen("/proc/self/statm", "r");
+  if (!f) return 0;
+  unsigned long long pages = 0, resident = 0;
+  const int n = std::fscanf(f, "%llu %llu", &pages, &resident);
+  std::fclose(f);
+  if (n != 2) return 0;
+  return resident * static_cast<std::uint64_t>(sysconf(_SC_PAGESIZE));
+}
 
 void release_large_message_memory(std::size_t message_bytes) {
   if (message_bytes >= kTrimAfterMessageBytes) malloc_trim(0);

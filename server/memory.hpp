@@ -55,6 +55,32 @@ std::size_t trim_free_heap(std::size_t threshold = kTrimWhenFreeBytes);
 // `io` stops.
 void start_heap_trimmer(boost::asio::io_context& io, const std::atomic<bool>& stop);
 
+// Caches that outlive a render (each renderer's photon maps, volume textures,
+// frame targets) hold hundreds of MiB after a large request: fog maps of
+// 6 M events are 330 MB, and one renderer may keep 256 MiB of maps. A render
+// worker that has rendered nothing for kIdleReleaseMs gives them back
+// (FrameRenderer::release_idle_memory), keeping kIdlePhotonCacheBytes of the
+// most recently used photon maps, so a preview of a lit scene that pauses
+// does not trace again; then it trims the heap. Repeated renders never wait
+// that long between slices, so they keep every cache
+// (docs/performance.md, "Memory after large requests").
+inline constexpr int kIdleReleaseMs = 2000;
+inline constexpr std::size_t kIdlePhotonCacheBytes = 16u << 20;
+// What the caches do not hold, llvmpipe may: after fog renders of millions of
+// volume photons (drawn as quads) its context kept 150-220 MiB (heaptrack:
+// live blocks allocated by swrast_dri.so during the draws) that no GL delete
+// frees. So after the release, if the process is still more than
+// kRebuildWhenIdleAboveBytes above its leanest idle size (the lowest RSS
+// seen after an idle release, at most its size at start plus
+// kRebuildWhenIdleAboveBytes), the idle worker replaces its renderer with a
+// new one (a new GL context, ~0.1-0.3 s of CPU; the next render compiles its
+// shader variants again). Between small renders RSS stays under it (a
+// small render of each kind adds up to 45 MiB of shader variants and
+// tables over the server's size at start), so a normal session never pays it.
+inline constexpr std::uint64_t kRebuildWhenIdleAboveBytes = 48ull << 20;
+// The process's resident size (/proc/self/statm), 0 if unknown.
+std::uint64_t resident_bytes();
+
 // Sets the allocator up for a server that handles large messages (Server's
 // constructor calls it; process-wide): a fixed mmap threshold, see memory.cpp.
 void configure_allocator();

@@ -20,6 +20,7 @@
 #include "render/gl_util.hpp"
 #include "render/image.hpp"
 #include "render/jpeg.hpp"
+#include "server/memory.hpp"
 
 namespace beamcast {
 namespace {
@@ -56,6 +57,7 @@ class GlFrameRenderer final : public FrameRenderer {
     return renderer_.render(scene, cameras, options);
   }
   void fail_next_render_for_test() override { renderer_.fail_next_render_for_test(); }
+  void release_idle_memory() override { renderer_.release_idle_memory(kIdlePhotonCacheBytes); }
 
  private:
   Renderer renderer_;
@@ -169,6 +171,7 @@ RenderService::RenderService(RendererFactory factory, int workers, int encode_th
       png_level_(png_level),
       png_filters_(png_filters),
       max_inflight_(max_inflight),
+      idle_release_ms_(kIdleReleaseMs),
       encoders_(static_cast<std::size_t>(std::max(1, encode_threads))) {
   for (int i = 0; i < std::max(1, workers); ++i) {
     workers_.emplace_back([this, i] { worker_main(i); });
@@ -181,6 +184,9 @@ std::string RenderService::wait_ready() {
   std::unique_lock lock(mu_);
   ready_cv_.wait(lock, [&] { return ready_ == static_cast<int>(workers_.size()); });
   if (description_.empty()) throw std::runtime_error(failure_);
+  // The leanest idle size is at most the size now (every context made,
+  // nothing rendered) plus the rebuild margin (server/memory.hpp).
+  idle_rss_floor_.store(resident_bytes() + kRebuildWhenIdleAboveBytes);
   return description_;
 }
 
@@ -391,15 +397,27 @@ void RenderService::worker_main(int index) {
   }
   ready_cv_.notify_all();
 
+  bool released = true;  // nothing rendered since the last idle release
   for (;;) {
     TaskPtr task;
     std::size_t slice = 0;
     {
       std::unique_lock lock(mu_);
-      cv_.wait(lock, [&] { return stopping_ || has_work_locked(); });
+      const auto woken = [&] { return stopping_ || has_work_locked(); };
+      if (!released &&
+          !cv_.wait_for(lock, std::chrono::milliseconds(idle_release_ms_.load()), woken)) {
+        // Idle: the caches go (server/memory.hpp, kIdleReleaseMs), then
+        // the heap pages they held.
+        lock.unlock();
+        release_when_idle(renderer, index);
+        released = true;
+        continue;
+      }
+      cv_.wait(lock, woken);
       if (stopping_) return;  // stop() drops what is still queued
       std::tie(task, slice) = pick_locked(lock);
     }
+    released = false;
     if (!task) continue;
     // Between slices: a job whose clients have all gone costs no more GPU
     // time. Its remaining slices leave the queue; nothing is answered.
@@ -441,6 +459,38 @@ void RenderService::worker_main(int index) {
       }
     }
   }
+}
+
+void RenderService::release_when_idle(std::unique_ptr<FrameRenderer>& renderer, int index) {
+  bool rebuild = false;
+  try {
+    if (renderer) renderer->release_idle_memory();
+  } catch (const std::exception& e) {
+    // A GL error leaves the context in an unknown state: a new one.
+    std::fprintf(stderr, "beamcast-server: render worker %d: releasing memory failed: %s\n",
+                 index, e.what());
+    rebuild = true;
+  }
+  malloc_trim(0);
+  const std::uint64_t rss = resident_bytes();
+  std::uint64_t floor = idle_rss_floor_.load();
+  rebuild = rebuild || (renderer && rss > floor + kRebuildWhenIdleAboveBytes);
+  if (rebuild) {
+    const auto t0 = Clock::now();
+    renderer.reset();
+    malloc_trim(0);
+    renderer = make_renderer(index);
+    if (renderer) idle_rebuilds_.fetch_add(1);
+    std::fprintf(stderr,
+                 "beamcast-server: render worker %d idle at %.0f MiB (leanest idle %.0f MiB): "
+                 "new renderer in %.0f ms, %.0f MiB now\n",
+                 index, rss / 1048576.0, floor / 1048576.0, ms_between(t0, Clock::now()),
+                 resident_bytes() / 1048576.0);
+  }
+  const std::uint64_t now = resident_bytes();
+  while (now < floor && !idle_rss_floor_.compare_exchange_weak(floor, now)) {
+  }
+  idle_releases_.fetch_add(1);
 }
 
 void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer* renderer,

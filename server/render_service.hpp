@@ -51,6 +51,10 @@ class FrameRenderer {
   // Test hook (RenderService::fail_next_render_for_test): the next render
   // throws GlError from inside the renderer.
   virtual void fail_next_render_for_test() = 0;
+  // The worker has been idle a while (RenderService::set_idle_release): give
+  // back what is kept for later renders (caches, targets), as far as
+  // repeating the last render stays cheap.
+  virtual void release_idle_memory() {}
 };
 
 // Called on each worker thread, so a GL context is created on the thread that uses it.
@@ -160,6 +164,15 @@ class RenderService {
   // encoders, and the preview frame then has them to itself.
   void set_hold_batch_encodes(bool hold);
 
+  // A worker that has rendered nothing for `idle` releases its renderer's
+  // caches (FrameRenderer::release_idle_memory) and trims the heap, once
+  // per idle spell. Default kIdleReleaseMs (server/memory.hpp).
+  void set_idle_release(std::chrono::milliseconds idle) { idle_release_ms_.store(idle.count()); }
+  // Idle releases done (all workers), and the renderers they replaced
+  // (kRebuildWhenIdleAboveBytes, server/memory.hpp).
+  std::uint64_t idle_releases() const { return idle_releases_.load(); }
+  std::uint64_t idle_rebuilds() const { return idle_rebuilds_.load(); }
+
   // False if `max_inflight` jobs are already accepted and unanswered (busy).
   bool submit(RenderJob job);
   int inflight() const { return inflight_.load(); }
@@ -210,6 +223,9 @@ class RenderService {
   // One slice: render it and hand its frames to the encoders.
   void run_slice(const TaskPtr& task, std::size_t slice, FrameRenderer* renderer, int index,
                  bool* gl_failed);
+  // The worker has been idle for idle_release_ms_: release, trim, and if
+  // the process is still well above its leanest idle size, a new renderer.
+  void release_when_idle(std::unique_ptr<FrameRenderer>& renderer, int index);
   // `slice` of `task` is finished (encoded; none: SIZE_MAX) and `dropped`
   // more (never rendered); streamed parts go out in order, and the last
   // finished slice completes the task's jobs.
@@ -233,6 +249,12 @@ class RenderService {
   std::atomic<std::uint64_t> rebuilds_{0};
   std::atomic<int> inject_failures_{0};
   std::atomic<bool> cancel_all_{false};
+  std::atomic<std::int64_t> idle_release_ms_;
+  std::atomic<std::uint64_t> idle_releases_{0};
+  std::atomic<std::uint64_t> idle_rebuilds_{0};
+  // The lowest RSS after an idle release; set by wait_ready to the size at
+  // start plus kRebuildWhenIdleAboveBytes.
+  std::atomic<std::uint64_t> idle_rss_floor_{~std::uint64_t{0}};
   mutable std::mutex mu_;
   std::condition_variable cv_;
   std::condition_variable window_cv_;  // batch windows wait here (stop() wakes them)

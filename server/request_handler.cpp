@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 
 #include "protocol/request.hpp"
 #include "protocol/request_cost.hpp"
@@ -318,8 +319,108 @@ bool reserve_request_memory(ServerCore& core, Connection& connection, std::uint6
   return false;
 }
 
-void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
-                    std::string_view json_text, Clock::time_point arrived) {
+namespace {
+
+// Runs `fn`, answering what it throws: a ProtocolError as the client's error,
+// anything else as `internal`.
+template <class Fn>
+void answering_errors(ServerCore& core, Connection& session, const json& id,
+                      const std::string& method, Fn&& fn) {
+  try {
+    fn();
+  } catch (const ProtocolError& e) {
+    core.metrics.count_request(method, false);
+    log_request(core, id, method, e.info().code);
+    session.send_error(id, e.info());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "beamcast-server: internal error: %s\n", e.what());
+    core.metrics.count_request(method, false);
+    session.send_error(id, ErrorInfo{"internal", e.what(), ""});
+  }
+}
+
+// Whether handling `req` may read asset files: a render or scene.put with an
+// inline scene that names one, or any scene.update (it parses the stored
+// scene again).
+bool reads_asset_files(const Request& req) {
+  if (req.method == "scene.update") return true;
+  if (req.method != "render" && req.method != "scene.put") return false;
+  const auto it = req.params.find("scene");
+  return it != req.params.end() && scene_reads_files(*it);
+}
+
+// The method's work, once the request is parsed, authenticated and admitted.
+void run_method(ServerCore& core, const std::shared_ptr<Connection>& session, Request& req,
+                const json& id, const std::string& method, Clock::time_point arrived) {
+  const json& params = req.params;
+  if (req.method == "hello") {
+    json result = hello_result(core, params);
+    // Only a hello that succeeded (token and protocol) authenticates.
+    if (token_required(core.config)) session->set_authenticated();
+    session->send(ok_response(id, std::move(result)));
+  } else if (req.method == "ping") {
+    json result = json::object();
+    result["echo"] = std::move(req.params);  // moved: a large ping's document is not copied
+    session->send(ok_response(id, std::move(result)));
+  } else if (req.method == "stats" && stats_format(params) == "prometheus") {
+    // The Prometheus exposition (server/metrics.hpp) inside a JSON response.
+    session->send(ok_response(id, {{"format", "prometheus"},
+                                   {"text", core.metrics.prometheus(sample_gauges(core))}}));
+  } else if (req.method == "stats" && stats_format(params) == "health") {
+    session->send(ok_response(
+        id, health_json(core.shutting_down.load(), sample_gauges(core), core.renderer_description)));
+  } else if (req.method == "stats") {
+    json s = core.stats.to_json();
+    s["inflight"] = core.renders->inflight();
+    s["queue_depth"] = core.renders->queued();
+    s["renders_dropped"] = core.renders->dropped();
+    s["renders_cancelled"] = core.renders->cancelled();
+    s["slices_dropped"] = core.renders->slices_dropped();
+    s["queue_depth_by_class"] = {
+        {"interactive", core.renders->queued(WorkClass::kInteractive)},
+        {"batch", core.renders->queued(WorkClass::kBatch)}};
+    s["renderer_rebuilds"] = core.renders->renderer_rebuilds();
+    s["scenes"] = {{"count", core.scenes.count()}, {"bytes", core.scenes.bytes()}};
+    session->send(ok_response(id, std::move(s)));
+  } else if (req.method == "render") {
+    handle_render(core, session, id, params, arrived);
+  } else if (req.method == "scene.put") {
+    allow_params(params, {"scene_id", "scene"}, "scene.put");
+    const std::string sid = parse_scene_id(params, "/params/scene_id");
+    const json& sj = required_object(params, "scene");
+    Scene scene = parse_scene_at(core, sj, "/params/scene");
+    session->send(ok_response(id, store_scene(core, sid, sj, std::move(scene), "/params/scene")));
+  } else if (req.method == "scene.update") {
+    allow_params(params, {"scene_id", "patch"}, "scene.update");
+    const std::string sid = parse_scene_id(params, "/params/scene_id");
+    const json& patch = required_object(params, "patch");
+    auto stored = core.scenes.get(sid);
+    if (!stored) fail("unknown_scene", "/params/scene_id", "no stored scene \"" + sid + "\"");
+    json merged = stored->json;
+    merged.merge_patch(patch);
+    Scene scene = parse_scene_at(core, merged, "/params/patch");
+    session->send(ok_response(
+        id, store_scene(core, sid, std::move(merged), std::move(scene), "/params/patch")));
+  } else if (req.method == "scene.delete") {
+    allow_params(params, {"scene_id"}, "scene.delete");
+    const std::string sid = parse_scene_id(params, "/params/scene_id");
+    if (!core.scenes.erase(sid)) fail("unknown_scene", "/params/scene_id", "no stored scene \"" + sid + "\"");
+    session->send(ok_response(id, {{"deleted", true}}));
+  } else {
+    fail("unknown_method", "/method",
+         "unknown method \"" + req.method + "\" (" + request_methods_text() + ")");
+  }
+  if (method != "render") {  // render is counted when its answer is ready
+    core.metrics.count_request(method, true);
+    log_request(core, id, method, "ok");
+  }
+}
+
+}  // namespace
+
+bool handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
+                    std::string_view json_text, Clock::time_point arrived,
+                    std::function<void()> resume) {
   // Time spent here is not the client's (MessageClock).
   struct HandlingTime {
     ServerCore& core;
@@ -331,88 +432,39 @@ void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
   } handling{core};
   json id;
   std::string method = "(invalid)";  // metrics key: a known method or a fixed placeholder
-  try {
+  std::optional<Request> load;       // handled on core.loaders
+  answering_errors(core, *session, id, method, [&] {
     Request req = parse_request(json_text, &id, core.config.json_limits);
     // Count unknown methods under one key: client-chosen strings must not grow the map.
     const bool known = is_request_method(req.method);
     method = known ? req.method : "(unknown)";
     core.stats.count_request(method);
-    const json& params = req.params;
-    check_request_token(core.config, req.method, params, session->authenticated());
+    check_request_token(core.config, req.method, req.params, session->authenticated());
     const bool mutating = req.method == "render" || req.method.starts_with("scene.");
     if (mutating && core.shutting_down.load()) {
       fail("shutting_down", "", "the server is shutting down and takes no new work");
     }
-    if (req.method == "hello") {
-      json result = hello_result(core, params);
-      // Only a hello that succeeded (token and protocol) authenticates.
-      if (token_required(core.config)) session->set_authenticated();
-      session->send(ok_response(id, std::move(result)));
-    } else if (req.method == "ping") {
-      json result = json::object();
-      result["echo"] = std::move(req.params);  // moved: a large ping's document is not copied
-      session->send(ok_response(id, std::move(result)));
-    } else if (req.method == "stats" && stats_format(params) == "prometheus") {
-      // The Prometheus exposition (server/metrics.hpp) inside a JSON response.
-      session->send(ok_response(id, {{"format", "prometheus"},
-                                     {"text", core.metrics.prometheus(sample_gauges(core))}}));
-    } else if (req.method == "stats" && stats_format(params) == "health") {
-      session->send(ok_response(
-          id, health_json(core.shutting_down.load(), sample_gauges(core), core.renderer_description)));
-    } else if (req.method == "stats") {
-      json s = core.stats.to_json();
-      s["inflight"] = core.renders->inflight();
-      s["queue_depth"] = core.renders->queued();
-      s["renders_dropped"] = core.renders->dropped();
-      s["renders_cancelled"] = core.renders->cancelled();
-      s["slices_dropped"] = core.renders->slices_dropped();
-      s["queue_depth_by_class"] = {
-          {"interactive", core.renders->queued(WorkClass::kInteractive)},
-          {"batch", core.renders->queued(WorkClass::kBatch)}};
-      s["renderer_rebuilds"] = core.renders->renderer_rebuilds();
-      s["scenes"] = {{"count", core.scenes.count()}, {"bytes", core.scenes.bytes()}};
-      session->send(ok_response(id, std::move(s)));
-    } else if (req.method == "render") {
-      handle_render(core, session, id, params, arrived);
-    } else if (req.method == "scene.put") {
-      allow_params(params, {"scene_id", "scene"}, "scene.put");
-      const std::string sid = parse_scene_id(params, "/params/scene_id");
-      const json& sj = required_object(params, "scene");
-      Scene scene = parse_scene_at(core, sj, "/params/scene");
-      session->send(ok_response(id, store_scene(core, sid, sj, std::move(scene), "/params/scene")));
-    } else if (req.method == "scene.update") {
-      allow_params(params, {"scene_id", "patch"}, "scene.update");
-      const std::string sid = parse_scene_id(params, "/params/scene_id");
-      const json& patch = required_object(params, "patch");
-      auto stored = core.scenes.get(sid);
-      if (!stored) fail("unknown_scene", "/params/scene_id", "no stored scene \"" + sid + "\"");
-      json merged = stored->json;
-      merged.merge_patch(patch);
-      Scene scene = parse_scene_at(core, merged, "/params/patch");
-      session->send(ok_response(
-          id, store_scene(core, sid, std::move(merged), std::move(scene), "/params/patch")));
-    } else if (req.method == "scene.delete") {
-      allow_params(params, {"scene_id"}, "scene.delete");
-      const std::string sid = parse_scene_id(params, "/params/scene_id");
-      if (!core.scenes.erase(sid)) fail("unknown_scene", "/params/scene_id", "no stored scene \"" + sid + "\"");
-      session->send(ok_response(id, {{"deleted", true}}));
-    } else {
-      fail("unknown_method", "/method",
-           "unknown method \"" + req.method + "\" (" + request_methods_text() + ")");
+    if (resume && core.loaders && reads_asset_files(req)) {
+      load = std::move(req);
+      return;
     }
-    if (method != "render") {  // render is counted when its answer is ready
-      core.metrics.count_request(method, true);
-      log_request(core, id, method, "ok");
-    }
-  } catch (const ProtocolError& e) {
-    core.metrics.count_request(method, false);
-    log_request(core, id, method, e.info().code);
-    session->send_error(id, e.info());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "beamcast-server: internal error: %s\n", e.what());
-    core.metrics.count_request(method, false);
-    session->send_error(id, ErrorInfo{"internal", e.what(), ""});
-  }
+    run_method(core, session, req, id, method, arrived);
+  });
+  if (!load) return true;
+  // Reading a mesh, SLIM or volume file takes up to a second (a 14 MB OBJ:
+  // 0.15-0.2 s; files are limited by max_mesh_triangles, max_slim_spheres,
+  // max_volume_voxels): on a loader thread, so this network thread's other
+  // connections are answered meanwhile. The connection reads its next
+  // message once `resume` has run, so its requests are handled in order.
+  core.loading.fetch_add(1);
+  core.loaders->post([&core, session, req = std::make_shared<Request>(std::move(*load)),
+                      id = std::move(id), method, arrived, resume = std::move(resume)] {
+    answering_errors(core, *session, id, method,
+                     [&] { run_method(core, session, *req, id, method, arrived); });
+    core.loading.fetch_sub(1);
+    resume();
+  });
+  return false;
 }
 
 }  // namespace beamcast

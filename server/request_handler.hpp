@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <string_view>
 
@@ -12,8 +13,15 @@ namespace beamcast {
 
 class Connection;
 
-void handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
-                    std::string_view json_text, std::chrono::steady_clock::time_point arrived);
+// Handles one message; true when done. A render or scene method whose scene
+// reads asset files (scene_reads_files) is handed to core.loaders after
+// parsing, if the caller gives `resume`: then false, and `resume` is called
+// on the loader thread once the message has been handled; the caller reads
+// the connection's next message only then, so its messages are handled in
+// order while the network thread serves other connections.
+bool handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
+                    std::string_view json_text, std::chrono::steady_clock::time_point arrived,
+                    std::function<void()> resume = {});
 
 // Reserves a message's estimated memory against max_request_memory_bytes
 // (server/memory.hpp); if it does not fit, answers the connection (`busy` or

@@ -38,8 +38,10 @@ Server::Server(const ServerConfig& config, RendererFactory renderers)
 }
 
 Server::~Server() {
-  // Workers and encoders call into sessions; stop them before the io_context
-  // (and the handlers that hold sessions) goes away.
+  // Loaders, workers and encoders call into sessions; stop them before the
+  // io_context (and the handlers that hold sessions) goes away. Loaders
+  // first: they submit renders.
+  if (core_.loaders) core_.loaders->stop();
   if (core_.renders) core_.renders->stop();
 }
 
@@ -65,6 +67,9 @@ unsigned short Server::start() {
                                   c.scene_limits.max_cameras);
   core_.renders->set_hold_batch_encodes(c.hold_batch_encodes);
   core_.renderer_description = core_.renders->wait_ready();
+  // One thread: files are parsed one at a time, as they were on the network
+  // thread, so a burst of them peaks no higher.
+  core_.loaders = std::make_unique<WorkPool>(1);
   const tcp::endpoint ep(asio::ip::make_address(c.bind), c.port);
   acceptor_.open(ep.protocol());
   acceptor_.set_option(tcp::acceptor::reuse_address(true));
@@ -167,7 +172,8 @@ void Server::shutdown() {
 }
 
 void Server::drain_step(std::chrono::steady_clock::time_point deadline) {
-  if (core_.renders->inflight() > 0 && std::chrono::steady_clock::now() < deadline) {
+  const bool busy = core_.renders->inflight() > 0 || core_.loading.load() > 0;
+  if (busy && std::chrono::steady_clock::now() < deadline) {
     drain_timer_.expires_after(std::chrono::milliseconds(20));
     drain_timer_.async_wait([this, deadline](const boost::system::error_code& ec) {
       if (!ec) drain_step(deadline);
@@ -194,6 +200,7 @@ void Server::drain_step(std::chrono::steady_clock::time_point deadline) {
     }
     for (auto& s : open) s->close();
     http_->close_all();
+    if (core_.loaders) core_.loaders->stop();
     core_.renders->stop();
     io_.stop();
   });

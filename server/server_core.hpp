@@ -15,6 +15,7 @@
 #include "server/render_service.hpp"
 #include "server/scene_store.hpp"
 #include "server/stats.hpp"
+#include "server/threads.hpp"
 
 namespace beamcast {
 
@@ -25,6 +26,13 @@ struct ServerCore {
   SceneStore scenes;
   MemoryBudget request_memory;  // max_request_memory_bytes
   std::unique_ptr<RenderService> renders;
+  // Handles the messages whose scene reads asset files (mesh, SLIM, volume
+  // files: parsing one takes up to a second), off the network threads
+  // (handle_message); null: they are handled where they arrive.
+  std::unique_ptr<WorkPool> loaders;
+  // Messages handed to `loaders` and not yet handled: shutdown's drain waits
+  // for them as for renders in flight.
+  std::atomic<int> loading{0};
   std::string renderer_description;
   std::atomic<bool> shutting_down{false};
   // Nanoseconds the network threads have spent handling messages (parsing,

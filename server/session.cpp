@@ -128,8 +128,17 @@ void Session::on_body(const boost::system::error_code& ec, std::size_t) {
     body_.clear();
     body_.shrink_to_fit();
     bytes = text.size();
-    handle_message(core_, shared_from_this(), text, Clock::now());
+    // A scene that reads files is handled on a loader thread; this
+    // connection reads on once it has been (message_handled).
+    auto resume = [self = shared_from_this(), bytes] {
+      asio::post(self->socket_.get_executor(), [self, bytes] { self->message_handled(bytes); });
+    };
+    if (!handle_message(core_, shared_from_this(), text, Clock::now(), std::move(resume))) return;
   }  // the text is freed before the trim
+  message_handled(bytes);
+}
+
+void Session::message_handled(std::size_t bytes) {
   reservation_.release();
   release_large_message_memory(bytes);
   do_read_header();

@@ -47,6 +47,9 @@ class Session : public Connection, public std::enable_shared_from_this<Session> 
   void on_header();
   void do_read_body();
   void on_body(const boost::system::error_code& ec, std::size_t n);
+  // The message of `bytes` has been handled: its memory is released and the
+  // next one read.
+  void message_handled(std::size_t bytes);
   // Answers `error` (id null) and reads the message's body away.
   void refuse_and_discard(const ErrorInfo& error, std::uint64_t body_bytes);
   void do_discard();

@@ -7,9 +7,13 @@
 // limit).
 #pragma once
 
+#include <condition_variable>
 #include <cstddef>
+#include <deque>
 #include <functional>
 #include <memory>
+#include <mutex>
+#include <vector>
 
 #include <pthread.h>
 
@@ -33,6 +37,27 @@ class SizedThread {
  private:
   pthread_t thread_{};
   bool joinable_ = false;
+};
+
+// A few SizedThreads that run posted work, first posted first started.
+class WorkPool {
+ public:
+  explicit WorkPool(int threads);
+  WorkPool(const WorkPool&) = delete;
+  WorkPool& operator=(const WorkPool&) = delete;
+  ~WorkPool() { stop(); }
+  void post(std::function<void()> fn);
+  // Lets the work already started finish, drops the rest (destroyed
+  // unrun), joins the threads. Work posted afterwards is dropped too.
+  void stop();
+
+ private:
+  void run();
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::deque<std::function<void()>> queue_;
+  bool stopping_ = false;
+  std::vector<SizedThread> threads_;
 };
 
 }  // namespace beamcast
