@@ -45,9 +45,11 @@ def main() -> None:
     ap.add_argument("--duration", type=float, default=10)
     ap.add_argument("--connections", type=int, default=4)
     ap.add_argument("--server-args", default="--quiet-requests --http-port -1 --no-demo")
+    ap.add_argument("--old-args", default="", help="more options for the old server only "
+                    "(e.g. --png-encoder libpng, with --old the new binary)")
     a = ap.parse_args()
     extra = shlex.split(a.server_args)
-    old, old_port = start_server([a.old] + extra)
+    old, old_port = start_server([a.old] + extra + shlex.split(a.old_args))
     new, new_port = start_server([a.new] + extra)
     configs = [("old png", old_port, "png"), ("new png", new_port, "png"),
                ("new raw", new_port, "raw"), ("new raw_zstd", new_port, "raw_zstd")]
@@ -57,7 +59,7 @@ def main() -> None:
             order = configs[r % len(configs):] + configs[:r % len(configs)]
             for name, port, fmt in order:
                 res = load(a.beamcast, port, a.scene, a, fmt)
-                fps = res["frames_per_s"] if "frames_per_s" in res else res["throughput"]["frames_per_s"]
+                fps = res["frames_per_s"]
                 runs[name].append({"fps": fps, "result": res})
                 print(r, name, f"{fps:.2f} frames/s", flush=True)
     finally:
