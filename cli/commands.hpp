@@ -26,6 +26,9 @@ struct RemoteRenderArgs {
   std::string out = ".";
   std::string encoding = "binary";
   std::string token;  // presented in hello when set
+  // "png" (not asked), "raw" or "raw_zstd": frames come as samples and are
+  // written as PNG here (PROTOCOL.md, "Frame formats").
+  std::string frame_format = "png";
   double timeout_s = 120;
   bool json = false;
 };

@@ -47,6 +47,7 @@
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
 #include "render/jpeg.hpp"
+#include "protocol/frame_format.hpp"
 #include "render/renderer.hpp"
 
 namespace beamcast::cli {
@@ -90,6 +91,9 @@ struct LoadArgs {
   double timeout_s = 60;
   double timeline_ms = 1000;  // width of the report's timeline buckets
   std::string token;
+  // "png" (not asked), "raw" or "raw_zstd": asked for in each connection's
+  // hello (PROTOCOL.md, "Frame formats"); every frame is still decoded.
+  std::string frame_format = "png";
   bool json_out = false;
   bool quiet = false;
 };
@@ -200,9 +204,10 @@ void note_failure(Results& r, std::string what) {
 // ---- frame verification -----------------------------------------------------
 
 struct VerifyJob {
-  std::vector<std::uint8_t> png;  // or a JPEG (interactive preview frames)
+  std::vector<std::uint8_t> png;  // or a JPEG (interactive preview frames), or raw samples
   bool jpeg = false;
-  int width = 0, height = 0;
+  FrameFormat format = FrameFormat::kPng;  // when not JPEG
+  int width = 0, height = 0, bit_depth = 8;
   json camera;     // set for a reference comparison
   std::uint64_t seq = 0;
 };
@@ -243,7 +248,13 @@ class Verifier {
  private:
   std::optional<Image> decode(const VerifyJob& job) {
     try {
-      Image img = job.jpeg ? decode_jpeg(job.png) : decode_png(job.png);
+      Image img = job.jpeg                          ? decode_jpeg(job.png)
+                  : job.format == FrameFormat::kPng ? decode_png(job.png)
+                                                    : Image{job.width, job.height, job.bit_depth,
+                                                            decode_raw_frame(job.png, job.width,
+                                                                             job.height,
+                                                                             job.bit_depth,
+                                                                             job.format)};
       std::lock_guard lock(results_.mu);
       ++results_.decoded;
       if (img.width != job.width || img.height != job.height) {
@@ -572,10 +583,12 @@ void Conn::connect() {
                         if (ec) return self->on_transport_error("connect_failed");
                         self->socket_.set_option(tcp::no_delay(true));
                         self->read_header();
-                        if (!self->load_.args.token.empty()) {
-                          json hello = {{"id", 0},
-                                        {"method", "hello"},
-                                        {"params", {{"protocol", 1}, {"token", self->load_.args.token}}}};
+                        const LoadArgs& a = self->load_.args;
+                        if (!a.token.empty() || a.frame_format != "png") {
+                          json params = {{"protocol", 1}};
+                          if (!a.token.empty()) params["token"] = a.token;
+                          if (a.frame_format != "png") params["frame_format"] = a.frame_format;
+                          json hello = {{"id", 0}, {"method", "hello"}, {"params", params}};
                           self->write(encode_frame(hello.dump()));
                         }
                         // The scene on this connection's own server (behind a
@@ -774,7 +787,10 @@ void Conn::on_message(json msg, std::vector<std::uint8_t> binary) {
       job.width = p.cameras[i]["width"];
       job.height = p.cameras[i]["height"];
       job.seq = p.seq;
-      job.jpeg = res->frames[i].format.value_or("png") == "jpeg";
+      const std::string format = res->frames[i].format.value_or("png");
+      job.jpeg = format == "jpeg";
+      job.format = parse_frame_format(format).value_or(FrameFormat::kPng);
+      job.bit_depth = res->frames[i].bit_depth.value_or(8);
       // Deterministic sample of requests for the reference comparison.
       const double u = static_cast<double>((p.seq * 0x9E3779B97F4A7C15ull) >> 11) * 0x1.0p-53;
       if (u < cls_.verify_fraction) job.camera = p.cameras[i];
@@ -1197,6 +1213,11 @@ void add_load_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--token", args->token, "Token for hello (servers on non-loopback addresses)")
       ->envname("BEAMCAST_TOKEN");
+  cmd->add_option("--frame-format", args->frame_format,
+                  "Frames as png, or raw / raw_zstd samples (asked for in hello); every frame is "
+                  "decoded either way")
+      ->check(CLI::IsMember({"png", "raw", "raw_zstd"}))
+      ->capture_default_str();
   cmd->add_option("--attempts", args->max_attempts,
                   "Tries of a connection that drops or is refused before its requests fail "
                   "(reconnects with backoff and jitter; 1: no retries)")

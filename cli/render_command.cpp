@@ -245,6 +245,12 @@ void add_render_command(CLI::App& app) {
                   "With --server: PNG transport, binary (attachments) or base64")
       ->check(CLI::IsMember({"binary", "base64"}))
       ->needs(server);
+  cmd->add_option("--frame-format", remote->frame_format,
+                  "With --server: frames as png (the server encodes), or raw / raw_zstd "
+                  "(samples, asked for in hello; PNG files written here)")
+      ->check(CLI::IsMember({"png", "raw", "raw_zstd"}))
+      ->capture_default_str()
+      ->needs(server);
   cmd->add_option("--timeout", remote->timeout_s, "With --server: seconds to wait for the frames")
       ->check(CLI::PositiveNumber)
       ->needs(server);

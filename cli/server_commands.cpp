@@ -16,6 +16,7 @@
 #include "cli/commands.hpp"
 #include "client/client.hpp"
 #include "client/resilient_client.hpp"
+#include "render/image.hpp"
 
 namespace beamcast::cli {
 namespace {
@@ -95,6 +96,7 @@ int run_remote_render(const RemoteRenderArgs& args) {
   opts.receive_timeout = std::chrono::milliseconds(static_cast<long long>(args.timeout_s * 1000));
   opts.connect_timeout = std::min(opts.receive_timeout, std::chrono::milliseconds(10000));
   opts.token = args.token;
+  if (args.frame_format != "png") opts.frame_format = args.frame_format;
   client::ResilientClient c(ep, nullptr, opts);
   const client::RenderResult r = c.render(req);
   if (!r.ok) {
@@ -113,12 +115,19 @@ int run_remote_render(const RemoteRenderArgs& args) {
   summary["passes"] = r.passes;
   summary["frames"] = nlohmann::json::array();
   for (const client::RenderedFrame& f : r.frames) {
+    const bool raw = !f.samples.empty();
     const fs::path file = fs::path(args.out) / (frame_stem(f) + ".png");
-    write_file(file, f.png);
+    if (raw) {
+      // Raw samples from the server: the PNG is made here, on the client's cores.
+      write_png(file, Image{f.width, f.height, f.bit_depth, f.samples});
+    } else {
+      write_file(file, f.png);
+    }
     nlohmann::json jf = {{"camera", f.camera},
                          {"file", file.string()},
                          {"width", f.width},
                          {"height", f.height},
+                         {"format", f.format},
                          {"bytes", f.png.size()}};
     jf.update(f.timings);
     summary["frames"].push_back(jf);

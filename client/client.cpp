@@ -9,6 +9,7 @@
 
 #include <boost/asio.hpp>
 
+#include "protocol/frame_format.hpp"
 #include "protocol/framing.hpp"
 
 namespace beamcast::client {
@@ -190,8 +191,10 @@ Response Client::call(const std::string& method, const nlohmann::json& params) {
   return receive_for(send({{"id", next_id_++}, {"method", method}, {"params", params}}));
 }
 
-Response Client::hello(const std::string& client_name) {
-  return call("hello", {{"protocol", 1}, {"client", client_name}});
+Response Client::hello(const std::string& client_name, const std::string& frame_format) {
+  nlohmann::json params = {{"protocol", 1}, {"client", client_name}};
+  if (!frame_format.empty()) params["frame_format"] = frame_format;
+  return call("hello", params);
 }
 Response Client::ping(const nlohmann::json& payload) { return call("ping", payload); }
 Response Client::stats() { return call("stats"); }
@@ -309,6 +312,15 @@ std::vector<RenderedFrame> decode_frames(const Response& response, const RenderR
       }
     } else {
       throw std::runtime_error(what + " has neither attachment nor data_base64");
+    }
+    fr.format = f.format.value_or("png");
+    const std::optional<FrameFormat> raw = parse_frame_format(fr.format);
+    if (raw && *raw != FrameFormat::kPng) {
+      try {
+        fr.samples = decode_raw_frame(fr.png, fr.width, fr.height, fr.bit_depth, *raw);
+      } catch (const std::runtime_error& e) {
+        throw std::runtime_error(what + ": " + e.what());
+      }
     }
     // The timings as sent (gpu_ms, pass_ms, readback_ms, encode_ms).
     fr.timings = nlohmann::json::object();

@@ -76,7 +76,11 @@ struct RenderedFrame {
   int width = 0;
   int height = 0;
   int bit_depth = 8;
-  std::vector<std::uint8_t> png;
+  std::string format = "png";    // "png", "jpeg", or what hello negotiated: "raw", "raw_zstd"
+  std::vector<std::uint8_t> png;  // the frame's bytes as sent, in `format`
+  // "raw" and "raw_zstd" frames: the samples, unpacked and checked against the
+  // frame's size (R, G, B per pixel, rows from the top; protocol/frame_format.hpp).
+  std::vector<std::uint16_t> samples;
   nlohmann::json timings;  // gpu_ms, pass_ms, readback_ms, encode_ms as sent
 };
 
@@ -136,7 +140,10 @@ class Client {
   // send + receive_for with a fresh id.
   Response call(const std::string& method, const nlohmann::json& params = nlohmann::json::object());
 
-  Response hello(const std::string& client_name = "beamcast-cpp/0.1.0");
+  // `frame_format` (PROTOCOL.md, "Frame formats"): "raw" or "raw_zstd" asks
+  // for this connection's frames as samples; empty: not asked (PNG).
+  Response hello(const std::string& client_name = "beamcast-cpp/0.1.0",
+                 const std::string& frame_format = "");
   Response ping(const nlohmann::json& payload = nlohmann::json::object());
   Response stats();
   Response scene_put(const std::string& scene_id, const nlohmann::json& scene);

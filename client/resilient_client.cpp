@@ -59,8 +59,11 @@ Client& ResilientClient::connection() {
   client_->set_receive_timeout(options_.receive_timeout);
   ++stats_.connections;
   client_->connect(endpoint_.host, endpoint_.port, options_.connect_timeout);
-  if (!options_.token.empty()) {
-    const Response h = client_->call("hello", {{"protocol", 1}, {"token", options_.token}});
+  if (!options_.token.empty() || !options_.frame_format.empty()) {
+    nlohmann::json params = {{"protocol", 1}};
+    if (!options_.token.empty()) params["token"] = options_.token;
+    if (!options_.frame_format.empty()) params["frame_format"] = options_.frame_format;
+    const Response h = client_->call("hello", params);
     if (!h.ok) {
       client_.reset();
       throw RequestRefused(endpoint() + " refused hello: [" + h.error.code + "] " + h.error.message,

@@ -69,6 +69,9 @@ struct ResilientOptions {
   std::chrono::milliseconds connect_timeout{5000};
   std::chrono::milliseconds receive_timeout{60000};
   std::string token;       // presented in hello on every new connection when set
+  // Asked for in hello on every new connection when set: "raw" or "raw_zstd"
+  // (PROTOCOL.md, "Frame formats").
+  std::string frame_format;
   std::uint64_t seed = 1;  // of the jitter
 };
 

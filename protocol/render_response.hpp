@@ -71,7 +71,7 @@ struct RenderFrame {
   // Atlas tiles only: top-left pixel in the atlas.
   std::optional<int> x, y;
   // The image: on camera frames and the atlas frame, not on tiles.
-  std::optional<std::string> format;  // "png" or "jpeg"
+  std::optional<std::string> format;  // "png", "jpeg", "raw" or "raw_zstd" (frame_format.hpp)
   std::optional<int> bit_depth;
   std::optional<double> encode_ms;
   std::optional<Attachment> attachment;    // "encoding": "binary"

@@ -1,8 +1,10 @@
 #include "render/image.hpp"
 
+#include <libdeflate.h>
 #include <png.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -160,6 +162,103 @@ std::vector<std::uint8_t> encode_png(const Image& img, int level, int filters) {
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   return out;
+}
+
+namespace {
+
+void put_be32(std::vector<std::uint8_t>& out, std::uint32_t v) {
+  for (int shift = 24; shift >= 0; shift -= 8) out.push_back(static_cast<std::uint8_t>(v >> shift));
+}
+
+// One PNG chunk: length, type, data, CRC-32 of type and data.
+void put_chunk(std::vector<std::uint8_t>& out, const char type[4], const std::uint8_t* data,
+               std::size_t size) {
+  put_be32(out, static_cast<std::uint32_t>(size));
+  const std::size_t start = out.size();
+  out.insert(out.end(), type, type + 4);
+  out.insert(out.end(), data, data + size);
+  put_be32(out, libdeflate_crc32(0, out.data() + start, size + 4));
+}
+
+// A compressor per level and thread: allocating one costs more than
+// compressing a small frame at level 1.
+libdeflate_compressor* deflate_compressor(int level) {
+  thread_local struct Cache {
+    std::array<libdeflate_compressor*, 13> c{};
+    ~Cache() {
+      for (auto* p : c) libdeflate_free_compressor(p);
+    }
+  } cache;
+  auto*& c = cache.c[static_cast<std::size_t>(level)];
+  if (!c) c = libdeflate_alloc_compressor(level);
+  if (!c) throw std::runtime_error("libdeflate_alloc_compressor failed");
+  return c;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_png_libdeflate(const Image& img, int level, PngRowFilter filter) {
+  check_image(img);
+  if (level < 0 || level > 12) throw std::invalid_argument("libdeflate level must be 0..12");
+  // Scanlines: the filter type byte, then the row's samples (16-bit ones
+  // big-endian), filtered against the pixel to the left (sub) or above (up).
+  const std::size_t bps = static_cast<std::size_t>(img.bit_depth / 8);  // bytes a sample
+  const std::size_t bpp = 3 * bps;
+  const std::size_t row_bytes = bpp * static_cast<std::size_t>(img.width);
+  std::vector<std::uint8_t> row(row_bytes), prev(row_bytes, 0);
+  std::vector<std::uint8_t> lines((row_bytes + 1) * static_cast<std::size_t>(img.height));
+  for (int y = 0; y < img.height; ++y) {
+    const std::uint16_t* src = img.rgb.data() + 3 * static_cast<std::size_t>(img.width) * y;
+    if (bps == 1) {
+      for (std::size_t i = 0; i < row_bytes; ++i) row[i] = static_cast<std::uint8_t>(src[i]);
+    } else {
+      for (std::size_t i = 0; i < row_bytes / 2; ++i) {
+        row[2 * i] = static_cast<std::uint8_t>(src[i] >> 8);
+        row[2 * i + 1] = static_cast<std::uint8_t>(src[i] & 0xff);
+      }
+    }
+    std::uint8_t* out = lines.data() + (row_bytes + 1) * static_cast<std::size_t>(y);
+    *out++ = static_cast<std::uint8_t>(filter);
+    switch (filter) {
+      case PngRowFilter::kNone:
+        std::memcpy(out, row.data(), row_bytes);
+        break;
+      case PngRowFilter::kSub:
+        for (std::size_t i = 0; i < bpp; ++i) out[i] = row[i];
+        for (std::size_t i = bpp; i < row_bytes; ++i) {
+          out[i] = static_cast<std::uint8_t>(row[i] - row[i - bpp]);
+        }
+        break;
+      case PngRowFilter::kUp:
+        for (std::size_t i = 0; i < row_bytes; ++i) {
+          out[i] = static_cast<std::uint8_t>(row[i] - prev[i]);
+        }
+        break;
+    }
+    std::swap(row, prev);
+  }
+  libdeflate_compressor* c = deflate_compressor(level);
+  std::vector<std::uint8_t> z(libdeflate_zlib_compress_bound(c, lines.size()));
+  const std::size_t zsize = libdeflate_zlib_compress(c, lines.data(), lines.size(), z.data(), z.size());
+  BEAMCAST_CHECK(zsize > 0, "libdeflate_zlib_compress: output larger than its own bound");
+  std::vector<std::uint8_t> out;
+  out.reserve(zsize + 64);
+  const std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  out.insert(out.end(), signature, signature + 8);
+  std::vector<std::uint8_t> ihdr;
+  put_be32(ihdr, static_cast<std::uint32_t>(img.width));
+  put_be32(ihdr, static_cast<std::uint32_t>(img.height));
+  // bit depth, colour type 2 (RGB), deflate, adaptive filtering, no interlace
+  ihdr.insert(ihdr.end(), {static_cast<std::uint8_t>(img.bit_depth), 2, 0, 0, 0});
+  put_chunk(out, "IHDR", ihdr.data(), ihdr.size());
+  put_chunk(out, "IDAT", z.data(), zsize);
+  put_chunk(out, "IEND", nullptr, 0);
+  return out;
+}
+
+std::vector<std::uint8_t> encode_png(const Image& img, const PngSettings& s) {
+  return s.encoder == PngEncoder::kLibdeflate ? encode_png_libdeflate(img, s.level, s.row_filter)
+                                              : encode_png(img, s.level, s.libpng_filters);
 }
 
 void write_png(const std::filesystem::path& file, const Image& img) {

@@ -43,6 +43,21 @@ Image tone_map(const HdrImage& hdr, const OutputSettings& out);
 
 // PNG encoding with libpng; level 0..9 (zlib), filter as libpng's PNG_FILTER_* mask.
 std::vector<std::uint8_t> encode_png(const Image& img, int level = 3, int filters = -1);
+// PNG with libdeflate (zlib format, one IDAT chunk) and one row filter for
+// every row: the server's default for still frames, 2-4x faster than libpng at
+// the same size (docs/performance.md, "Frame encoders"). level 0..12.
+enum class PngRowFilter { kNone = 0, kSub = 1, kUp = 2 };  // PNG filter type bytes
+std::vector<std::uint8_t> encode_png_libdeflate(const Image& img, int level = 1,
+                                                PngRowFilter filter = PngRowFilter::kSub);
+// Which encoder and its settings (the server's --png-encoder, --png-level, --png-filter).
+enum class PngEncoder { kLibdeflate, kLibpng };
+struct PngSettings {
+  PngEncoder encoder = PngEncoder::kLibdeflate;
+  int level = 1;                                  // libdeflate 0..12, libpng (zlib) 0..9
+  PngRowFilter row_filter = PngRowFilter::kSub;   // libdeflate
+  int libpng_filters = 0x10;                      // libpng's PNG_FILTER_* mask (SUB)
+};
+std::vector<std::uint8_t> encode_png(const Image& img, const PngSettings& settings);
 void write_png(const std::filesystem::path& file, const Image& img);
 // Decodes an 8- or 16-bit RGB or RGBA PNG (alpha dropped); throws std::runtime_error.
 Image decode_png(const std::vector<std::uint8_t>& bytes);

@@ -8,6 +8,8 @@ PACKAGES=(
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri   # EGL + OpenGL (llvmpipe without a GPU)
   libglm-dev nlohmann-json3-dev libpng-dev libcli11-dev
   libturbojpeg0-dev                                   # JPEG frames of the interactive preview
+  libdeflate-dev                                      # PNG frames (render/image.cpp)
+  libzstd-dev python3-zstandard                       # raw_zstd frames (server, C++ and Python clients)
   zlib1g-dev                                          # gzip-compressed volume files (NRRD, .inr.gz)
   libembree-dev                                       # photon tracing and the path-traced reference (gi/)
   libnanoflann-dev                                    # k-nearest photons of the CPU gather (gi/)

@@ -8,6 +8,7 @@
 
 #include "protocol/bounded_json.hpp"
 #include "protocol/scene_json.hpp"
+#include "render/image.hpp"
 
 namespace beamcast {
 
@@ -29,7 +30,9 @@ struct ServerConfig {
   int device_index = -1;       // EGL device; -1: automatic
   std::string egl_platform = "auto";
   int render_workers = 1;  // threads that each own a GL context
-  int encode_threads = 2;  // PNG encoding pool
+  // Frame encoding pool; 0: default_encode_threads (server/threads.hpp), the
+  // cores less the render workers and network threads, at least 2.
+  int encode_threads = 0;
   int network_threads = 1;
   // Cross-connection batching: renders of one stored scene arriving within this
   // many ms are rendered as one multi-view pass. 0: off (lowest latency).
@@ -49,10 +52,10 @@ struct ServerConfig {
   // preview's render then has the CPU to itself on a software rasterizer);
   // docs/performance.md, "Encode hold".
   bool hold_batch_encodes = true;
-  // PNG zlib level and libpng filter mask (PNG_FILTER_SUB = 0x10), chosen by
-  // measurement: docs/performance.md, "PNG encoding".
-  int png_level = 2;
-  int png_filters = 0x10;
+  // PNG encoder, level and row filter, chosen by measurement
+  // (docs/performance.md, "Frame encoders"): libdeflate level 1, SUB. The
+  // setting before issue 39 is --png-encoder libpng (zlib level 2, SUB).
+  PngSettings png;
   std::filesystem::path assets_dir;
 
   SceneLimits scene_limits = kServerSceneLimits;

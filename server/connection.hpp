@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "protocol/errors.hpp"
+#include "protocol/frame_format.hpp"
 #include "server/accuracy_controller.hpp"
 
 namespace beamcast {
@@ -102,6 +103,11 @@ class Connection {
   bool authenticated() const { return authenticated_.load(); }
   void set_authenticated() { authenticated_.store(true); }
 
+  // The format of this connection's frames that are not JPEG, as negotiated
+  // in hello (params.frame_format); PNG until a hello asks for another.
+  FrameFormat frame_format() const { return frame_format_.load(); }
+  void set_frame_format(FrameFormat f) { frame_format_.store(f); }
+
  protected:
   int renders_in_flight() const { return inflight_.load(); }
   // The client has gone: its queued renders are dropped.
@@ -118,6 +124,7 @@ class Connection {
   std::shared_ptr<std::atomic<bool>> alive_ = std::make_shared<std::atomic<bool>>(true);
   InteractiveState interactive_;
   std::atomic<bool> authenticated_{false};
+  std::atomic<FrameFormat> frame_format_{FrameFormat::kPng};
 };
 
 }  // namespace beamcast

@@ -48,8 +48,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
   app.add_option("--render-workers", c.render_workers, "Render threads, each with a GL context")
       ->check(CLI::Range(1, 64))->capture_default_str();
-  app.add_option("--encode-threads", c.encode_threads, "PNG encoding threads")
-      ->check(CLI::Range(1, 256))->capture_default_str();
+  app.add_option("--encode-threads", c.encode_threads,
+                 "Frame encoding threads; 0: the cores less the render workers and network "
+                 "threads, at least 2 (hello and stats report the number)")
+      ->check(CLI::Range(0, 256))->capture_default_str();
   app.add_option("--batch-window-ms", c.batch_window_ms,
                  "Batch renders of one stored scene arriving within this window into one "
                  "multi-view pass (0: off)")
@@ -66,10 +68,19 @@ int main(int argc, char** argv) {
                "Let batch frames' encodes run while an interactive frame renders");
   app.add_option("--network-threads", c.network_threads, "Threads running connections")
       ->check(CLI::Range(1, 64))->capture_default_str();
-  app.add_option("--png-level", c.png_level, "zlib level of PNG frames (docs/performance.md)")
-      ->check(CLI::Range(0, 9))->capture_default_str();
+  std::string png_encoder = "libdeflate";
+  app.add_option("--png-encoder", png_encoder,
+                 "PNG encoder of still frames: libdeflate, or libpng (the setting before issue 39, "
+                 "with level 2; docs/performance.md, \"Frame encoders\")")
+      ->check(CLI::IsMember({"libdeflate", "libpng"}))->capture_default_str();
+  int png_level = -1;
+  app.add_option("--png-level", png_level,
+                 "Compression level of PNG frames: libdeflate 0..12 (default 1), libpng (zlib) "
+                 "0..9 (default 2)")
+      ->check(CLI::Range(-1, 12));
   std::string png_filter = "sub";
-  app.add_option("--png-filter", png_filter, "PNG row filter: none, sub, up, paeth or adaptive")
+  app.add_option("--png-filter", png_filter,
+                 "PNG row filter: none, sub or up; libpng also paeth or adaptive")
       ->check(CLI::IsMember({"none", "sub", "up", "paeth", "adaptive"}))->capture_default_str();
   app.add_option("--assets", assets, "Directory scenes' mesh files are read from")->capture_default_str();
   app.add_flag("--no-demo", no_demo, "Do not preload the scene 'demo'");
@@ -91,12 +102,27 @@ int main(int argc, char** argv) {
   c.assets_dir = assets;
   c.request_log = !quiet_requests;
   c.hold_batch_encodes = !no_encode_hold;
-  // libpng's PNG_FILTER_* masks.
-  c.png_filters = png_filter == "none"    ? 0x08
-                  : png_filter == "sub"   ? 0x10
-                  : png_filter == "up"    ? 0x20
-                  : png_filter == "paeth" ? 0x80
-                                          : 0xF8;
+  const bool libpng = png_encoder == "libpng";
+  c.png.encoder = libpng ? PngEncoder::kLibpng : PngEncoder::kLibdeflate;
+  c.png.level = png_level >= 0 ? png_level : (libpng ? 2 : 1);
+  if (libpng && c.png.level > 9) {
+    std::fprintf(stderr, "beamcast-server: --png-level %d: libpng (zlib) levels are 0..9\n", png_level);
+    return 1;
+  }
+  if (!libpng && (png_filter == "paeth" || png_filter == "adaptive")) {
+    std::fprintf(stderr, "beamcast-server: --png-filter %s needs --png-encoder libpng\n",
+                 png_filter.c_str());
+    return 1;
+  }
+  // libpng's PNG_FILTER_* masks; libdeflate's encoder writes one filter type.
+  c.png.libpng_filters = png_filter == "none"    ? 0x08
+                         : png_filter == "sub"   ? 0x10
+                         : png_filter == "up"    ? 0x20
+                         : png_filter == "paeth" ? 0x80
+                                                 : 0xF8;
+  c.png.row_filter = png_filter == "none" ? PngRowFilter::kNone
+                     : png_filter == "up" ? PngRowFilter::kUp
+                                          : PngRowFilter::kSub;
 
   try {
     RendererOptions ropts;

@@ -151,6 +151,7 @@ struct RenderService::Task {
       o.encode_ms.push_back(encode_ms[i]);
       o.frame_index.push_back(i);
     }
+    o.frame_format = members[0].frame_format;
     o.queue_ms = ms_between(members[0].arrived, start);
     o.render_ms = render_ms;
     o.encode_wall_ms = encode_wall_ms;
@@ -166,10 +167,9 @@ RendererFactory gl_renderer_factory(const RendererOptions& opts) {
 
 
 RenderService::RenderService(RendererFactory factory, int workers, int encode_threads,
-                             int png_level, int png_filters, int max_inflight)
+                             PngSettings png, int max_inflight)
     : factory_(std::move(factory)),
-      png_level_(png_level),
-      png_filters_(png_filters),
+      png_(png),
       max_inflight_(max_inflight),
       idle_release_ms_(kIdleReleaseMs),
       encoders_(static_cast<std::size_t>(std::max(1, encode_threads))) {
@@ -610,7 +610,7 @@ void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer
           png = true;
         }
       }
-      if (png) bytes = encode_png(img, png_level_, png_filters_);
+      if (png) bytes = encode_still(img, job.frame_format);
       const auto t1 = Clock::now();
       bool slice_complete = false;
       {
@@ -625,6 +625,13 @@ void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer
       if (slice_complete) slices_finished(t, slice, 0);
     });
   }
+}
+
+// A frame that is not JPEG: PNG with the server's settings, or the raw
+// samples the connection asked for in hello.
+std::vector<std::uint8_t> RenderService::encode_still(const Image& img, FrameFormat f) const {
+  if (f == FrameFormat::kPng) return encode_png(img, png_);
+  return encode_raw_frame(img.rgb, img.bit_depth, f);
 }
 
 // Marks `slice` done (none: max) and `dropped` more slices finished; sends the
@@ -669,6 +676,7 @@ void RenderService::complete(Task& task) {
     out.render_ms = task.render_ms;
     out.encode_wall_ms = task.encode_wall_ms;
     out.slices = static_cast<int>(task.slices.size());
+    out.frame_format = job.frame_format;
     if (task.cancelled || !job.client_alive->load()) {
       out.dropped = true;
       finish(job, std::move(out));
@@ -696,7 +704,7 @@ void RenderService::complete(Task& task) {
       for (const FrameResult& f : out.frames) images.push_back(&f.image);
       out.atlas = make_atlas(images);
       for (FrameResult& f : out.frames) f.image.rgb = {};
-      out.pngs.push_back(encode_png(out.atlas->image, png_level_, png_filters_));
+      out.pngs.push_back(encode_still(out.atlas->image, job.frame_format));
       out.atlas->image.rgb = {};
       out.is_jpeg.push_back(0);
       out.encode_ms.push_back(ms_between(t0, Clock::now()));

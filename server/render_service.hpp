@@ -29,8 +29,10 @@
 #include "server/threads.hpp"
 
 #include "protocol/errors.hpp"
+#include "protocol/frame_format.hpp"
 #include "protocol/scene.hpp"
 #include "render/atlas.hpp"
+#include "render/image.hpp"
 #include "render/renderer.hpp"
 
 namespace beamcast {
@@ -75,6 +77,8 @@ struct RenderOutcome {
   std::vector<FrameResult> frames;  // images released after encoding
   std::vector<std::vector<std::uint8_t>> pngs;  // encoded frames (JPEG when RenderJob::jpeg)
   std::vector<char> is_jpeg;      // per frame: 1 if encoded as JPEG
+  // The other frames' format: PNG, or what the connection negotiated in hello.
+  FrameFormat frame_format = FrameFormat::kPng;
   std::vector<double> encode_ms;  // per frame
   // The request's camera index of each frame (empty: frame i is camera i).
   // Set for the parts of a streamed job, which carry a slice's frames each.
@@ -108,6 +112,8 @@ struct RenderJob {
   // size of the slices the service renders the job in.
   FrameOptions options;
   bool jpeg = false;       // encode as JPEG (interactive frames) instead of PNG
+  // Frames that are not JPEG: PNG, or raw samples (hello's frame_format).
+  FrameFormat frame_format = FrameFormat::kPng;
   int jpeg_quality = 90;
   std::shared_ptr<const std::atomic<bool>> client_alive;
   std::chrono::steady_clock::time_point arrived;
@@ -140,8 +146,8 @@ struct RenderJob {
 
 class RenderService {
  public:
-  RenderService(RendererFactory factory, int workers, int encode_threads, int png_level,
-                int png_filters, int max_inflight);
+  RenderService(RendererFactory factory, int workers, int encode_threads, PngSettings png,
+                int max_inflight);
   ~RenderService();
 
   // Blocks until every worker has a renderer (or failed to get one); returns
@@ -235,8 +241,8 @@ class RenderService {
   void post_encode(WorkClass c, std::function<void()> fn);
 
   RendererFactory factory_;
-  int png_level_;
-  int png_filters_;
+  std::vector<std::uint8_t> encode_still(const Image& img, FrameFormat f) const;
+  const PngSettings png_;
   int max_inflight_;
   std::chrono::milliseconds batch_window_{0};
   std::atomic<std::int64_t> interactive_window_ms_{1000};

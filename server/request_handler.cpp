@@ -57,8 +57,26 @@ const json& required_object(const json& params, const char* key) {
   return *it;
 }
 
-json hello_result(const ServerCore& core, const json& params) {
-  allow_params(params, {"protocol", "client", "token"}, "hello");
+// hello's params.frame_format (PROTOCOL.md, "Frame formats"), if present.
+std::optional<FrameFormat> hello_frame_format(const json& params) {
+  const auto it = params.find("frame_format");
+  if (it == params.end()) return std::nullopt;
+  std::string names;
+  for (const std::string& n : frame_format_names()) names += (names.empty() ? "\"" : ", \"") + n + "\"";
+  if (!it->is_string()) {
+    fail("wrong_type", "/params/frame_format", "frame_format must be a string: one of " + names);
+  }
+  const auto f = parse_frame_format(it->get_ref<const std::string&>());
+  if (!f) {
+    fail("invalid_value", "/params/frame_format",
+         "unknown frame format (this server offers " + names + ")");
+  }
+  return f;
+}
+
+// `format`: the connection's frame format after this hello.
+json hello_result(const ServerCore& core, const json& params, FrameFormat format) {
+  allow_params(params, {"protocol", "client", "token", "frame_format"}, "hello");
   if (auto c = params.find("client"); c != params.end() && !c->is_string()) {
     fail("wrong_type", "/params/client", "client must be a string (\"name/version\")");
   }
@@ -71,16 +89,21 @@ json hello_result(const ServerCore& core, const json& params) {
   json passes = json::array();
   for (const PassDecl& pass : pass_catalog()) passes.push_back(pass.name);
   json capabilities = {{"formats", {"png", "jpeg"}},
+                       {"frame_formats", frame_format_names()},
+                       {"png_encoder", core.config.png.encoder == PngEncoder::kLibdeflate
+                                           ? "libdeflate"
+                                           : "libpng"},
                        {"quality", {"full", "auto"}},
                        {"encodings", {"binary", "base64"}},
                        {"batch_window_ms", core.config.batch_window_ms},
                        {"stream", true},
-                       {"scheduling", {{"classes", {"interactive", "batch"}}, {"slice_views", core.config.slice_views}, {"slice_pixels", core.config.slice_pixels}, {"hold_batch_encodes", core.config.hold_batch_encodes}}},
+                       {"scheduling", {{"classes", {"interactive", "batch"}}, {"slice_views", core.config.slice_views}, {"slice_pixels", core.config.slice_pixels}, {"hold_batch_encodes", core.config.hold_batch_encodes}, {"encode_threads", core.config.encode_threads}}},
                        {"passes", passes}};
   capabilities.update(scene_capabilities());
   return {{"protocol", kProtocolVersion},
           {"server", "beamcast-server 0.1.0"},
           {"renderer", core.renderer_description},
+          {"frame_format", frame_format_name(format)},
           {"methods", request_methods()},
           {"capabilities", capabilities},
           {"limits", limits_json(core.config)}};
@@ -228,6 +251,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   job.cameras = cameras;
   job.client_alive = session->alive_flag();
   job.atlas = rp.atlas;
+  job.frame_format = session->frame_format();
   job.arrived = arrived;
   job.deadline = arrived + std::chrono::milliseconds(core.config.max_render_ms);
   job.scene_path = rp.scene ? "/params/scene" : "/params/scene_id";
@@ -354,9 +378,12 @@ void run_method(ServerCore& core, const std::shared_ptr<Connection>& session, Re
                 const json& id, const std::string& method, Clock::time_point arrived) {
   const json& params = req.params;
   if (req.method == "hello") {
-    json result = hello_result(core, params);
-    // Only a hello that succeeded (token and protocol) authenticates.
+    const std::optional<FrameFormat> format = hello_frame_format(params);
+    json result = hello_result(core, params, format.value_or(session->frame_format()));
+    // Only a hello that succeeded (token and protocol) authenticates, or
+    // sets the frame format.
     if (token_required(core.config)) session->set_authenticated();
+    if (format) session->set_frame_format(*format);
     session->send(ok_response(id, std::move(result)));
   } else if (req.method == "ping") {
     json result = json::object();
@@ -380,6 +407,7 @@ void run_method(ServerCore& core, const std::shared_ptr<Connection>& session, Re
         {"interactive", core.renders->queued(WorkClass::kInteractive)},
         {"batch", core.renders->queued(WorkClass::kBatch)}};
     s["renderer_rebuilds"] = core.renders->renderer_rebuilds();
+    s["encode_threads"] = core.config.encode_threads;
     s["scenes"] = {{"count", core.scenes.count()}, {"bytes", core.scenes.bytes()}};
     session->send(ok_response(id, std::move(s)));
   } else if (req.method == "render") {

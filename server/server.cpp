@@ -33,6 +33,10 @@ Server::Server(const ServerConfig& config, RendererFactory renderers)
       drain_timer_(io_),
       http_(std::make_unique<HttpServer>(io_, core_)) {
   configure_allocator();
+  ServerConfig& c = core_.config;
+  if (c.encode_threads <= 0) {
+    c.encode_threads = default_encode_threads(usable_cores(), c.render_workers, c.network_threads);
+  }
   register_preview_routes(*http_, core_);
   register_metrics_routes(*http_, core_);
 }
@@ -61,8 +65,7 @@ unsigned short Server::start() {
     http_->enable_tls(c.tls_cert_file, c.tls_key_file);  // before any port is bound
   }
   core_.renders = std::make_unique<RenderService>(factory_, c.render_workers, c.encode_threads,
-                                                  c.png_level, c.png_filters,
-                                                  c.max_inflight_total);
+                                                  c.png, c.max_inflight_total);
   core_.renders->set_batch_window(std::chrono::milliseconds(c.batch_window_ms),
                                   c.scene_limits.max_cameras);
   core_.renders->set_hold_batch_encodes(c.hold_batch_encodes);

@@ -1,7 +1,11 @@
 #include "server/threads.hpp"
 
+#include <sched.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <system_error>
+#include <thread>
 #include <utility>
 
 namespace beamcast {
@@ -14,6 +18,17 @@ void* trampoline(void* arg) {
 }
 
 }  // namespace
+
+int usable_cores() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+int default_encode_threads(int cores, int render_workers, int network_threads) {
+  return std::max(2, cores - render_workers - network_threads);
+}
 
 SizedThread::SizedThread(std::function<void()> fn, std::size_t stack_bytes) {
   pthread_attr_t attr;

@@ -21,6 +21,14 @@ namespace beamcast {
 
 inline constexpr std::size_t kServerThreadStackBytes = 8u << 20;
 
+// Cores this process may run on (its affinity mask; hardware_concurrency if
+// that cannot be read).
+int usable_cores();
+// The encode pool's default size (--encode-threads 0): the cores less one per
+// render worker and per network thread, at least 2 (one frame encodes while
+// the next one's slice is handed over; 2 was the default before issue 39).
+int default_encode_threads(int cores, int render_workers, int network_threads);
+
 class SizedThread {
  public:
   // Starts `fn` on a new thread with a stack of `stack_bytes`; throws

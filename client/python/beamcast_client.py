@@ -4,6 +4,7 @@
 As a module:
     c = BeamcastClient("127.0.0.1", 7878)
     frames, result = c.render(scene_id="demo")   # frames: list of dicts with "png" bytes
+    c.hello(frame_format="raw")    # later frames: dicts with "raw" samples (raw_to_png writes one)
 As a script:
     beamcast_client.py --server 127.0.0.1:7878 --scene-id demo --out /tmp/frame.png
     beamcast_client.py --server 127.0.0.1:7878 --scene scene.json --out /tmp/frame.png
@@ -18,6 +19,7 @@ import struct
 import sys
 import threading
 import time
+import zlib
 
 MAGIC = b"BCP1"
 HEADER = struct.Struct(">4sII")  # magic, json_length, binary_length (big-endian)
@@ -31,6 +33,49 @@ class ServerError(Exception):
         self.message = error.get("message", "")
         self.path = error.get("path", "")
         super().__init__(f"[{self.code}] {self.path + ': ' if self.path else ''}{self.message}")
+
+
+def raw_frame_bytes(width, height, bit_depth):
+    """Bytes of a "raw" frame: RGB, rows from the top, 1 byte a sample at bit
+    depth 8, 2 little-endian bytes at 16 (PROTOCOL.md, "Frame formats")."""
+    return width * height * 3 * (bit_depth // 8)
+
+
+def unpack_raw_frame(data, fmt, width, height, bit_depth):
+    """The raw bytes of a "raw" or "raw_zstd" frame, checked against its size."""
+    expected = raw_frame_bytes(width, height, bit_depth)
+    if fmt == "raw_zstd":
+        try:
+            import zstandard  # Debian: python3-zstandard; not in the standard library
+        except ImportError as e:
+            raise RuntimeError("raw_zstd frames need the zstandard module (Debian: "
+                               "python3-zstandard); ask for frame_format \"raw\" instead") from e
+        size = zstandard.get_frame_parameters(data).content_size
+        if size != expected:
+            raise ValueError(f"raw_zstd frame holds {size} bytes, expected {expected}")
+        data = zstandard.ZstdDecompressor().decompress(data, max_output_size=expected)
+    elif fmt != "raw":
+        raise ValueError(f"not a raw frame format: {fmt!r}")
+    if len(data) != expected:
+        raise ValueError(f"raw frame of {len(data)} bytes, expected {expected}")
+    return bytes(data)
+
+
+def raw_to_png(raw, width, height, bit_depth, level=1):
+    """A PNG (RGB, no filter) of a raw frame's bytes, with zlib: lossless."""
+    if bit_depth == 16:  # raw is little-endian, PNG big-endian
+        swapped = bytearray(raw)
+        swapped[0::2], swapped[1::2] = raw[1::2], raw[0::2]
+        raw = bytes(swapped)
+    stride = width * 3 * (bit_depth // 8)
+    lines = b"".join(b"\x00" + raw[y * stride:(y + 1) * stride] for y in range(height))
+
+    def chunk(kind, body):
+        return (struct.pack(">I", len(body)) + kind + body +
+                struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF))
+    ihdr = struct.pack(">IIBBBBB", width, height, bit_depth, 2, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) +
+            chunk(b"IDAT", zlib.compress(lines, level)) + chunk(b"IEND", b""))
 
 
 class BeamcastClient:
@@ -104,8 +149,13 @@ class BeamcastClient:
         return msg.get("result", {}), binary
 
     # --- methods ---
-    def hello(self, client="beamcast-py/0.1.0"):
-        return self.call("hello", {"protocol": 1, "client": client})[0]
+    def hello(self, client="beamcast-py/0.1.0", frame_format=None):
+        """frame_format "raw" or "raw_zstd": this connection's frames come as
+        samples (frames then have "raw" bytes instead of "png")."""
+        params = {"protocol": 1, "client": client}
+        if frame_format is not None:
+            params["frame_format"] = frame_format
+        return self.call("hello", params)[0]
 
     def ping(self, payload=None):
         return self.call("ping", payload if payload is not None else {})[0]
@@ -117,7 +167,8 @@ class BeamcastClient:
         return self.call("scene.put", {"scene_id": scene_id, "scene": scene})[0]
 
     def render(self, scene=None, scene_id=None, encoding="binary", cameras=None, output=None):
-        """Returns (frames, result); each frame is the server's dict plus "png" bytes,
+        """Returns (frames, result); each frame is the server's dict plus "png" bytes
+        (a "raw" or "raw_zstd" frame: "raw", its unpacked bytes; raw_to_png makes a PNG),
         result["client_e2e_ms"] is the client-measured wall time of the request."""
         if (scene is None) == (scene_id is None):
             raise ValueError("give exactly one of scene, scene_id")
@@ -137,9 +188,15 @@ class BeamcastClient:
                 off, n = f["attachment"]["offset"], f["attachment"]["length"]
                 if off + n > len(binary):
                     raise ConnectionError(f"frame {f['camera']}: attachment outside binary part")
-                f["png"] = binary[off:off + n]
+                data = binary[off:off + n]
             else:
-                f["png"] = base64.b64decode(f["data_base64"], validate=True)
+                data = base64.b64decode(f["data_base64"], validate=True)
+            fmt = f.get("format", "png")
+            if fmt in ("raw", "raw_zstd"):
+                f["raw"] = unpack_raw_frame(data, fmt, f["width"], f["height"],
+                                            f.get("bit_depth", 8))
+            else:
+                f["png"] = data
             frames.append(f)
         return frames, result
 
@@ -262,6 +319,8 @@ def main(argv=None):
     src.add_argument("--scene-id", help="a scene stored on the server (e.g. demo)")
     ap.add_argument("--out", default="frame.png", help="where the first frame's PNG goes")
     ap.add_argument("--encoding", choices=["binary", "base64"], default="binary")
+    ap.add_argument("--frame-format", choices=["png", "raw", "raw_zstd"], default="png",
+                    help="raw, raw_zstd: the server sends samples, the PNG is written here")
     args = ap.parse_args(argv)
     try:
         host, port = parse_server(args.server)
@@ -273,11 +332,17 @@ def main(argv=None):
             scene = json.load(f)
     try:
         with BeamcastClient(host, port) as c:
+            if args.frame_format != "png":
+                c.hello(frame_format=args.frame_format)
             frames, result = c.render(scene=scene, scene_id=args.scene_id, encoding=args.encoding)
+            first = frames[0]
+            if "raw" in first:
+                first["png"] = raw_to_png(first["raw"], first["width"], first["height"],
+                                          first.get("bit_depth", 8))
     except ServerError as e:
         print(f"server error {e}", file=sys.stderr)
         return 2
-    except (OSError, ValueError) as e:
+    except (OSError, ValueError, RuntimeError) as e:
         print(f"beamcast_client: {args.server}: {e}", file=sys.stderr)
         return 1
     with open(args.out, "wb") as f:

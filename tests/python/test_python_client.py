@@ -7,6 +7,7 @@ Starts the server on an ephemeral port (--port 0), runs the checks below, sends
 SIGTERM and expects exit status 0 within 15 s. Plain python3, no pytest: prints
 "N passed, M failed" and exits 0 only if everything passed.
 """
+import json
 import os
 import signal
 import socket
@@ -14,10 +15,13 @@ import struct
 import subprocess
 import sys
 import traceback
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "client", "python"))
-from beamcast_client import BeamcastClient, ResilientClient, RetryBudget, ServerError  # noqa: E402
+import beamcast_client  # noqa: E402
+from beamcast_client import (BeamcastClient, ResilientClient, RetryBudget, ServerError,  # noqa: E402
+                             raw_to_png)
 from local_server import start_server  # noqa: E402
 
 # One sphere beam seen from the front by one 64x64 camera.
@@ -45,6 +49,72 @@ def check_frames(frames, result):
             f"{f['camera']}: IHDR {w}x{h}, response says {f['width']}x{f['height']}"
         assert depth == f.get("bit_depth", 8), f"{f['camera']}: IHDR bit depth {depth}"
     assert "server_ms" in result["timings"], result.get("timings")
+
+
+def png_samples(data):
+    """The sample bytes (16-bit: little-endian, as raw frames) of an RGB PNG
+    without interlace: a minimal decoder (IDAT, the five row filters)."""
+    w, h, depth = png_size(data)
+    pos, idat = 8, b""
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        if kind == b"IDAT":
+            idat += data[pos + 8:pos + 8 + n]
+        pos += 12 + n
+    lines, bpp = zlib.decompress(idat), 3 * depth // 8
+    stride, out, prev = w * bpp, bytearray(), bytearray(w * bpp)
+    for y in range(h):
+        ftype, row = lines[y * (stride + 1)], bytearray(lines[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = row[i - bpp] if i >= bpp else 0
+            b, c = prev[i], prev[i - bpp] if i >= bpp else 0
+            p = a + b - c
+            pred = [0, a, b, (a + b) // 2,
+                    a if abs(p - a) <= abs(p - b) and abs(p - a) <= abs(p - c)
+                    else b if abs(p - b) <= abs(p - c) else c][ftype]
+            row[i] = (row[i] + pred) & 0xFF
+        out += row
+        prev = row
+    if depth == 16:  # PNG is big-endian
+        out[0::2], out[1::2] = out[1::2], out[0::2]
+    return bytes(out)
+
+
+def test_raw_frames(c):
+    """hello frame_format raw / raw_zstd: the frame's samples equal the PNG's."""
+    host, port = c.sock.getpeername()[:2]
+    for depth in (8, 16):
+        frames, _ = c.render(scene=TINY_SCENE, output={"bit_depth": depth})
+        want = png_samples(frames[0]["png"])
+        for fmt in ("raw", "raw_zstd"):
+            with BeamcastClient(host, port, timeout=120) as rc:
+                assert rc.hello(frame_format=fmt)["frame_format"] == fmt
+                got, _ = rc.render(scene=TINY_SCENE, output={"bit_depth": depth})
+            assert got[0]["format"] == fmt and "png" not in got[0], got[0].keys()
+            assert got[0]["raw"] == want, f"{fmt} at {depth} bits differs from the PNG"
+            assert png_samples(raw_to_png(got[0]["raw"], 64, 64, depth)) == want
+
+
+def test_raw_frames_script_and_refusal(c):
+    host, port = c.sock.getpeername()[:2]
+    base = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"beamcast_raw_{os.getpid()}")
+    with open(base + ".json", "w") as f:
+        json.dump(TINY_SCENE, f)
+    rc = beamcast_client.main(["--server", f"{host}:{port}", "--scene", base + ".json",
+                               "--frame-format", "raw_zstd", "--out", base + ".png"])
+    assert rc == 0, rc
+    with open(base + ".png", "rb") as f:
+        written = f.read()
+    os.unlink(base + ".png")
+    os.unlink(base + ".json")
+    frames, _ = c.render(scene=TINY_SCENE)
+    assert png_samples(written) == png_samples(frames[0]["png"])
+    try:
+        c.hello(frame_format="webp")
+    except ServerError as e:
+        assert (e.code, e.path) == ("invalid_value", "/params/frame_format"), (e.code, e.path)
+        return
+    raise AssertionError("frame_format webp was accepted")
 
 
 def test_hello(c):
@@ -122,7 +192,8 @@ def main():
     proc, port = start_server(sys.argv[1:2] + sys.argv[2:], echo=True)
     passed = failed = 0
     tests = [test_hello, test_ping, test_render_demo_binary, test_render_inline_base64,
-             test_bad_scene_names_path, test_pipelined_by_id, test_resilient_client]
+             test_bad_scene_names_path, test_pipelined_by_id, test_resilient_client,
+             test_raw_frames, test_raw_frames_script_and_refusal]
     try:
         with BeamcastClient("127.0.0.1", port, timeout=120) as c:
             for t in tests:

@@ -185,7 +185,7 @@ RenderJob hold_job(const std::shared_ptr<const Scene>& scene, WorkClass cls, std
 
 void check_encode_hold(bool hold) {
   auto control = std::make_shared<test::FakeRendererControl>();
-  RenderService service(test::fake_renderer_factory(control), 2, 1, 2, 0x10, 16);
+  RenderService service(test::fake_renderer_factory(control), 2, 1, PngSettings{}, 16);
   service.wait_ready();
   service.set_hold_batch_encodes(hold);
   const auto scene = std::make_shared<const Scene>(parse_scene(test::tiny_scene(8), {}));
