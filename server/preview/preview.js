@@ -51,7 +51,7 @@ let ws = null;
 let nextId = 1;
 const pending = new Map();  // id -> {resolve, reject, sent, camera}
 let awaitingBinary = null;  // a response whose attachments come in the next binary message
-let orbit = null;           // {target, yaw, pitch, dist, up, fov, near, far, projection, ortho}
+let orbit = null;           // {target, dist, up, e1, e2, yaw, pitch, initial, moved}: orbitFromCamera
 let lastSentKey = null;
 let lastSentAt = 0;
 let lastChangeAt = 0;       // when the pose last changed
@@ -179,45 +179,67 @@ const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
 const norm = (a) => mul(a, 1 / Math.hypot(a[0], a[1], a[2]));
 
-// Forward vector (-Z) of a (w, x, y, z) rotation.
+// Forward (-Z) and up (+Y) vectors of a (w, x, y, z) rotation.
 function quatForward(q) {
   const [w, x, y, z] = q;
   return [-(2 * (x * z + w * y)), -(2 * (y * z - w * x)), -(1 - 2 * (x * x + y * y))];
 }
+function quatUp(q) {
+  const [w, x, y, z] = q;
+  return [2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x)];
+}
 
+// The orbit of a scene camera: around its target, about the camera's own up
+// axis (its `up`, default +Y, or its rotation's up), so a Z-up scene turns
+// about Z. yaw and pitch are angles in the frame (e1, e2, up) where e1 is the
+// initial horizontal direction from the target to the camera: the initial
+// pose is yaw 0 and its own pitch. `initial` is the scene's camera as given
+// (at the canvas size): the view until the user moves, and after a reset, so
+// the first frame is the scene's own camera bit for bit, not a recomputation.
 function orbitFromCamera(cam) {
   const position = cam.position || [0, 0, 5];
   let target = cam.target;
-  if (!target) {
-    const f = cam.rotation ? quatForward(cam.rotation) : [0, 0, -1];
-    target = add(position, mul(norm(f), Math.hypot(...position) || 5));
+  let up = cam.up || [0, 1, 0];
+  if (cam.rotation) {
+    target = add(position, mul(norm(quatForward(cam.rotation)), Math.hypot(...position) || 5));
+    up = quatUp(cam.rotation);
+  } else if (!target) {
+    target = add(position, [0, 0, -(Math.hypot(...position) || 5)]);
   }
+  up = norm(up);
   const d = sub(position, target);
   const dist = Math.hypot(d[0], d[1], d[2]) || 1;
+  // The horizontal part of d; looking straight along up, any axis normal to it.
+  let h = sub(d, mul(up, dot(d, up)));
+  if (Math.hypot(...h) < 1e-9 * dist) h = cross(up, Math.abs(up[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0]);
+  const e1 = norm(h);
+  const initial = {...cam, name: 'preview', width: size, height: size};
   return {
-    target, dist,
-    yaw: Math.atan2(d[0], d[2]),
-    pitch: Math.asin(Math.max(-1, Math.min(1, d[1] / dist))),
-    fov: cam.fov_y, near: cam.near, far: cam.far, projection: cam.projection,
-    ortho: cam.ortho_height,
+    target, dist, up, e1, e2: cross(up, e1),
+    yaw: 0,
+    pitch: Math.asin(Math.max(-1, Math.min(1, dot(d, up) / dist))),
+    initial, moved: false,
   };
 }
 
 function cameraFromOrbit(o) {
-  const dir = [Math.sin(o.yaw) * Math.cos(o.pitch), Math.sin(o.pitch), Math.cos(o.yaw) * Math.cos(o.pitch)];
-  const cam = {
-    name: 'preview',
-    position: add(o.target, mul(dir, o.dist)).map((v) => +v.toFixed(6)),
-    target: o.target.map((v) => +v.toFixed(6)),
-    up: [0, 1, 0],
-    width: size, height: size,
-  };
-  if (o.fov !== undefined) cam.fov_y = o.fov;
-  if (o.near !== undefined) cam.near = o.near;
-  if (o.far !== undefined) cam.far = o.far;
-  if (o.projection !== undefined) cam.projection = o.projection;
-  if (o.ortho !== undefined) cam.ortho_height = o.ortho;
+  if (!o.moved) return {...o.initial};
+  const c = Math.cos(o.pitch);
+  const dir = add(mul(o.up, Math.sin(o.pitch)),
+                  add(mul(o.e1, c * Math.cos(o.yaw)), mul(o.e2, c * Math.sin(o.yaw))));
+  const cam = {...o.initial};
+  delete cam.rotation;
+  cam.position = add(o.target, mul(dir, o.dist)).map((v) => +v.toFixed(6));
+  cam.target = o.target.map((v) => +v.toFixed(6));
+  cam.up = o.up.map((v) => +v.toFixed(6));
   return cam;
+}
+
+// Back to the scene's camera (the reset-view key and button).
+function resetView() {
+  if (!orbit) return;
+  orbit = orbitFromCamera(orbit.initial);
+  maybeSend();
 }
 
 // --- input ------------------------------------------------------------------
@@ -239,16 +261,20 @@ canvas.addEventListener('pointermove', (e) => {
   const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
   drag.x = e.clientX;
   drag.y = e.clientY;
+  if (!dx && !dy) return;
+  orbit.moved = true;
+  const cam = cameraFromOrbit(orbit);
   if (drag.pan) {
-    const cam = cameraFromOrbit(orbit);
     const f = norm(sub(cam.target, cam.position));
-    const right = norm(cross(f, [0, 1, 0]));
+    const right = norm(cross(f, orbit.up));
     const up = cross(right, f);
-    const s = orbit.dist * 2 * Math.tan(((orbit.fov || 45) * Math.PI) / 360) / size;
+    const s = orbit.dist * 2 * Math.tan(((cam.fov_y || 45) * Math.PI) / 360) / canvas.clientHeight;
     orbit.target = add(orbit.target, add(mul(right, -dx * s), mul(up, dy * s)));
   } else {
-    orbit.yaw -= dx * 0.01;
-    orbit.pitch = Math.max(-1.55, Math.min(1.55, orbit.pitch + dy * 0.01));
+    // A drag across the whole canvas turns the camera by 180 degrees.
+    const k = Math.PI / canvas.clientWidth;
+    orbit.yaw -= dx * k;
+    orbit.pitch = Math.max(-1.55, Math.min(1.55, orbit.pitch + dy * k));
   }
   maybeSend();
 });
@@ -258,9 +284,16 @@ canvas.addEventListener('pointercancel', endDrag);
 canvas.addEventListener('wheel', (e) => {
   if (!orbit) return;
   e.preventDefault();
+  orbit.moved = true;
   orbit.dist *= Math.exp(e.deltaY * 0.001);
   maybeSend();
 }, {passive: false});
+// R or Home: back to the scene's camera.
+document.addEventListener('keydown', (e) => {
+  if (e.target instanceof HTMLSelectElement || e.ctrlKey || e.metaKey || e.altKey) return;
+  if (e.key === 'r' || e.key === 'R' || e.key === 'Home') resetView();
+});
+document.getElementById('reset').addEventListener('click', resetView);
 
 // --- frames -----------------------------------------------------------------
 
