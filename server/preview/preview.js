@@ -25,6 +25,7 @@ const ctx2d = canvas.getContext('2d');
 const overlay = document.getElementById('overlay');
 const statusEl = document.getElementById('status');
 const picker = document.getElementById('scene');
+const errorEl = document.getElementById('error');
 canvas.width = size;
 canvas.height = size;
 
@@ -403,6 +404,9 @@ async function getJson(path) {
   return res.json();
 }
 
+// The stored id of an example the page stores: `example.` + its name.
+const exampleId = (name) => 'example.' + name.replace(/\.json$/, '').replace(/[^A-Za-z0-9_.-]/g, '_');
+
 // Makes `value` (a picker value) the scene rendered on this WebSocket: an
 // example is stored on the server first. The view is the scene's first camera,
 // except when the same scene is established again after a reconnection, where
@@ -416,7 +420,7 @@ async function selectScene(value) {
   if (value.startsWith('example:')) {
     const name = value.slice(8);
     json = await getJson('/api/examples/' + encodeURIComponent(name));
-    id = 'example.' + name.replace(/\.json$/, '').replace(/[^A-Za-z0-9_.-]/g, '_');
+    id = exampleId(name);
     await request('scene.put', {scene_id: id, scene: json});
   } else {
     id = value.slice(7);
@@ -433,7 +437,50 @@ async function selectScene(value) {
     resumed = true;
   }
   setStatus(`connected · scene ${preview.sceneId}`);
+  errorEl.hidden = true;
   preview.ready = true;
+}
+
+// The picker: stored scenes, then the examples. The copies this page stored
+// of examples (`example.NAME`) are not listed twice: picking the example
+// stores it again.
+function fillPicker(list) {
+  picker.innerHTML = '';
+  for (const id of ownStored(list)) picker.add(new Option('stored: ' + id, 'stored:' + id));
+  for (const name of list.examples) picker.add(new Option('example: ' + name, 'example:' + name));
+}
+
+// The stored scenes other than this page's copies of examples.
+function ownStored(list) {
+  const copies = new Set(list.examples.map(exampleId));
+  return list.stored.filter((id) => !copies.has(id));
+}
+
+// The picker value for `?scene=NAME`: a stored id, an example file name, or
+// an example's name without `.json`; null if there is none.
+function pickerValue(list, want) {
+  if (list.stored.includes(want)) return 'stored:' + want;
+  if (list.examples.includes(want)) return 'example:' + want;
+  if (list.examples.includes(want + '.json')) return 'example:' + want + '.json';
+  const copy = list.examples.find((n) => exampleId(n) === want);
+  return copy ? 'example:' + copy : null;
+}
+
+// The bare URL opens the demo: the stored `demo` (beamcast-server preloads it
+// unless --no-demo), else its example file, else the first scene listed.
+function defaultScene(list) {
+  return pickerValue(list, 'demo') || pickerValue(list, 'paper_10sets.json') ||
+         (list.stored[0] ? 'stored:' + list.stored[0] : null) ||
+         (list.examples[0] ? 'example:' + list.examples[0] : null);
+}
+
+// A visible error over the canvas (and in the status line); cleared when a
+// scene is established.
+function showError(text) {
+  setStatus('error', 'error');
+  preview.errors[preview.errors.length - 1] = text;
+  errorEl.textContent = text;
+  errorEl.hidden = false;
 }
 
 // On every open WebSocket: the first time fills the picker and starts the
@@ -442,17 +489,20 @@ async function establish(sock) {
   try {
     if (!started) {
       const list = await getJson('/api/scenes');
-      picker.innerHTML = '';
-      for (const id of list.stored) picker.add(new Option('stored: ' + id, 'stored:' + id));
-      for (const name of list.examples) picker.add(new Option('example: ' + name, 'example:' + name));
+      fillPicker(list);
       const want = params.get('scene');
-      if (want) {
-        const v = list.stored.includes(want) ? 'stored:' + want : 'example:' + want;
-        picker.value = v;
+      const value = want ? pickerValue(list, want) : defaultScene(list);
+      if (!value) {
+        showError(`No scene "${want}" on this server. Stored scenes: ${ownStored(list).join(', ') || 'none'}. ` +
+                  `Examples: ${list.examples.join(', ') || 'none'}. ` +
+                  'Pick one above, or open the page with ?scene=NAME.');
+        picker.value = '';
+      } else {
+        picker.value = value;
       }
       picker.onchange = () => selectScene(picker.value).catch((e) => {
         // Without a WebSocket the reconnection establishes the picked scene.
-        if (e.code !== 'disconnected') setStatus(String(e.message || e), 'error');
+        if (e.code !== 'disconnected') showError(`scene ${sceneKey()}: ${e.code || ''} ${e.message || e}`);
       });
       started = true;
       requestAnimationFrame(tick);
@@ -464,7 +514,7 @@ async function establish(sock) {
     if (e.code) {
       // The server refused the scene or has none by that name: another
       // attempt would get the same answer.
-      setStatus(`scene: ${e.code}: ${e.message}`, 'error');
+      showError(`scene ${sceneKey()}: ${e.code}: ${e.message}`);
       return;
     }
     // A fetch failed: start over on a new WebSocket, after the backoff.

@@ -14,6 +14,8 @@
 //     about the scene's up axis (height along it and distance kept),
 //  6. the reset key returns the initial view: the same camera, the same
 //     still frame byte for byte,
+//  7. an unknown ?scene= shows a visible error naming the scene and what is
+//     available, and ?scene=NAME without .json finds NAME.json.
 //
 // node preview_test.mjs --server BIN --cli BIN --artifacts DIR
 //     [--scene demo] [--size 512] [--drag-ms 2000] [--budget 33]
@@ -143,6 +145,28 @@ async function checkTurnAndReset(page, initial, cx, cy, width) {
         'the reset button returns the initial view (same camera, same still frame bytes)');
 }
 
+// 7. Scene names in the URL, on pages of their own (one browser).
+async function checkSceneNames(context) {
+  const page = await context.newPage();
+  // At 64x64: these pages' frames are not looked at.
+  await page.goto(`${server.url}?scene=nope&size=64`);
+  let text = '';
+  try {
+    await page.locator('#error').waitFor({state: 'visible', timeout: 10000});
+    text = await page.locator('#error').innerText();
+  } catch {
+    text = '(no visible error)';
+  }
+  await page.screenshot({path: path.join(artifacts, 'unknown_scene.png')});
+  check(text.includes('"nope"') && text.includes('demo') && text.includes('cornell_box.json'),
+        `an unknown scene shows a visible error naming it and what is available: ${text}`);
+  await page.goto(`${server.url}?scene=cornell_box&size=64`);
+  const found = await page.waitForFunction(() => window.beamcastPreview.sceneId, null,
+                                           {timeout: 30000}).then((h) => h.jsonValue(), () => null);
+  check(found === 'example.cornell_box', `?scene=cornell_box opens cornell_box.json (${found})`);
+  await page.close();
+}
+
 let server = null;
 let context = null;
 const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'beamcast-preview-'));
@@ -257,6 +281,7 @@ try {
   }
   await page.screenshot({path: path.join(artifacts, 'example_scene.png')});
   check(picked, 'picking an example scene stores it and shows its full-accuracy frame');
+  if (viewChecks) await checkSceneNames(context);
   fs.writeFileSync(path.join(artifacts, 'result.json'), JSON.stringify(result, null, 2));
 } catch (e) {
   failures.push(String(e.stack || e));
