@@ -62,6 +62,7 @@ let inflight = 0;
 let drawing = Promise.resolve();
 let started = false;        // the picker is filled and the animation loop runs
 let viewOf = null;          // the picker value whose view `orbit` holds
+let sceneJson = null;       // the selected scene (the overlay leaves out what it lacks)
 let selectSeq = 0;          // the latest selectScene call; earlier ones give way
 let attempt = 0;            // connection attempts since a scene was last established
 
@@ -319,6 +320,7 @@ async function show(res, camera, socket) {
   preview.frames.push({
     t: now, latency_ms: received - sent, level: q.level, levels: q.levels, still: !!q.still,
     reason: q.reason, label: q.label, scale: q.scale, format: f.format, bytes: data.length,
+    frame_ms: q.frame_ms, budget_ms: q.budget_ms,
     server_ms: r.timings.server_ms, passes: r.passes, socket,
   });
   if (q.still) {
@@ -330,6 +332,33 @@ async function show(res, camera, socket) {
   updateOverlay();
 }
 
+// A level's label (server/accuracy_controller.cpp) in words, without what does
+// not apply to this scene (a beam table on a scene without beams).
+function describeLevel(label, scale) {
+  const words = [];
+  const volume = [];
+  const hasBeams = !!(sceneJson && Array.isArray(sceneJson.beams) && sceneJson.beams.length);
+  for (const part of (label || '').split('@')[0].split('+')) {
+    let m;
+    if ((m = /^table(\d+)x(\d+)$/.exec(part))) {
+      if (hasBeams) words.push(`beams from a ${m[1]}x${m[2]} table`);
+    } else if ((m = /^march(\d+)$/.exec(part))) {
+      if (hasBeams) words.push(`beams with ${m[1]} samples`);
+    } else if ((m = /^photons(\S+)$/.exec(part))) {
+      words.push(`${m[1]} of the photons`);
+    } else if (part === 'lod') {
+      words.push('fewer near photons');
+    } else if ((m = /^sz(\S+)$/.exec(part))) {
+      volume.push(`${m[1]} sample per voxel`);
+    } else if ((m = /^rv(\d+)$/.exec(part))) {
+      volume.push(`resolution level ${m[1]}`);
+    }
+  }
+  if (volume.length) words.push(`volume: ${volume.join(' and ')}`);
+  if (scale < 1) words.push(`${scale === 0.75 ? '3/4' : scale === 0.5 ? '1/2' : scale === 0.25 ? '1/4' : scale} resolution`);
+  return words.join(', ');
+}
+
 function updateOverlay() {
   const fr = preview.frames;
   const now = performance.now();
@@ -339,12 +368,32 @@ function updateOverlay() {
   const latency = recent.reduce((s, x) => s + x.latency_ms, 0) / Math.max(1, recent.length);
   const last = fr[fr.length - 1];
   if (!last) return;
+  // Level 0 is full accuracy; the server's ladder goes down to levels - 1.
+  let accuracy;
+  if (last.still || last.level === 0) {
+    accuracy = 'full accuracy' + (last.still ? ' (still frame)' : '');
+  } else {
+    const what = describeLevel(last.label, last.scale);
+    accuracy = `reduced accuracy: step ${last.level} of ${last.levels - 1} below full` +
+               (what ? `\n  ${what}` : '');
+  }
+  // Moving frames against the frame budget: the latest, and the share of the
+  // last ten moving frames that took longer.
+  const moving = fr.filter((f) => !f.still).slice(-10);
+  const over = moving.filter((f) => f.frame_ms > f.budget_ms).length;
+  let budget = '';
+  if (!last.still && last.budget_ms > 0) {
+    const miss = last.frame_ms > last.budget_ms;
+    budget = `frame ${last.frame_ms.toFixed(0)} ms / budget ${last.budget_ms} ms` +
+             (miss ? '  OVER BUDGET' : '') + '\n' +
+             (over ? `${over} of the last ${moving.length} moving frames over budget\n` : '');
+    overlay.classList.toggle('over', miss);
+  } else {
+    overlay.classList.remove('over');
+  }
   overlay.textContent =
-      `FPS ${n}  latency ${latency.toFixed(0)} ms\n` +
-      `quality ${last.level}/${last.levels - 1} ${last.label || ''} (${last.reason})` +
-      `${last.still ? ' FULL' : ''}\n` +
-      `${last.format} ${(last.bytes / 1024).toFixed(0)} KiB  server ${last.server_ms.toFixed(0)} ms\n` +
-      `passes ${last.passes.join(' ')}`;
+      `${n} frames/s  latency ${latency.toFixed(0)} ms\n${accuracy}\n${budget}` +
+      `${last.format} ${(last.bytes / 1024).toFixed(0)} KiB  server ${last.server_ms.toFixed(0)} ms`;
 }
 
 function tick() {
@@ -428,6 +477,7 @@ async function selectScene(value) {
   }
   if (seq !== selectSeq) return;  // a later pick or reconnection took over
   preview.sceneId = id;
+  sceneJson = json;
   if (viewOf !== value) {
     const cams = json.cameras || [];
     orbit = orbitFromCamera(cams[0] || {});

@@ -15,7 +15,9 @@
 //  6. the reset key returns the initial view: the same camera, the same
 //     still frame byte for byte,
 //  7. an unknown ?scene= shows a visible error naming the scene and what is
-//     available, and ?scene=NAME without .json finds NAME.json.
+//     available, and ?scene=NAME without .json finds NAME.json,
+//  8. the overlay while dragging names the reduced accuracy in words and the
+//     budget, with no beam table for a scene without beams.
 //
 // node preview_test.mjs --server BIN --cli BIN --artifacts DIR
 //     [--scene demo] [--size 512] [--drag-ms 2000] [--budget 33]
@@ -207,6 +209,7 @@ try {
   await dragFor(dragMs, 100);
   const t1 = await page.evaluate(() => performance.now());
   await page.screenshot({path: path.join(artifacts, 'dragging.png')});
+  const movingOverlay = await page.locator('#overlay').innerText();
   await page.mouse.up();
   const tRelease = await page.evaluate(() => performance.now());
 
@@ -264,7 +267,17 @@ try {
   const offline = fs.readFileSync(path.join(offlineDir, `${still.camera.name}.png`));
   result.still_pixel_identical = checkIdentical(stillPng, offline, 'still frame');
 
-  if (viewChecks) await checkTurnAndReset(page, initial, cx, cy, box.width);
+  if (viewChecks) {
+    // 8. The overlay in words: a reduced level says so and names its budget,
+    // and a scene without beams shows no beam table.
+    const src = fileURLToPath(new URL(`../../examples/${sceneId}`, import.meta.url));
+    const hasBeams = (JSON.parse(fs.readFileSync(src, 'utf8')).beams || []).length > 0;
+    check(/reduced accuracy: step \d+ of \d+ below full/.test(movingOverlay) &&
+              /budget \d+ ms/.test(movingOverlay) && !/quality \d/.test(movingOverlay) &&
+              (hasBeams || !/table/.test(movingOverlay)),
+          `the overlay while dragging says the accuracy in words: ${JSON.stringify(movingOverlay)}`);
+    await checkTurnAndReset(page, initial, cx, cy, box.width);
+  }
 
   // The scene picker: an example is stored over the WebSocket and rendered.
   const before = await page.evaluate(() => window.beamcastPreview.frames.length);
