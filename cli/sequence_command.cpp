@@ -100,7 +100,7 @@ void delete_scene(const std::vector<client::Endpoint>& endpoints, const std::str
   for (const client::Endpoint& ep : endpoints) {
     try {
       client::Client c;
-      connect_to_server(c, ep, args.token, 10.0);
+      connect_to_server(c, ep, args.token, std::min(args.timeout_s, 10.0));
       c.scene_delete(scene_id);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "beamcast: could not delete scene %s: %s\n", scene_id.c_str(), e.what());
@@ -141,6 +141,7 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
   struct Worker {
     std::string endpoint;
     std::size_t batches = 0, frames = 0;
+    bool stored = false;  // the job's copy of the scene is on its server
     client::RetryStats stats;
     std::string error;
   };
@@ -161,7 +162,10 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
       me.endpoint = c.endpoint();
       std::optional<std::size_t> mine;
       try {
-        if (temporary) c.scene_put(scene_id, scene_json);
+        if (temporary) {
+          c.scene_put(scene_id, scene_json);
+          me.stored = true;
+        }
         for (;;) {
           {
             // Idle workers wait while batches are out: one may come back.
@@ -228,7 +232,18 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
     });
   }
   for (auto& t : threads) t.join();
-  if (temporary) delete_scene(endpoints, scene_id, args);
+  if (temporary) {
+    // Off the servers that took it (one worker per server suffices).
+    std::vector<client::Endpoint> holders;
+    for (std::size_t w = 0; w < report.size(); ++w) {
+      const client::Endpoint& ep = endpoints[w / static_cast<std::size_t>(per_endpoint)];
+      if (report[w].stored && (holders.empty() || holders.back().port != ep.port ||
+                               holders.back().host != ep.host)) {
+        holders.push_back(ep);
+      }
+    }
+    delete_scene(holders, scene_id, args);
+  }
   // A worker that stopped before the queue drained leaves work: the others
   // took it, unless every one failed.
   std::string failures;
