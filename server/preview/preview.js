@@ -47,6 +47,7 @@ const preview = {
   abandoned: 0,        // requests whose WebSocket closed before their answer
 };
 window.beamcastPreview = preview;
+preview.view = () => (orbit ? cameraFromOrbit(orbit) : null);  // the camera the page shows next
 
 let ws = null;
 let nextId = 1;
