@@ -86,7 +86,8 @@ void add_bench_command(CLI::App& app) {
   acc->add_option("--size", opts->size, "Frame width and height (default 512, 128 with --quick)")
       ->check(CLI::Range(16, 4096));
   acc->add_option("--scene", opts->scenes, "Only this scene (repeatable); names as in the CSV");
-  acc->add_flag("!--no-plots", opts->plots, "Do not run bench/plot_accuracy.py");
+  acc->add_flag_function(
+      "--no-plots", [opts](std::int64_t) { opts->plots = false; }, "Do not run bench/plot_accuracy.py");
   acc->add_option("--device", opts->egl.device_index,
                   "EGL device index (default: $BEAMCAST_EGL_DEVICE, else the first that works)");
   acc->add_option("--platform", opts->egl.platform, "EGL platform: auto, device or surfaceless")
@@ -99,8 +100,8 @@ void add_bench_command(CLI::App& app) {
   auto volopts = std::make_shared<bench::VolumeBenchOptions>();
   CLI::App* volumes = bench->add_subcommand(
       "volumes",
-      "Volume ray casting against the CPU reference: the seed's tables (S_z, S_xy, R_v) with "
-      "error columns, ERT and empty-space skipping on a sparse and a dense volume; writes "
+      "Volume ray casting against the CPU reference: samples per voxel along and across the "
+      "ray (S_z, S_xy) and the resolution level (R_v), each with error columns, ERT and empty-space skipping on a sparse and a dense volume; writes "
       "volumes.csv and volumes.md to --out");
   volumes->add_option("--out,-o", volopts->out, "Output directory (created if missing)")->required();
   volumes->add_flag("--quick", volopts->quick, "96x96, small volumes, fewer settings");
@@ -180,9 +181,11 @@ void add_bench_command(CLI::App& app) {
                     "Use the beamcast-server at HOST:PORT (default: start one as a child)");
   views->add_option("--server-binary", vopts->server_binary,
                     "beamcast-server to start (default: the one beside this program)");
-  views->add_flag("!--no-renderer", vopts->renderer,
-                  "Skip the in-process renderer timings (batched vs one camera at a time)");
-  views->add_flag("!--no-plots", vopts->plots, "Do not run bench/plot_views.py");
+  views->add_flag_function(
+      "--no-renderer", [vopts](std::int64_t) { vopts->renderer = false; },
+      "Skip the in-process renderer timings (batched vs one camera at a time)");
+  views->add_flag_function(
+      "--no-plots", [vopts](std::int64_t) { vopts->plots = false; }, "Do not run bench/plot_views.py");
   views->callback([vopts] {
     const int rc = bench::run_views(*vopts);
     if (rc != 0) throw CLI::RuntimeError(rc);
@@ -251,9 +254,9 @@ void add_bench_command(CLI::App& app) {
   add_size_spp_bench(
       bench, "fog",
       "In-scattered light in fog on examples/fog_stage.json, a denser copy and "
-      "examples/ground_fog.json (its layer also as a mesh region): the seed's estimate and the "
-      "beam radiance estimate against the path tracer, photon count, LOD, the seed's S view-ray "
-      "segments, GPU time; writes fog.csv, fog.md, fog.png and fog_segments.png to --out (runs "
+      "examples/ground_fog.json (its layer also as a mesh region): the volume photon estimate and "
+      "the beam radiance estimate against the path tracer, photon count, LOD, the number of "
+      "view-ray segments, GPU time; writes fog.csv, fog.md, fog.png and fog_segments.png to --out (runs "
       "bench/fog_bench.py with /usr/bin/python3 and numpy)",
       "fog_bench.py", 256, 2048);
   // The Cornell box beside POV-Ray 3.7 (issue 14's peer; installed by the

@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/frame_choice.hpp"
+
 namespace beamcast::cli {
 
 void add_render_command(CLI::App& app);
@@ -31,6 +33,8 @@ struct RemoteRenderArgs {
   std::string frame_format = "png";
   double timeout_s = 120;
   bool json = false;
+  FrameChoice choice;  // --camera, --size
+  std::string prefix;  // before each file name
 };
 int run_remote_render(const RemoteRenderArgs& args);
 
@@ -47,11 +51,14 @@ struct SequenceArgs {
   bool json = false;
   int device = -1;
   std::string platform = "auto";
+  std::string scene_id;    // with server: a stored scene instead of the file (scene.get)
+  std::string prefix;      // file names: PREFIX + frame_0000.png ...
   std::string server;      // HOST:PORT, or several separated by commas
   int connections = 2;     // workers per server (each its own connection)
   std::string token;       // presented in hello when set
   std::string encoding = "binary";
   double timeout_s = 120;
+  FrameChoice choice;  // --camera (the one that frames the rig or path), --size
 };
 int run_sequence(const SequenceArgs& args);
 

@@ -9,6 +9,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"beamcast: render energy-beam scenes headless (offline or through a server)"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", "beamcast " BEAMCAST_VERSION);
   beamcast::cli::add_render_command(app);
   beamcast::cli::add_info_command(app);
   beamcast::cli::add_server_commands(app);

@@ -7,12 +7,13 @@
 
 namespace beamcast::cli {
 
-ProgressBar::ProgressBar(int total, std::string what, std::FILE* out)
+ProgressBar::ProgressBar(int total, std::string what, std::FILE* out, double min_interval_s)
     : total_(std::max(total, 1)),
       what_(std::move(what)),
       out_(out),
       tty_(isatty(fileno(out)) == 1),
-      start_(std::chrono::steady_clock::now()) {}
+      start_(std::chrono::steady_clock::now()),
+      min_interval_s_(min_interval_s) {}
 
 void ProgressBar::update(int done) {
   if (done == last_) return;
@@ -21,6 +22,8 @@ void ProgressBar::update(int done) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   const double frac = static_cast<double>(done) / total_;
   if (!tty_) {
+    if (done > 0 && done < total_ && s - printed_s_ < min_interval_s_) return;
+    printed_s_ = s;
     std::fprintf(out_, "%s %d/%d (%.0f%%), %.1f s\n", what_.c_str(), done, total_, 100 * frac, s);
     std::fflush(out_);
     return;

@@ -9,10 +9,12 @@
 namespace beamcast::cli {
 
 // A bar redrawn in place ("\r") when stderr is a terminal; otherwise one plain
-// line per update ("frames 12/36 (33%), 1.4 s"), so logs stay readable.
+// line per update ("frames 12/36 (33%), 1.4 s"), or with `min_interval_s`
+// at most one per that many seconds between the first and the last, so logs
+// stay readable.
 class ProgressBar {
  public:
-  ProgressBar(int total, std::string what, std::FILE* out = stderr);
+  ProgressBar(int total, std::string what, std::FILE* out = stderr, double min_interval_s = 0.0);
   void update(int done);
   void finish();  // ends the bar's line (terminal) or prints the last line
 
@@ -23,6 +25,8 @@ class ProgressBar {
   std::FILE* out_;
   bool tty_;
   std::chrono::steady_clock::time_point start_;
+  double min_interval_s_;
+  double printed_s_ = -1e9;  // when the last plain line was printed
 };
 
 struct TimeSummary {

@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -9,6 +10,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "cli/frame_choice.hpp"
+#include "cli/progress.hpp"
+#include "cli/server_options.hpp"
 #include "gi/gi_scene.hpp"
 #include "gi/photon_gather.hpp"
 #include "gi/photon_map.hpp"
@@ -36,6 +40,8 @@ struct RenderArgs {
   int bounces = 32;
   std::string gather;  // "", "radius" or "nearest": the CPU photon gather
   int gather_k = 50;
+  FrameChoice choice;  // --camera, --size
+  std::string prefix;  // before each file name
 };
 
 std::string frame_stem(const Camera& cam, std::size_t index) {
@@ -59,6 +65,7 @@ int run_render(const RenderArgs& args) {
   Scene scene;
   try {
     scene = load_scene_file(args.scene, load);
+    apply_frame_choice(args.choice, &scene.cameras);
   } catch (const ProtocolError& e) {
     std::fprintf(stderr, "beamcast: %s: [%s] %s%s%s\n", args.scene.c_str(), e.info().code.c_str(),
                  e.info().path.c_str(), e.info().path.empty() ? "" : ": ",
@@ -124,10 +131,21 @@ int run_render(const RenderArgs& args) {
       summary["gi_spp"] = args.spp;
       summary["gi_bounces"] = args.bounces;
     }
-    for (const Camera& cam : scene.cameras) {
+    for (std::size_t i = 0; i < scene.cameras.size(); ++i) {
+      const Camera& cam = scene.cameras[i];
       const auto t0 = std::chrono::steady_clock::now();
+      // Progress in rows (a lit scene's twice: path tracing, then shading), on stderr.
+      ProgressBar bar((scene.has_gi() ? 2 : 1) * cam.height,
+                      frame_stem(cam, i) + ": CPU reference, rows", stderr, /*min_interval_s=*/1.0);
+      std::mutex bar_mu;
+      bar.update(0);
+      refopts.on_progress = [&](int done, int) {
+        std::lock_guard lock(bar_mu);
+        bar.update(done);
+      };
       FrameResult fr;
       fr.hdr = render_reference(scene, cam, refopts);
+      bar.finish();
       fr.image = tone_map(fr.hdr, scene.output);
       fr.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                        .count();
@@ -139,7 +157,7 @@ int run_render(const RenderArgs& args) {
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const Camera& cam = scene.cameras[i];
     const FrameResult& fr = frames[i];
-    const fs::path file = fs::path(args.out) / (frame_stem(cam, i) + ".png");
+    const fs::path file = fs::path(args.out) / (args.prefix + frame_stem(cam, i) + ".png");
     write_png(file, fr.image);
     nlohmann::json jf;
     jf["camera"] = frame_stem(cam, i);
@@ -161,7 +179,7 @@ int run_render(const RenderArgs& args) {
       }
     }
     if (args.hdr) {
-      const fs::path raw = fs::path(args.out) / (frame_stem(cam, i) + ".rgb32f");
+      const fs::path raw = fs::path(args.out) / (args.prefix + frame_stem(cam, i) + ".rgb32f");
       write_hdr(raw, fr.hdr);
       jf["hdr_file"] = raw.string();
     }
@@ -194,7 +212,12 @@ void add_render_command(CLI::App& app) {
   CLI::Option* scene =
       cmd->add_option("scene", args->scene, "Scene JSON file (docs/scene-format.md)")
           ->check(CLI::ExistingFile);
-  cmd->add_option("--out,-o", args->out, "Output directory (created if missing)");
+  CLI::Option* out_opt = cmd->add_option(
+      "--out,-o", args->out,
+      "Output directory (created if missing); frames are named CAMERA.png (with --rig or "
+      "--path: frame_0000.png ...). Without it: the current directory, with the scene's name "
+      "before each file name (SCENE_CAMERA.png)");
+  add_frame_choice_options(cmd, &args->choice);
   CLI::Option* assets =
       cmd->add_option("--assets", args->assets,
                       "Directory mesh files are read from (default: the scene file's directory)");
@@ -234,10 +257,13 @@ void add_render_command(CLI::App& app) {
       ->needs(gather);
 
   // Rendering on a server: the scene file is sent inline, or a stored scene named.
-  CLI::Option* server = cmd->add_option(
-      "--server", remote->server,
-      "Render on the beamcast-server at HOST:PORT instead of locally; with --rig or --path, "
-      "on several (A,B,C): the batches are shared out and the frames written in order");
+  CLI::Option* server =
+      cmd->add_option("--server", remote->server,
+                      "Render on the beamcast-server at HOST:PORT instead of locally (given "
+                      "alone: $BEAMCAST_SERVER, else 127.0.0.1:7878); with --rig or --path, on "
+                      "several (A,B,C): the batches are shared out and the frames written in order")
+          ->expected(0, 1)
+          ->default_str(default_server());
   cmd->add_option("--scene-id", remote->scene_id, "With --server: render this stored scene")
       ->needs(server)
       ->excludes(scene);
@@ -255,8 +281,9 @@ void add_render_command(CLI::App& app) {
       ->check(CLI::PositiveNumber)
       ->needs(server);
   cmd->add_option("--token", remote->token,
-                  "With --server: the token for hello (servers on non-loopback addresses)")
-      ->needs(server);
+                  "With --server: the token for hello, for servers started with one (default: "
+                  "$BEAMCAST_TOKEN)")
+      ->envname("BEAMCAST_TOKEN");
   // Frame sequences: numbered PNGs of a rig or a camera path.
   CLI::Option* rig = cmd->add_option(
       "--rig", seq->rig,
@@ -290,13 +317,25 @@ void add_render_command(CLI::App& app) {
        {assets, reference, hdr, device, platform, threads, spp, seed, bounces, gather})
     server->excludes(local);
 
-  cmd->callback([args, remote, seq, batch, connections] {
+  cmd->callback([args, remote, seq, batch, connections, out_opt] {
     int rc = 0;
+    // Without --out, frames go to the current directory named after the
+    // scene as well as the camera, so renders of different scenes do not
+    // overwrite each other.
+    const std::string prefix =
+        out_opt->count() > 0 ? std::string()
+                             : (remote->scene_id.empty()
+                                    ? std::filesystem::path(args->scene).stem().string()
+                                    : remote->scene_id) + "_";
     if (!seq->rig.empty() || !seq->path.empty()) {
-      if (args->scene.empty()) {
-        throw CLI::ValidationError("--rig and --path need a scene file (they frame its camera)");
+      if (args->scene.empty() && remote->scene_id.empty()) {
+        throw CLI::ValidationError(
+            "--rig and --path need a scene file, or --server with --scene-id (they frame the "
+            "scene's first camera)");
       }
       seq->scene = args->scene;
+      seq->scene_id = remote->scene_id;
+      seq->prefix = prefix;
       seq->out = args->out;
       seq->assets = args->assets;
       seq->json = args->json;
@@ -306,6 +345,7 @@ void add_render_command(CLI::App& app) {
       seq->encoding = remote->encoding;
       seq->timeout_s = remote->timeout_s;
       seq->token = remote->token;
+      seq->choice = args->choice;
       rc = run_sequence(*seq);
     } else if (batch->count() > 0 || connections->count() > 0) {
       throw CLI::ValidationError("--batch and --connections apply to --rig and --path only");
@@ -316,9 +356,12 @@ void add_render_command(CLI::App& app) {
       remote->scene = args->scene;
       remote->out = args->out;
       remote->json = args->json;
+      remote->choice = args->choice;
+      remote->prefix = prefix;
       rc = run_remote_render(*remote);
     } else {
       if (args->scene.empty()) throw CLI::RequiredError("scene");
+      args->prefix = prefix;
       rc = run_render(*args);
     }
     if (rc != 0) throw CLI::RuntimeError(rc);

@@ -22,6 +22,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
+#include "cli/server_options.hpp"
 #include "client/client.hpp"
 #include "client/resilient_client.hpp"
 #include "protocol/camera_path.hpp"
@@ -45,10 +46,10 @@ void print_error(const std::string& where, const ErrorInfo& e) {
                e.path.c_str(), e.path.empty() ? "" : ": ", e.message.c_str());
 }
 
-fs::path frame_file(const fs::path& dir, std::size_t i) {
+fs::path frame_file(const SequenceArgs& args, std::size_t i) {
   char name[32];
   std::snprintf(name, sizeof name, "frame_%04zu.png", i);
-  return dir / name;
+  return fs::path(args.out) / (args.prefix + name);
 }
 
 void write_bytes(const fs::path& file, const std::vector<std::uint8_t>& bytes) {
@@ -92,9 +93,24 @@ struct RemoteResult {
 using DeliverFn = std::function<void(std::size_t first, const std::vector<client::RenderedFrame>& frames,
                                      double request_ms)>;
 
+// The job's copy of the scene off each server (best effort: a server that
+// has gone keeps it until it is evicted or restarts).
+void delete_scene(const std::vector<client::Endpoint>& endpoints, const std::string& scene_id,
+                  const SequenceArgs& args) {
+  for (const client::Endpoint& ep : endpoints) {
+    try {
+      client::Client c;
+      connect_to_server(c, ep, args.token, std::min(args.timeout_s, 10.0));
+      c.scene_delete(scene_id);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "beamcast: could not delete scene %s: %s\n", scene_id.c_str(), e.what());
+    }
+  }
+}
+
 RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& scene_json,
                                const std::vector<Camera>& cams, std::size_t batch,
-                               const DeliverFn& deliver) {
+                               const DeliverFn& deliver, const std::function<void(std::size_t)>& on_part) {
   std::vector<client::Endpoint> endpoints;
   std::string list = args.server;
   for (std::size_t at = 0; at <= list.size();) {
@@ -117,11 +133,15 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
   std::string refusal;  // a server's error answer: the job's end
 
   auto budget = std::make_shared<client::RetryBudget>();
-  const std::string scene_id = "render-" + std::to_string(::getpid());
+  // The user's stored scene, or a copy of the file stored for this job (and
+  // deleted after it).
+  const bool temporary = args.scene_id.empty();
+  const std::string scene_id = temporary ? "render-" + std::to_string(::getpid()) : args.scene_id;
   const auto timeout = std::chrono::milliseconds(static_cast<long long>(args.timeout_s * 1000));
   struct Worker {
     std::string endpoint;
     std::size_t batches = 0, frames = 0;
+    bool stored = false;  // the job's copy of the scene is on its server
     client::RetryStats stats;
     std::string error;
   };
@@ -142,7 +162,10 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
       me.endpoint = c.endpoint();
       std::optional<std::size_t> mine;
       try {
-        c.scene_put(scene_id, scene_json);
+        if (temporary) {
+          c.scene_put(scene_id, scene_json);
+          me.stored = true;
+        }
         for (;;) {
           {
             // Idle workers wait while batches are out: one may come back.
@@ -160,6 +183,12 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
           req.encoding = args.encoding;
           req.cameras = nlohmann::json::array();
           for (std::size_t k = at; k < at + count; ++k) req.cameras.push_back(camera_to_json(cams[k]));
+          // Streamed: each GPU slice's frames come as they finish, so the
+          // progress moves within a batch.
+          req.stream = true;
+          req.on_part = [&, count](int, const std::vector<client::RenderedFrame>& part) {
+            if (on_part) on_part(std::min(part.size(), count));
+          };
           const auto t0 = Clock::now();
           const client::RenderResult r = c.render(req);
           if (!r.ok) {
@@ -203,6 +232,18 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
     });
   }
   for (auto& t : threads) t.join();
+  if (temporary) {
+    // Off the servers that took it (one worker per server suffices).
+    std::vector<client::Endpoint> holders;
+    for (std::size_t w = 0; w < report.size(); ++w) {
+      const client::Endpoint& ep = endpoints[w / static_cast<std::size_t>(per_endpoint)];
+      if (report[w].stored && (holders.empty() || holders.back().port != ep.port ||
+                               holders.back().host != ep.host)) {
+        holders.push_back(ep);
+      }
+    }
+    delete_scene(holders, scene_id, args);
+  }
   // A worker that stopped before the queue drained leaves work: the others
   // took it, unless every one failed.
   std::string failures;
@@ -225,6 +266,16 @@ RemoteResult render_on_servers(const SequenceArgs& args, const nlohmann::json& s
   return out;
 }
 
+// A stored scene's JSON, by scene.get on the first server.
+nlohmann::json fetch_stored_scene(const SequenceArgs& args) {
+  const std::string first = args.server.substr(0, args.server.find(','));
+  client::Client c;
+  connect_to_server(c, first, args.token, args.timeout_s);
+  const client::Response r = c.call("scene.get", {{"scene_id", args.scene_id}});
+  if (!r.ok) throw ProtocolError(r.error);
+  return r.result().value("scene", nlohmann::json::object());
+}
+
 }  // namespace
 
 int run_sequence(const SequenceArgs& args) {
@@ -232,11 +283,22 @@ int run_sequence(const SequenceArgs& args) {
   load.assets_dir = args.assets.empty() ? fs::path(args.scene).parent_path() : fs::path(args.assets);
   if (load.assets_dir.empty()) load.assets_dir = ".";
   Scene scene;
+  nlohmann::json scene_json;  // with --server: what is stored there
   std::vector<Camera> cams;
+  const std::string source = args.scene_id.empty() ? args.scene : "scene " + args.scene_id;
   try {
-    scene = load_scene_file(args.scene, load);
+    if (!args.scene_id.empty()) {
+      // The rig is framed here, from the stored scene's cameras and content;
+      // the frames are rendered from the stored scene itself.
+      scene_json = fetch_stored_scene(args);
+      scene = parse_scene(scene_json, load);
+    } else {
+      scene = load_scene_file(args.scene, load);
+      if (!args.server.empty()) scene_json = nlohmann::json::parse(std::ifstream(args.scene));
+    }
+    apply_frame_choice(args.choice, &scene.cameras);
   } catch (const ProtocolError& e) {
-    print_error(args.scene, e.info());
+    print_error(source, e.info());
     return 2;
   }
   try {
@@ -283,25 +345,21 @@ int run_sequence(const SequenceArgs& args) {
       std::vector<double> write_ms(count);
       for (std::size_t k = 0; k < count; ++k) {
         const auto w0 = Clock::now();
-        write_png(frame_file(args.out, at + k), frames[k].image);
+        write_png(frame_file(args, at + k), frames[k].image);
         write_ms[k] = ms_since(w0);
       }
       complete(at, count, write_ms);
     }
   } else {
-    nlohmann::json scene_json;
-    {
-      std::ifstream in(args.scene);
-      scene_json = nlohmann::json::parse(in);
-    }
-    std::mutex mu;  // guards `complete` and the progress bar
+    std::mutex mu;  // guards the progress bar and the frame times
+    std::size_t received = 0;  // frames in the parts so far (a retried part counts again)
     const RemoteResult remote = render_on_servers(
         args, scene_json, cams, batch,
         [&](std::size_t at, const std::vector<client::RenderedFrame>& frames, double request_ms) {
           std::vector<double> write_ms(frames.size());
           for (std::size_t k = 0; k < frames.size(); ++k) {
             const auto w0 = Clock::now();
-            write_bytes(frame_file(args.out, at + k), frames[k].png);
+            write_bytes(frame_file(args, at + k), frames[k].png);
             write_ms[k] = ms_since(w0);
           }
           std::lock_guard lock(mu);
@@ -309,8 +367,13 @@ int run_sequence(const SequenceArgs& args) {
             frame_ms[at + k] = request_ms / static_cast<double>(frames.size()) + write_ms[k];
           }
           done += frames.size();
-          progress.update(static_cast<int>(done));
+        },
+        [&](std::size_t frames) {
+          std::lock_guard lock(mu);
+          received += frames;
+          progress.update(static_cast<int>(std::min(received, n)));
         });
+    progress.update(static_cast<int>(n));
     if (!remote.error.empty()) {
       progress.finish();
       std::fprintf(stderr, "beamcast: %s\n", remote.error.c_str());
@@ -324,7 +387,7 @@ int run_sequence(const SequenceArgs& args) {
   const TimeSummary t = summarize(frame_ms);
   if (args.json) {
     nlohmann::json files = nlohmann::json::array();
-    for (std::size_t i = 0; i < n; ++i) files.push_back(frame_file(args.out, i).string());
+    for (std::size_t i = 0; i < n; ++i) files.push_back(frame_file(args, i).string());
     nlohmann::json summary = {{"renderer", renderer_name},
                               {"frames", n},
                               {"files", files},

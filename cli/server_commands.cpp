@@ -14,27 +14,16 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "cli/server_options.hpp"
 #include "client/client.hpp"
 #include "client/resilient_client.hpp"
+#include "protocol/errors.hpp"
 #include "render/image.hpp"
 
 namespace beamcast::cli {
 namespace {
 
 using client::Client;
-
-// Connects to a validated HOST:PORT; bad text is a usage error (exit 2 via CLI11).
-void connect(Client& c, const std::string& server, double timeout_s) {
-  client::Endpoint ep;
-  try {
-    ep = client::parse_endpoint(server);
-  } catch (const std::invalid_argument& e) {
-    throw CLI::ValidationError("--server", e.what());
-  }
-  const auto timeout = std::chrono::milliseconds(static_cast<long long>(timeout_s * 1000));
-  c.set_receive_timeout(timeout);
-  c.connect(ep.host, ep.port, std::min(timeout, std::chrono::milliseconds(10000)));
-}
 
 void print_error(const ErrorInfo& e) {
   std::fprintf(stderr, "beamcast: server error [%s] %s%s%s\n", e.code.c_str(), e.path.c_str(),
@@ -65,6 +54,58 @@ std::string frame_stem(const client::RenderedFrame& f) {
   return safe ? n : "camera_" + std::to_string(f.index);
 }
 
+// --camera and --size on a stored scene: its cameras (scene.get), chosen
+// and sized, sent as the render's camera list.
+int choose_stored_cameras(const RemoteRenderArgs& args, nlohmann::json* cameras) {
+  Client c;
+  connect_to_server(c, args.server, args.token, args.timeout_s);
+  const client::Response r = c.call("scene.get", {{"scene_id", args.scene_id}});
+  if (!r.ok) {
+    print_error(r.error);
+    return 2;
+  }
+  nlohmann::json scene = r.result().value("scene", nlohmann::json::object());
+  try {
+    apply_frame_choice(args.choice, &scene);
+  } catch (const ProtocolError& e) {
+    std::fprintf(stderr, "beamcast: scene %s: %s\n", args.scene_id.c_str(), e.what());
+    return 2;
+  }
+  *cameras = scene.value("cameras", nlohmann::json::array());
+  return 0;
+}
+
+// `beamcast scenes`: the stored ids, one a line, then a count; with
+// --delete, each deleted (an unknown id is an error, exit 2).
+void run_scenes(const std::string& server, const std::string& token,
+                const std::vector<std::string>& remove, double timeout_s) {
+  Client c;
+  connect_to_server(c, server, token, timeout_s);
+  bool failed = false;
+  for (const std::string& id : remove) {
+    const client::Response r = c.scene_delete(id);
+    if (!r.ok) {
+      print_error(r.error);
+      failed = true;
+    } else {
+      std::printf("deleted %s\n", id.c_str());
+    }
+  }
+  if (failed) throw CLI::RuntimeError(2);
+  if (!remove.empty()) return;
+  const client::Response r = c.call("scene.list");
+  if (!r.ok) {
+    print_error(r.error);
+    throw CLI::RuntimeError(2);
+  }
+  const nlohmann::json& res = r.result();
+  for (const auto& id : res.value("scenes", nlohmann::json::array())) {
+    if (id.is_string()) std::printf("%s\n", id.get<std::string>().c_str());
+  }
+  std::printf("%zu scene(s), %.0f bytes\n", res.value("scenes", nlohmann::json::array()).size(),
+              number(res, "bytes"));
+}
+
 }  // namespace
 
 int run_remote_render(const RemoteRenderArgs& args) {
@@ -73,12 +114,22 @@ int run_remote_render(const RemoteRenderArgs& args) {
   req.encoding = args.encoding;
   if (!args.scene_id.empty()) {
     req.scene_id = args.scene_id;
+    if (args.choice.any()) {
+      const int rc = choose_stored_cameras(args, &req.cameras);
+      if (rc != 0) return rc;
+    }
   } else {
     // Sent as is: the server validates it (meshes come from the server's --assets).
     std::ifstream in(args.scene);
     try {
       req.scene = nlohmann::json::parse(in);
     } catch (const nlohmann::json::parse_error& e) {
+      std::fprintf(stderr, "beamcast: %s: %s\n", args.scene.c_str(), e.what());
+      return 2;
+    }
+    try {
+      apply_frame_choice(args.choice, &req.scene);
+    } catch (const ProtocolError& e) {
       std::fprintf(stderr, "beamcast: %s: %s\n", args.scene.c_str(), e.what());
       return 2;
     }
@@ -116,7 +167,7 @@ int run_remote_render(const RemoteRenderArgs& args) {
   summary["frames"] = nlohmann::json::array();
   for (const client::RenderedFrame& f : r.frames) {
     const bool raw = !f.samples.empty();
-    const fs::path file = fs::path(args.out) / (frame_stem(f) + ".png");
+    const fs::path file = fs::path(args.out) / (args.prefix + frame_stem(f) + ".png");
     if (raw) {
       // Raw samples from the server: the PNG is made here, on the client's cores.
       write_png(file, Image{f.width, f.height, f.bit_depth, f.samples});
@@ -168,18 +219,20 @@ int run_remote_render(const RemoteRenderArgs& args) {
 void add_server_commands(CLI::App& app) {
   struct PingArgs {
     std::string server;
+    std::string token;
     int count = 4;
     double timeout_s = 10;
   };
   auto ping = std::make_shared<PingArgs>();
   CLI::App* pc = app.add_subcommand("ping", "Round-trip times to a beamcast-server");
-  pc->add_option("--server", ping->server, "Server address HOST:PORT")->required();
+  add_server_option(pc, &ping->server);
+  add_token_option(pc, &ping->token);
   pc->add_option("--count,-c", ping->count, "Number of pings")->check(CLI::Range(1, 1000000));
   pc->add_option("--timeout", ping->timeout_s, "Seconds to wait for each reply")
       ->check(CLI::PositiveNumber);
   pc->callback([ping] {
     Client c;
-    connect(c, ping->server, ping->timeout_s);
+    connect_to_server(c, ping->server, ping->token, ping->timeout_s);
     std::vector<double> rtts;
     for (int i = 0; i < ping->count; ++i) {
       const auto t0 = std::chrono::steady_clock::now();
@@ -202,16 +255,18 @@ void add_server_commands(CLI::App& app) {
 
   struct StatsArgs {
     std::string server;
+    std::string token;
     double timeout_s = 10;
   };
   auto stats = std::make_shared<StatsArgs>();
   CLI::App* sc = app.add_subcommand("stats", "Print a beamcast-server's counters as JSON");
-  sc->add_option("--server", stats->server, "Server address HOST:PORT")->required();
+  add_server_option(sc, &stats->server);
+  add_token_option(sc, &stats->token);
   sc->add_option("--timeout", stats->timeout_s, "Seconds to wait for the reply")
       ->check(CLI::PositiveNumber);
   sc->callback([stats] {
     Client c;
-    connect(c, stats->server, stats->timeout_s);
+    connect_to_server(c, stats->server, stats->token, stats->timeout_s);
     const client::Response r = c.stats();
     if (!r.ok) {
       print_error(r.error);
@@ -219,6 +274,22 @@ void add_server_commands(CLI::App& app) {
     }
     std::printf("%s\n", r.result().dump(2).c_str());
   });
+
+  struct ScenesArgs {
+    std::string server;
+    std::string token;
+    std::vector<std::string> remove;
+    double timeout_s = 10;
+  };
+  auto scenes = std::make_shared<ScenesArgs>();
+  CLI::App* lc = app.add_subcommand(
+      "scenes", "List the scenes stored on a beamcast-server (most recently used first), or delete some");
+  add_server_option(lc, &scenes->server);
+  add_token_option(lc, &scenes->token);
+  lc->add_option("--delete", scenes->remove, "Delete this stored scene (repeatable)");
+  lc->add_option("--timeout", scenes->timeout_s, "Seconds to wait for each reply")
+      ->check(CLI::PositiveNumber);
+  lc->callback([scenes] { run_scenes(scenes->server, scenes->token, scenes->remove, scenes->timeout_s); });
 }
 
 }  // namespace beamcast::cli

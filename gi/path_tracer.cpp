@@ -249,6 +249,7 @@ std::vector<Color> path_trace(const GiScene& gi, const Camera& cam, const PathTr
       }
       img[index] = (1.0 / opts.spp) * sum;
     }
+    if (opts.on_row) opts.on_row();
   };
 
   parallel_items(h, opts.threads, trace_row);

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -21,6 +22,8 @@ struct PathTraceOptions {
   std::uint64_t seed = 1;  // with the pixel index, seeds each pixel's generator
   int threads = 0;         // 0: std::thread::hardware_concurrency()
   int max_depth = 32;  // surface interactions a path may have (Russian roulette ends most sooner)
+  // path_trace: called after each row, from the worker threads (progress).
+  std::function<void()> on_row;
 };
 
 // Radiance arriving at o from direction -v along o + t v (|v| = 1), t in

@@ -12,7 +12,8 @@ namespace beamcast {
 
 const std::vector<std::string>& request_methods() {
   static const std::vector<std::string> kMethods = {
-      "hello", "ping", "render", "scene.put", "scene.update", "scene.delete", "stats"};
+      "hello",     "ping",      "render",       "scene.put", "scene.update",
+      "scene.get", "scene.list", "scene.delete", "stats"};
   return kMethods;
 }
 

@@ -417,6 +417,11 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
   // Lit scenes: the surfaces' radiance from the path tracer, per pixel.
   std::optional<GiScene> gi;
   std::vector<Color> gi_radiance;
+  const int total_rows = (scene.has_gi() ? 2 : 1) * cam.height;
+  std::atomic<int> rows_done{0};
+  const auto row_done = [&] {
+    if (opts.on_progress) opts.on_progress(rows_done.fetch_add(1) + 1, total_rows);
+  };
   if (scene.has_gi()) {
     gi.emplace(scene);
     PathTraceOptions po;
@@ -424,6 +429,7 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
     po.seed = opts.gi_seed;
     po.threads = opts.threads;
     po.max_depth = opts.gi_max_depth;
+    if (opts.on_progress) po.on_row = row_done;
     gi_radiance = path_trace(*gi, cam, po);
   }
 
@@ -487,6 +493,7 @@ HdrImage render_reference(const Scene& scene, const Camera& cam, const Reference
       float* px = img.at(x, y);
       for (int k = 0; k < 3; ++k) px[k] = static_cast<float>(c[k]);
     }
+    row_done();
   };
 
   parallel_items(cam.height, opts.threads, shade_row);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "protocol/scene.hpp"
 #include "render/image.hpp"
@@ -29,6 +30,9 @@ struct ReferenceOptions {
   // volumes (Volume::exact) instead of the trilinear grid.
   double volume_step = 0.0;
   bool volume_exact = false;
+  // Progress: (rows done, rows in all), from the worker threads, after each
+  // row; a lit scene's path-traced rows come first, then the shading's.
+  std::function<void(int done, int total)> on_progress;
 };
 
 // One volume's front-to-back composite along a ray (unit `dir`) over

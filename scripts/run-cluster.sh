@@ -21,7 +21,7 @@ n="$1"
 shift
 gpus=0
 if [ "${1:-}" = "--gpus" ]; then gpus=1; shift; fi
-scripts/build.sh
+scripts/build.sh run
 if ! command -v haproxy >/dev/null; then
   SUDO=""
   if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi

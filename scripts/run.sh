@@ -5,5 +5,6 @@
 # server (e.g. --port 0, --device 1, --render-workers 2; see --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/build.sh
+# Only what running needs: no test packages, no test binaries.
+scripts/build.sh run
 exec build/bin/beamcast-server "$@"

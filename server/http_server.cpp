@@ -5,6 +5,7 @@
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
+#include <boost/asio/write.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/ssl.hpp>
@@ -12,6 +13,7 @@
 #include <boost/beast/websocket/ssl.hpp>
 
 #include <cstdio>
+#include <cstring>
 #include <deque>
 #include <map>
 #include <mutex>
@@ -24,6 +26,7 @@
 #include <openssl/ssl.h>
 #include <openssl/x509.h>
 
+#include "protocol/framing.hpp"
 #include "protocol/request.hpp"
 #include "server/auth.hpp"
 #include "server/connection.hpp"
@@ -336,6 +339,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     if (ec == http::error::header_limit || ec == http::error::body_limit) {
       return reply_error(http::status::payload_too_large, "request too large\n");
     }
+    if (ec && speaks_bcp1()) return reply_wrong_port();
     if (ec) return;  // timeout, reset, malformed: drop the connection
     http::request<http::string_body> req = parser_->release();
     if (websocket::is_upgrade(req)) {
@@ -391,6 +395,30 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     res->body() = std::move(text);
     res->prepare_payload();
     write(res);
+  }
+
+  // A BCP1 client (`beamcast ping` given this port) sent its frame here: the
+  // HTTP parser refused it without consuming it.
+  bool speaks_bcp1() const {
+    const auto data = buffer_.data();
+    return data.size() >= 4 && std::memcmp(data.data(), "BCP1", 4) == 0;
+  }
+
+  // Answers that client in its own framing, with an error that names the
+  // protocol port, then closes.
+  void reply_wrong_port() {
+    owner_->core.stats.count_error("wrong_port");
+    const ErrorInfo e{"wrong_port",
+                      "this is beamcast-server's HTTP port (the preview page, /metrics, /health); "
+                      "the BCP1 protocol is on TCP port " +
+                          std::to_string(owner_->core.config.port),
+                      ""};
+    auto frame = std::make_shared<std::vector<std::uint8_t>>(
+        encode_frame(error_response(nullptr, e).dump()));
+    asio::async_write(stream_, asio::buffer(*frame),
+                      [self = shared_from_this(), frame](beast::error_code, std::size_t) {
+                        self->shutdown();
+                      });
   }
 
   void write(std::shared_ptr<http::response<http::string_body>> res) {

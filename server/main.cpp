@@ -96,7 +96,10 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(e.min, e.max))
         ->capture_default_str();
   }
-  app.add_option("--drain-timeout-ms", c.drain_timeout_ms)->capture_default_str();
+  app.add_option("--drain-timeout-ms", c.drain_timeout_ms,
+                 "On SIGINT/SIGTERM: how long in-flight work may finish before the server exits")
+      ->check(CLI::Range(0, 3600000))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   for (std::size_t i = 0; i < limit_table().size(); ++i) limit_table()[i].set(c, limit_values[i]);
   c.assets_dir = assets;

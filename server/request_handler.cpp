@@ -429,6 +429,17 @@ void run_method(ServerCore& core, const std::shared_ptr<Connection>& session, Re
     Scene scene = parse_scene_at(core, merged, "/params/patch");
     session->send(ok_response(
         id, store_scene(core, sid, std::move(merged), std::move(scene), "/params/patch")));
+  } else if (req.method == "scene.list") {
+    allow_params(params, {}, "scene.list");
+    session->send(ok_response(id, {{"scenes", core.scenes.ids()},
+                                   {"count", core.scenes.count()},
+                                   {"bytes", core.scenes.bytes()}}));
+  } else if (req.method == "scene.get") {
+    allow_params(params, {"scene_id"}, "scene.get");
+    const std::string sid = parse_scene_id(params, "/params/scene_id");
+    auto stored = core.scenes.get(sid);
+    if (!stored) fail("unknown_scene", "/params/scene_id", "no stored scene \"" + sid + "\"");
+    session->send(ok_response(id, {{"scene_id", sid}, {"scene", stored->json}}));
   } else if (req.method == "scene.delete") {
     allow_params(params, {"scene_id"}, "scene.delete");
     const std::string sid = parse_scene_id(params, "/params/scene_id");

@@ -78,11 +78,15 @@ unsigned short Server::start() {
   acceptor_.set_option(tcp::acceptor::reuse_address(true));
   acceptor_.bind(ep);
   acceptor_.listen(asio::socket_base::max_listen_connections);
-  do_accept();
   start_heap_trimmer(io_, core_.shutting_down);
   if (c.http_port >= 0) {
     http_port_ = http_->start(c.bind, static_cast<unsigned short>(c.http_port));
   }
+  // The bound ports (port 0 picks one): each listener names the other's to a
+  // client that came to the wrong one. Set before either accepts.
+  core_.config.port = acceptor_.local_endpoint().port();
+  if (c.http_port >= 0) core_.config.http_port = http_port_;
+  do_accept();
   return acceptor_.local_endpoint().port();
 }
 

@@ -5,6 +5,7 @@
 #include <boost/asio/write.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 
 #include "protocol/request.hpp"
@@ -74,6 +75,10 @@ void Session::on_header() {
       // The stream cannot be resynchronized: answer once, then close.
       state_ = ReadState::kStopped;
       read_timer_.cancel();
+      if (looks_like_http(header_)) {
+        answer_http();
+        return;
+      }
       // Earlier requests still in flight are answered by nobody: say how many.
       const int dropped = renders_in_flight();
       const ErrorInfo e{"bad_framing",
@@ -225,6 +230,37 @@ void Session::send(const nlohmann::json& response, std::vector<std::uint8_t> bin
 void Session::send_error(const nlohmann::json& id, const ErrorInfo& error) {
   core_.stats.count_error(error.code);
   send(error_response(id, error));
+}
+
+// A browser or curl on this port: an HTTP request line starts with a method.
+bool Session::looks_like_http(std::span<const std::uint8_t> header) {
+  static constexpr std::string_view kMethods[] = {"GET ", "HEAD", "POST", "PUT ", "DELE", "OPTI",
+                                                  "PATC", "CONN", "TRAC"};
+  const std::string_view start(reinterpret_cast<const char*>(header.data()), 4);
+  return std::find(std::begin(kMethods), std::end(kMethods), start) != std::end(kMethods);
+}
+
+// A short plain HTTP answer in place of a BCP1 error frame: which port this
+// is and where the HTTP one is. The rest of the request that has arrived is
+// read first, so the close does not reset the connection under the answer.
+void Session::answer_http() {
+  core_.stats.count_error("wrong_port");
+  boost::system::error_code ec;
+  std::array<std::uint8_t, 8192> discard;
+  for (int i = 0; i < 8 && socket_.available(ec) > 0 && !ec; ++i) {
+    socket_.read_some(asio::buffer(discard), ec);
+  }
+  const int http = core_.config.http_port;
+  const std::string body =
+      "This is beamcast-server's TCP protocol port (BCP1 frames, protocol/PROTOCOL.md), "
+      "not HTTP.\n" +
+      (http > 0 ? "The preview page and the HTTP endpoints are on port " + std::to_string(http) +
+                      " of this host.\n"
+                : std::string("This server has no HTTP port (--http-port -1).\n"));
+  const std::string reply = "HTTP/1.1 400 Bad Request\r\nContent-Type: text/plain; charset=utf-8\r\n"
+                            "Connection: close\r\nContent-Length: " +
+                            std::to_string(body.size()) + "\r\n\r\n" + body;
+  enqueue(std::vector<std::uint8_t>(reply.begin(), reply.end()), true);
 }
 
 void Session::enqueue(std::vector<std::uint8_t> frame, bool close_after) {

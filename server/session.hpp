@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <span>
 #include <atomic>
 #include <cstdint>
 #include <deque>
@@ -45,6 +46,10 @@ class Session : public Connection, public std::enable_shared_from_this<Session> 
   void read_header_part(std::size_t begin, std::size_t end);
   void on_first_byte();
   void on_header();
+  // An HTTP client on the BCP1 port (curl http://HOST:7878/): a plain HTTP
+  // answer that names the HTTP port, then close.
+  static bool looks_like_http(std::span<const std::uint8_t> header);
+  void answer_http();
   void do_read_body();
   void on_body(const boost::system::error_code& ec, std::size_t n);
   // The message of `bytes` has been handled: its memory is released and the

@@ -25,6 +25,7 @@ const ctx2d = canvas.getContext('2d');
 const overlay = document.getElementById('overlay');
 const statusEl = document.getElementById('status');
 const picker = document.getElementById('scene');
+const errorEl = document.getElementById('error');
 canvas.width = size;
 canvas.height = size;
 
@@ -46,12 +47,13 @@ const preview = {
   abandoned: 0,        // requests whose WebSocket closed before their answer
 };
 window.beamcastPreview = preview;
+preview.view = () => (orbit ? cameraFromOrbit(orbit) : null);  // the camera the page shows next
 
 let ws = null;
 let nextId = 1;
 const pending = new Map();  // id -> {resolve, reject, sent, camera}
 let awaitingBinary = null;  // a response whose attachments come in the next binary message
-let orbit = null;           // {target, yaw, pitch, dist, up, fov, near, far, projection, ortho}
+let orbit = null;           // {target, dist, up, e1, e2, yaw, pitch, initial, moved}: orbitFromCamera
 let lastSentKey = null;
 let lastSentAt = 0;
 let lastChangeAt = 0;       // when the pose last changed
@@ -61,6 +63,7 @@ let inflight = 0;
 let drawing = Promise.resolve();
 let started = false;        // the picker is filled and the animation loop runs
 let viewOf = null;          // the picker value whose view `orbit` holds
+let sceneJson = null;       // the selected scene (the overlay leaves out what it lacks)
 let selectSeq = 0;          // the latest selectScene call; earlier ones give way
 let attempt = 0;            // connection attempts since a scene was last established
 
@@ -179,45 +182,67 @@ const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
 const norm = (a) => mul(a, 1 / Math.hypot(a[0], a[1], a[2]));
 
-// Forward vector (-Z) of a (w, x, y, z) rotation.
+// Forward (-Z) and up (+Y) vectors of a (w, x, y, z) rotation.
 function quatForward(q) {
   const [w, x, y, z] = q;
   return [-(2 * (x * z + w * y)), -(2 * (y * z - w * x)), -(1 - 2 * (x * x + y * y))];
 }
+function quatUp(q) {
+  const [w, x, y, z] = q;
+  return [2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x)];
+}
 
+// The orbit of a scene camera: around its target, about the camera's own up
+// axis (its `up`, default +Y, or its rotation's up), so a Z-up scene turns
+// about Z. yaw and pitch are angles in the frame (e1, e2, up) where e1 is the
+// initial horizontal direction from the target to the camera: the initial
+// pose is yaw 0 and its own pitch. `initial` is the scene's camera as given
+// (at the canvas size): the view until the user moves, and after a reset, so
+// the first frame is the scene's own camera bit for bit, not a recomputation.
 function orbitFromCamera(cam) {
   const position = cam.position || [0, 0, 5];
   let target = cam.target;
-  if (!target) {
-    const f = cam.rotation ? quatForward(cam.rotation) : [0, 0, -1];
-    target = add(position, mul(norm(f), Math.hypot(...position) || 5));
+  let up = cam.up || [0, 1, 0];
+  if (cam.rotation) {
+    target = add(position, mul(norm(quatForward(cam.rotation)), Math.hypot(...position) || 5));
+    up = quatUp(cam.rotation);
+  } else if (!target) {
+    target = add(position, [0, 0, -(Math.hypot(...position) || 5)]);
   }
+  up = norm(up);
   const d = sub(position, target);
   const dist = Math.hypot(d[0], d[1], d[2]) || 1;
+  // The horizontal part of d; looking straight along up, any axis normal to it.
+  let h = sub(d, mul(up, dot(d, up)));
+  if (Math.hypot(...h) < 1e-9 * dist) h = cross(up, Math.abs(up[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0]);
+  const e1 = norm(h);
+  const initial = {...cam, name: 'preview', width: size, height: size};
   return {
-    target, dist,
-    yaw: Math.atan2(d[0], d[2]),
-    pitch: Math.asin(Math.max(-1, Math.min(1, d[1] / dist))),
-    fov: cam.fov_y, near: cam.near, far: cam.far, projection: cam.projection,
-    ortho: cam.ortho_height,
+    target, dist, up, e1, e2: cross(up, e1),
+    yaw: 0,
+    pitch: Math.asin(Math.max(-1, Math.min(1, dot(d, up) / dist))),
+    initial, moved: false,
   };
 }
 
 function cameraFromOrbit(o) {
-  const dir = [Math.sin(o.yaw) * Math.cos(o.pitch), Math.sin(o.pitch), Math.cos(o.yaw) * Math.cos(o.pitch)];
-  const cam = {
-    name: 'preview',
-    position: add(o.target, mul(dir, o.dist)).map((v) => +v.toFixed(6)),
-    target: o.target.map((v) => +v.toFixed(6)),
-    up: [0, 1, 0],
-    width: size, height: size,
-  };
-  if (o.fov !== undefined) cam.fov_y = o.fov;
-  if (o.near !== undefined) cam.near = o.near;
-  if (o.far !== undefined) cam.far = o.far;
-  if (o.projection !== undefined) cam.projection = o.projection;
-  if (o.ortho !== undefined) cam.ortho_height = o.ortho;
+  if (!o.moved) return {...o.initial};
+  const c = Math.cos(o.pitch);
+  const dir = add(mul(o.up, Math.sin(o.pitch)),
+                  add(mul(o.e1, c * Math.cos(o.yaw)), mul(o.e2, c * Math.sin(o.yaw))));
+  const cam = {...o.initial};
+  delete cam.rotation;
+  cam.position = add(o.target, mul(dir, o.dist)).map((v) => +v.toFixed(6));
+  cam.target = o.target.map((v) => +v.toFixed(6));
+  cam.up = o.up.map((v) => +v.toFixed(6));
   return cam;
+}
+
+// Back to the scene's camera (the reset-view key and button).
+function resetView() {
+  if (!orbit) return;
+  orbit = orbitFromCamera(orbit.initial);
+  maybeSend();
 }
 
 // --- input ------------------------------------------------------------------
@@ -239,16 +264,20 @@ canvas.addEventListener('pointermove', (e) => {
   const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
   drag.x = e.clientX;
   drag.y = e.clientY;
+  if (!dx && !dy) return;
+  orbit.moved = true;
+  const cam = cameraFromOrbit(orbit);
   if (drag.pan) {
-    const cam = cameraFromOrbit(orbit);
     const f = norm(sub(cam.target, cam.position));
-    const right = norm(cross(f, [0, 1, 0]));
+    const right = norm(cross(f, orbit.up));
     const up = cross(right, f);
-    const s = orbit.dist * 2 * Math.tan(((orbit.fov || 45) * Math.PI) / 360) / size;
+    const s = orbit.dist * 2 * Math.tan(((cam.fov_y || 45) * Math.PI) / 360) / canvas.clientHeight;
     orbit.target = add(orbit.target, add(mul(right, -dx * s), mul(up, dy * s)));
   } else {
-    orbit.yaw -= dx * 0.01;
-    orbit.pitch = Math.max(-1.55, Math.min(1.55, orbit.pitch + dy * 0.01));
+    // A drag across the whole canvas turns the camera by 180 degrees.
+    const k = Math.PI / canvas.clientWidth;
+    orbit.yaw -= dx * k;
+    orbit.pitch = Math.max(-1.55, Math.min(1.55, orbit.pitch + dy * k));
   }
   maybeSend();
 });
@@ -258,9 +287,16 @@ canvas.addEventListener('pointercancel', endDrag);
 canvas.addEventListener('wheel', (e) => {
   if (!orbit) return;
   e.preventDefault();
+  orbit.moved = true;
   orbit.dist *= Math.exp(e.deltaY * 0.001);
   maybeSend();
 }, {passive: false});
+// R or Home: back to the scene's camera.
+document.addEventListener('keydown', (e) => {
+  if (e.target instanceof HTMLSelectElement || e.ctrlKey || e.metaKey || e.altKey) return;
+  if (e.key === 'r' || e.key === 'R' || e.key === 'Home') resetView();
+});
+document.getElementById('reset').addEventListener('click', resetView);
 
 // --- frames -----------------------------------------------------------------
 
@@ -285,6 +321,7 @@ async function show(res, camera, socket) {
   preview.frames.push({
     t: now, latency_ms: received - sent, level: q.level, levels: q.levels, still: !!q.still,
     reason: q.reason, label: q.label, scale: q.scale, format: f.format, bytes: data.length,
+    frame_ms: q.frame_ms, budget_ms: q.budget_ms,
     server_ms: r.timings.server_ms, passes: r.passes, socket,
   });
   if (q.still) {
@@ -296,6 +333,33 @@ async function show(res, camera, socket) {
   updateOverlay();
 }
 
+// A level's label (server/accuracy_controller.cpp) in words, without what does
+// not apply to this scene (a beam table on a scene without beams).
+function describeLevel(label, scale) {
+  const words = [];
+  const volume = [];
+  const hasBeams = !!(sceneJson && Array.isArray(sceneJson.beams) && sceneJson.beams.length);
+  for (const part of (label || '').split('@')[0].split('+')) {
+    let m;
+    if ((m = /^table(\d+)x(\d+)$/.exec(part))) {
+      if (hasBeams) words.push(`beams from a ${m[1]}x${m[2]} table`);
+    } else if ((m = /^march(\d+)$/.exec(part))) {
+      if (hasBeams) words.push(`beams with ${m[1]} samples`);
+    } else if ((m = /^photons(\S+)$/.exec(part))) {
+      words.push(`${m[1]} of the photons`);
+    } else if (part === 'lod') {
+      words.push('fewer near photons');
+    } else if ((m = /^sz(\S+)$/.exec(part))) {
+      volume.push(`${m[1]} sample per voxel`);
+    } else if ((m = /^rv(\d+)$/.exec(part))) {
+      volume.push(`resolution level ${m[1]}`);
+    }
+  }
+  if (volume.length) words.push(`volume: ${volume.join(' and ')}`);
+  if (scale < 1) words.push(`${scale === 0.75 ? '3/4' : scale === 0.5 ? '1/2' : scale === 0.25 ? '1/4' : scale} resolution`);
+  return words.join(', ');
+}
+
 function updateOverlay() {
   const fr = preview.frames;
   const now = performance.now();
@@ -305,12 +369,32 @@ function updateOverlay() {
   const latency = recent.reduce((s, x) => s + x.latency_ms, 0) / Math.max(1, recent.length);
   const last = fr[fr.length - 1];
   if (!last) return;
+  // Level 0 is full accuracy; the server's ladder goes down to levels - 1.
+  let accuracy;
+  if (last.still || last.level === 0) {
+    accuracy = 'full accuracy' + (last.still ? ' (still frame)' : '');
+  } else {
+    const what = describeLevel(last.label, last.scale);
+    accuracy = `reduced accuracy: step ${last.level} of ${last.levels - 1} below full` +
+               (what ? `\n  ${what}` : '');
+  }
+  // Moving frames against the frame budget: the latest, and the share of the
+  // last ten moving frames that took longer.
+  const moving = fr.filter((f) => !f.still).slice(-10);
+  const over = moving.filter((f) => f.frame_ms > f.budget_ms).length;
+  let budget = '';
+  if (!last.still && last.budget_ms > 0) {
+    const miss = last.frame_ms > last.budget_ms;
+    budget = `frame ${last.frame_ms.toFixed(0)} ms / budget ${last.budget_ms} ms` +
+             (miss ? '  OVER BUDGET' : '') + '\n' +
+             (over ? `${over} of the last ${moving.length} moving frames over budget\n` : '');
+    overlay.classList.toggle('over', miss);
+  } else {
+    overlay.classList.remove('over');
+  }
   overlay.textContent =
-      `FPS ${n}  latency ${latency.toFixed(0)} ms\n` +
-      `quality ${last.level}/${last.levels - 1} ${last.label || ''} (${last.reason})` +
-      `${last.still ? ' FULL' : ''}\n` +
-      `${last.format} ${(last.bytes / 1024).toFixed(0)} KiB  server ${last.server_ms.toFixed(0)} ms\n` +
-      `passes ${last.passes.join(' ')}`;
+      `${n} frames/s  latency ${latency.toFixed(0)} ms\n${accuracy}\n${budget}` +
+      `${last.format} ${(last.bytes / 1024).toFixed(0)} KiB  server ${last.server_ms.toFixed(0)} ms`;
 }
 
 function tick() {
@@ -370,6 +454,9 @@ async function getJson(path) {
   return res.json();
 }
 
+// The stored id of an example the page stores: `example.` + its name.
+const exampleId = (name) => 'example.' + name.replace(/\.json$/, '').replace(/[^A-Za-z0-9_.-]/g, '_');
+
 // Makes `value` (a picker value) the scene rendered on this WebSocket: an
 // example is stored on the server first. The view is the scene's first camera,
 // except when the same scene is established again after a reconnection, where
@@ -383,7 +470,7 @@ async function selectScene(value) {
   if (value.startsWith('example:')) {
     const name = value.slice(8);
     json = await getJson('/api/examples/' + encodeURIComponent(name));
-    id = 'example.' + name.replace(/\.json$/, '').replace(/[^A-Za-z0-9_.-]/g, '_');
+    id = exampleId(name);
     await request('scene.put', {scene_id: id, scene: json});
   } else {
     id = value.slice(7);
@@ -391,6 +478,7 @@ async function selectScene(value) {
   }
   if (seq !== selectSeq) return;  // a later pick or reconnection took over
   preview.sceneId = id;
+  sceneJson = json;
   if (viewOf !== value) {
     const cams = json.cameras || [];
     orbit = orbitFromCamera(cams[0] || {});
@@ -400,7 +488,50 @@ async function selectScene(value) {
     resumed = true;
   }
   setStatus(`connected · scene ${preview.sceneId}`);
+  errorEl.hidden = true;
   preview.ready = true;
+}
+
+// The picker: stored scenes, then the examples. The copies this page stored
+// of examples (`example.NAME`) are not listed twice: picking the example
+// stores it again.
+function fillPicker(list) {
+  picker.innerHTML = '';
+  for (const id of ownStored(list)) picker.add(new Option('stored: ' + id, 'stored:' + id));
+  for (const name of list.examples) picker.add(new Option('example: ' + name, 'example:' + name));
+}
+
+// The stored scenes other than this page's copies of examples.
+function ownStored(list) {
+  const copies = new Set(list.examples.map(exampleId));
+  return list.stored.filter((id) => !copies.has(id));
+}
+
+// The picker value for `?scene=NAME`: a stored id, an example file name, or
+// an example's name without `.json`; null if there is none.
+function pickerValue(list, want) {
+  if (list.stored.includes(want)) return 'stored:' + want;
+  if (list.examples.includes(want)) return 'example:' + want;
+  if (list.examples.includes(want + '.json')) return 'example:' + want + '.json';
+  const copy = list.examples.find((n) => exampleId(n) === want);
+  return copy ? 'example:' + copy : null;
+}
+
+// The bare URL opens the demo: the stored `demo` (beamcast-server preloads it
+// unless --no-demo), else its example file, else the first scene listed.
+function defaultScene(list) {
+  return pickerValue(list, 'demo') || pickerValue(list, 'paper_10sets.json') ||
+         (list.stored[0] ? 'stored:' + list.stored[0] : null) ||
+         (list.examples[0] ? 'example:' + list.examples[0] : null);
+}
+
+// A visible error over the canvas (and in the status line); cleared when a
+// scene is established.
+function showError(text) {
+  setStatus('error', 'error');
+  preview.errors[preview.errors.length - 1] = text;
+  errorEl.textContent = text;
+  errorEl.hidden = false;
 }
 
 // On every open WebSocket: the first time fills the picker and starts the
@@ -409,17 +540,20 @@ async function establish(sock) {
   try {
     if (!started) {
       const list = await getJson('/api/scenes');
-      picker.innerHTML = '';
-      for (const id of list.stored) picker.add(new Option('stored: ' + id, 'stored:' + id));
-      for (const name of list.examples) picker.add(new Option('example: ' + name, 'example:' + name));
+      fillPicker(list);
       const want = params.get('scene');
-      if (want) {
-        const v = list.stored.includes(want) ? 'stored:' + want : 'example:' + want;
-        picker.value = v;
+      const value = want ? pickerValue(list, want) : defaultScene(list);
+      if (!value) {
+        showError(`No scene "${want}" on this server. Stored scenes: ${ownStored(list).join(', ') || 'none'}. ` +
+                  `Examples: ${list.examples.join(', ') || 'none'}. ` +
+                  'Pick one above, or open the page with ?scene=NAME.');
+        picker.value = '';
+      } else {
+        picker.value = value;
       }
       picker.onchange = () => selectScene(picker.value).catch((e) => {
         // Without a WebSocket the reconnection establishes the picked scene.
-        if (e.code !== 'disconnected') setStatus(String(e.message || e), 'error');
+        if (e.code !== 'disconnected') showError(`scene ${sceneKey()}: ${e.code || ''} ${e.message || e}`);
       });
       started = true;
       requestAnimationFrame(tick);
@@ -431,7 +565,7 @@ async function establish(sock) {
     if (e.code) {
       // The server refused the scene or has none by that name: another
       // attempt would get the same answer.
-      setStatus(`scene: ${e.code}: ${e.message}`, 'error');
+      showError(`scene ${sceneKey()}: ${e.code}: ${e.message}`);
       return;
     }
     // A fetch failed: start over on a new WebSocket, after the backoff.

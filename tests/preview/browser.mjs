@@ -1,7 +1,10 @@
 // Shared by the preview page's browser tests: Debian's headless chromium
 // through playwright-core (no browser is downloaded), and the page's errors.
 import {chromium} from 'playwright-core';
+import {spawn} from 'node:child_process';
 import fs from 'node:fs';
+import path from 'node:path';
+import readline from 'node:readline';
 
 export function requireChromium() {
   if (!fs.existsSync('/usr/bin/chromium')) {
@@ -70,4 +73,29 @@ export function checkList() {
     if (!ok) failures.push(what);
   };
   return {failures, check};
+}
+
+// beamcast-server on ephemeral loopback ports, its log in DIR/server.log:
+// resolves to {proc, url} once it prints its preview URL.
+export function startServer(serverBin, dir, args = []) {
+  const proc = spawn(serverBin, ['--bind', '127.0.0.1', '--port', '0', '--http-port', '0', ...args],
+                     {stdio: ['ignore', 'pipe', 'pipe']});
+  const log = fs.createWriteStream(path.join(dir, 'server.log'));
+  proc.stderr.pipe(log);
+  return new Promise((resolve, reject) => {
+    const lines = readline.createInterface({input: proc.stdout});
+    let url = null;
+    const timer = setTimeout(() => reject(new Error('server did not print its URL in 60 s')), 60000);
+    lines.on('line', (line) => {
+      log.write(line + '\n');
+      const m = /preview: (http:\/\/\S+)/.exec(line);
+      if (m && !url) {
+        url = m[1];
+        clearTimeout(timer);
+        resolve({proc, url});
+      }
+    });
+    proc.on('error', (e) => reject(new Error(`cannot start ${serverBin}: ${e.message}`)));
+    proc.on('exit', (code) => reject(new Error(`server exited early (${code}); see server.log`)));
+  });
 }

@@ -6,18 +6,30 @@
 //  2. a full-accuracy frame arrives within one second of the release,
 //  3. that frame is pixel-identical to `beamcast render` of the same pose.
 // Reports the frames per second the browser received while dragging.
+// With --view-checks (issue 40), also that
+//  4. the first still frame is identical to `beamcast render` of the scene
+//     file itself at the canvas size (the page opens on the scene's camera,
+//     its `up` included),
+//  5. a drag across the whole canvas width turns the camera by 180 degrees
+//     about the scene's up axis (height along it and distance kept),
+//  6. the reset key returns the initial view: the same camera, the same
+//     still frame byte for byte,
+//  7. an unknown ?scene= shows a visible error naming the scene and what is
+//     available, and ?scene=NAME without .json finds NAME.json,
+//  8. the overlay while dragging names the reduced accuracy in words and the
+//     budget, with no beam table for a scene without beams.
 //
 // node preview_test.mjs --server BIN --cli BIN --artifacts DIR
 //     [--scene demo] [--size 512] [--drag-ms 2000] [--budget 33]
-//     [--still-deadline-ms 1000]
+//     [--still-deadline-ms 1000] [--view-checks]
 // --scene names a stored scene or an example file (volume_ml256.json: the
 // page stores it, as its picker does).
-import {spawn, execFileSync} from 'node:child_process';
+import {execFileSync} from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import readline from 'node:readline';
-import {launchBrowser, pointerMoves, requireChromium, stillAfter, checkList} from './browser.mjs';
+import {fileURLToPath} from 'node:url';
+import {launchBrowser, pointerMoves, requireChromium, startServer, stillAfter, checkList} from './browser.mjs';
 import {decodePng} from './png.mjs';
 
 const argv = process.argv.slice(2);
@@ -40,6 +52,7 @@ const stillDeadlineMs = parseInt(opt('still-deadline-ms', '1000'), 10);
 // Frames in the first part of the drag are excluded from the rate: the
 // controller starts from its first measurement and the pipeline fills.
 const warmupMs = 300;
+const viewChecks = argv.includes('--view-checks');
 
 const {failures, check} = checkList();
 
@@ -50,34 +63,122 @@ if (!serverBin || !cliBin) {
 requireChromium();
 fs.mkdirSync(artifacts, {recursive: true});
 
-function startServer() {
-  const proc = spawn(serverBin, ['--bind', '127.0.0.1', '--port', '0', '--http-port', '0'],
-                     {stdio: ['ignore', 'pipe', 'pipe']});
-  const log = fs.createWriteStream(path.join(artifacts, 'server.log'));
-  proc.stderr.pipe(log);
-  return new Promise((resolve, reject) => {
-    const lines = readline.createInterface({input: proc.stdout});
-    let url = null;
-    const timer = setTimeout(() => reject(new Error('server did not print its URL in 60 s')), 60000);
-    lines.on('line', (line) => {
-      log.write(line + '\n');
-      const m = /preview: (http:\/\/\S+)/.exec(line);
-      if (m && !url) {
-        url = m[1];
-        clearTimeout(timer);
-        resolve({proc, url});
-      }
-    });
-    proc.on('error', (e) => reject(new Error(`cannot start ${serverBin}: ${e.message}`)));
-    proc.on('exit', (code) => reject(new Error(`server exited early (${code}); see server.log`)));
+// Runs `fn`, then logs how long it took (the cost of each --view-checks part).
+async function timed(what, fn) {
+  const t0 = performance.now();
+  await fn();
+  console.log(`(${what}: ${((performance.now() - t0) / 1000).toFixed(1)} s)`);
+}
+
+// The latest full-accuracy frame: {camera, png (a Buffer)}.
+async function stillOf(page) {
+  const s = await page.evaluate(() => {
+    const s = window.beamcastPreview.lastStill;
+    let bin = '';
+    for (let i = 0; i < s.bytes.length; i += 0x8000) {
+      bin += String.fromCharCode.apply(null, s.bytes.subarray(i, i + 0x8000));
+    }
+    return {camera: s.camera, png: btoa(bin)};
   });
+  return {camera: s.camera, png: Buffer.from(s.png, 'base64')};
+}
+
+// Checks two PNGs decode to the same pixels at the canvas size.
+function checkIdentical(livePng, offlinePng, what) {
+  const offline = decodePng(offlinePng);
+  const live = decodePng(livePng);
+  let differing = 0, maxDiff = 0;
+  if (offline.data.length === live.data.length) {
+    for (let i = 0; i < live.data.length; ++i) {
+      const d = Math.abs(live.data[i] - offline.data[i]);
+      if (d) { ++differing; maxDiff = Math.max(maxDiff, d); }
+    }
+  }
+  const same = live.width === offline.width && live.height === offline.height &&
+               live.width === size && differing === 0;
+  check(same, `${what} pixel-identical to the offline render (${live.width}x${live.height}, ` +
+              `${differing} differing values, max difference ${maxDiff})`);
+  return same;
+}
+
+// 4. The first still frame against `beamcast render` of the scene file at
+// the canvas size (`--size`).
+async function checkFirstFrame(initial) {
+  const src = fileURLToPath(new URL(`../../examples/${sceneId}`, import.meta.url));
+  const scene = JSON.parse(fs.readFileSync(src, 'utf8'));
+  check(JSON.stringify({...scene.cameras[0], name: 'preview', width: size, height: size}) ===
+            JSON.stringify(initial.camera),
+        `the first frame's camera is the scene's first camera (${JSON.stringify(initial.camera)})`);
+  const dir = path.join(artifacts, 'offline-first');
+  fs.rmSync(dir, {recursive: true, force: true});
+  execFileSync(cliBin, ['render', src, '--size', `${size}x${size}`, '--out', dir], {stdio: 'inherit'});
+  fs.writeFileSync(path.join(artifacts, 'first_frame.png'), initial.png);
+  checkIdentical(initial.png, fs.readFileSync(path.join(dir, `${scene.cameras[0].name}.png`)),
+                 'first still frame');
+}
+
+// 5 and 6: a drag across the canvas width, then the reset key.
+async function checkTurnAndReset(page, initial, cx, cy, width) {
+  const cam0 = initial.camera;
+  const up = cam0.up || [0, 1, 0];
+  const rel = (c) => c.position.map((v, i) => v - c.target[i]);
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  await page.keyboard.press('r');  // from the first drag's pose back to the scene's
+  await page.mouse.move(cx - width / 2 + 1, cy);
+  await page.mouse.down();
+  await page.mouse.move(cx + width / 2 - 1, cy, {steps: 8});
+  await page.mouse.up();
+  // The pose the drag ended on (the page's view, requested or not yet).
+  const turned = await page.evaluate(() => window.beamcastPreview.view());
+  const a = rel(cam0), b = rel(turned);
+  // The angle about `up` between the horizontal parts of the two offsets.
+  const h = (v) => v.map((x, i) => x - dot(v, up) * up[i] / dot(up, up));
+  const cos = dot(h(a), h(b)) / Math.sqrt(dot(h(a), h(a)) * dot(h(b), h(b)));
+  const deg = Math.acos(Math.max(-1, Math.min(1, cos))) * 180 / Math.PI;
+  // (width - 2) of width pixels: 179.3 degrees at 512, 177.2 at 128; 2 degrees
+  // of slack on top.
+  check(Math.abs(deg - 180 * (width - 2) / width) < 2 &&
+            Math.abs(dot(a, up) - dot(b, up)) < 1e-4 && Math.abs(dot(a, a) - dot(b, b)) < 1e-3,
+        `a drag across the canvas turns ${deg.toFixed(1)} degrees about the scene's up axis ` +
+        `(height ${dot(a, up).toFixed(4)} -> ${dot(b, up).toFixed(4)})`);
+  await page.screenshot({path: path.join(artifacts, 'turned.png')});
+  const tReset = await page.evaluate(() => performance.now());
+  await page.locator('#reset').click();
+  const at = await stillAfter(page, tReset);
+  await page.screenshot({path: path.join(artifacts, 'reset.png')});
+  const back = at === null ? null : await stillOf(page);
+  check(back !== null && JSON.stringify(back.camera) === JSON.stringify(cam0) &&
+            back.png.equals(initial.png),
+        'the reset button returns the initial view (same camera, same still frame bytes)');
+}
+
+// 7. Scene names in the URL, on pages of their own (one browser).
+async function checkSceneNames(context) {
+  const page = await context.newPage();
+  // At 64x64: these pages' frames are not looked at.
+  await page.goto(`${server.url}?scene=nope&size=64`);
+  let text = '';
+  try {
+    await page.locator('#error').waitFor({state: 'visible', timeout: 10000});
+    text = await page.locator('#error').innerText();
+  } catch {
+    text = '(no visible error)';
+  }
+  await page.screenshot({path: path.join(artifacts, 'unknown_scene.png')});
+  check(text.includes('"nope"') && text.includes('demo') && text.includes('cornell_box.json'),
+        `an unknown scene shows a visible error naming it and what is available: ${text}`);
+  await page.goto(`${server.url}?scene=paper_1set&size=64`);
+  const found = await page.waitForFunction(() => window.beamcastPreview.sceneId, null,
+                                           {timeout: 30000}).then((h) => h.jsonValue(), () => null);
+  check(found === 'example.paper_1set', `?scene=paper_1set opens paper_1set.json (${found})`);
+  await page.close();
 }
 
 let server = null;
 let context = null;
 const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'beamcast-preview-'));
 try {
-  server = await startServer();
+  server = await startServer(serverBin, artifacts);
   console.log(`server: ${server.url}`);
   context = await launchBrowser(userDataDir, size);
   const page = context.pages()[0] || await context.newPage();
@@ -89,6 +190,8 @@ try {
   await page.waitForFunction(() => window.beamcastPreview && window.beamcastPreview.lastStill,
                              null, {timeout: 60000});
   await page.screenshot({path: path.join(artifacts, 'initial.png')});
+  const initial = viewChecks ? await stillOf(page) : null;
+  if (viewChecks) await timed('first frame vs offline render', () => checkFirstFrame(initial));
 
   // Drag: a smooth orbit, one pointer move per ~16 ms (a 60 Hz mouse).
   const box = await page.locator('#canvas').boundingBox();
@@ -111,6 +214,7 @@ try {
   await dragFor(dragMs, 100);
   const t1 = await page.evaluate(() => performance.now());
   await page.screenshot({path: path.join(artifacts, 'dragging.png')});
+  const movingOverlay = await page.locator('#overlay').innerText();
   await page.mouse.up();
   const tRelease = await page.evaluate(() => performance.now());
 
@@ -152,15 +256,8 @@ try {
         `full-accuracy frame within ${stillDeadlineMs} ms of the release (${result.still_after_release_ms} ms)`);
 
   // 3. Pixel-identical to an offline render of the same pose.
-  const still = await page.evaluate(() => {
-    const s = window.beamcastPreview.lastStill;
-    let bin = '';
-    for (let i = 0; i < s.bytes.length; i += 0x8000) {
-      bin += String.fromCharCode.apply(null, s.bytes.subarray(i, i + 0x8000));
-    }
-    return {camera: s.camera, png: btoa(bin)};
-  });
-  const stillPng = Buffer.from(still.png, 'base64');
+  const still = await stillOf(page);
+  const stillPng = still.png;
   fs.writeFileSync(path.join(artifacts, 'still_frame.png'), stillPng);
   // The scene as the server stored it (an example, `--scene NAME.json`, is
   // stored by the page under its own id).
@@ -172,20 +269,20 @@ try {
   const offlineDir = path.join(artifacts, 'offline');
   fs.rmSync(offlineDir, {recursive: true, force: true});
   execFileSync(cliBin, ['render', scenePath, '--out', offlineDir], {stdio: 'inherit'});
-  const offline = decodePng(fs.readFileSync(path.join(offlineDir, `${still.camera.name}.png`)));
-  const live = decodePng(stillPng);
-  let differing = 0, maxDiff = 0;
-  if (offline.data.length === live.data.length) {
-    for (let i = 0; i < live.data.length; ++i) {
-      const d = Math.abs(live.data[i] - offline.data[i]);
-      if (d) { ++differing; maxDiff = Math.max(maxDiff, d); }
-    }
+  const offline = fs.readFileSync(path.join(offlineDir, `${still.camera.name}.png`));
+  result.still_pixel_identical = checkIdentical(stillPng, offline, 'still frame');
+
+  if (viewChecks) {
+    // 8. The overlay in words: a reduced level says so and names its budget,
+    // and a scene without beams shows no beam table.
+    const src = fileURLToPath(new URL(`../../examples/${sceneId}`, import.meta.url));
+    const hasBeams = (JSON.parse(fs.readFileSync(src, 'utf8')).beams || []).length > 0;
+    check(/reduced accuracy: step \d+ of \d+ below full/.test(movingOverlay) &&
+              /budget \d+ ms/.test(movingOverlay) && !/quality \d/.test(movingOverlay) &&
+              (hasBeams || !/table/.test(movingOverlay)),
+          `the overlay while dragging says the accuracy in words: ${JSON.stringify(movingOverlay)}`);
+    await timed('turn and reset', () => checkTurnAndReset(page, initial, cx, cy, box.width));
   }
-  check(live.width === offline.width && live.height === offline.height && live.width === size &&
-        differing === 0,
-        `still frame pixel-identical to the offline render (${live.width}x${live.height}, ` +
-        `${differing} differing values, max difference ${maxDiff})`);
-  result.still_pixel_identical = differing === 0;
 
   // The scene picker: an example is stored over the WebSocket and rendered.
   const before = await page.evaluate(() => window.beamcastPreview.frames.length);
@@ -202,6 +299,7 @@ try {
   }
   await page.screenshot({path: path.join(artifacts, 'example_scene.png')});
   check(picked, 'picking an example scene stores it and shows its full-accuracy frame');
+  if (viewChecks) await timed('scene names', () => checkSceneNames(context));
   fs.writeFileSync(path.join(artifacts, 'result.json'), JSON.stringify(result, null, 2));
 } catch (e) {
   failures.push(String(e.stack || e));
