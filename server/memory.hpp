@@ -72,11 +72,13 @@ inline constexpr std::size_t kIdlePhotonCacheBytes = 16u << 20;
 // frees. So after the release, if the process is still more than
 // kRebuildWhenIdleAboveBytes above its leanest idle size (the lowest RSS
 // seen after an idle release, at most its size at start plus
-// kRebuildWhenIdleAboveBytes), the idle worker replaces its renderer with a
+// kRebuildWhenIdleAboveBytes; after a replacement, the size it left), the
+// idle worker replaces its renderer with a
 // new one (a new GL context, ~0.1-0.3 s of CPU; the next render compiles its
 // shader variants again). Between small renders RSS stays under it (a
 // small render of each kind adds up to 45 MiB of shader variants and
 // tables over the server's size at start), so a normal session never pays it.
+// Not under ASan, whose quarantine is most of the resident size.
 inline constexpr std::uint64_t kRebuildWhenIdleAboveBytes = 48ull << 20;
 // The process's resident size (/proc/self/statm), 0 if unknown.
 std::uint64_t resident_bytes();
