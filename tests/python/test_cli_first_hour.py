@@ -161,12 +161,7 @@ def main():
         # Wrong ports.
         with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
             s.sendall(b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nUser-Agent: curl/7.88\r\n\r\n")
-            reply = b""
-            while True:
-                chunk = s.recv(4096)
-                if not chunk:
-                    break
-                reply += chunk
+            reply = s.makefile("rb").read()  # up to the server's close
         text = reply.decode("utf-8", "replace")
         check("HTTP on the TCP port: a plain HTTP answer naming the HTTP port",
               text.startswith("HTTP/1.1 400") and f"port {http_port}" in text, text)
