@@ -208,14 +208,21 @@ TEST(HostileRenders, CachedPhotonMapsAreGivenBackOnceIdle) {
               std::chrono::duration<double>(Clock::now() - t0).count(), before, held, after);
   EXPECT_GE(server.core().renders->idle_releases(), 2u);
 #if !defined(__SANITIZE_ADDRESS__)
-  // Right after the render the cache holds the maps (measured +35 MiB, and
-  // still +35 after 4 s without the release); once idle the cache keeps at
-  // most 16 MiB of maps (these are larger: evicted; measured +6 MiB). 20
-  // MiB: that plus room for the test client's buffers, under what the kept
-  // maps hold. Not under AddressSanitizer: its quarantine keeps freed
+  // Right after the render the cache holds the maps (measured +35 MiB here,
+  // +54 in CI, and still +35 after 4 s without the release); once idle the
+  // cache keeps at most 16 MiB of maps (these are larger: evicted), so the
+  // release gives back what they held: measured 30 MiB both here and in CI.
+  // What stays above the baseline is not the cache's and differs between
+  // machines (+6 MiB here, +24 in CI: llvmpipe's code for the shader
+  // variants this render compiled, allocator pages), so it is held to the
+  // issue's budget (50 MiB) and the release's share is checked on its own:
+  // 20 MiB, two thirds of the measured return and far above the ~0 returned
+  // without it. Not under AddressSanitizer: its quarantine keeps freed
   // memory resident.
   EXPECT_GT(held - before, 25.0) << "the render held too little to tell";
-  EXPECT_LT(after - before, 20.0) << "RSS " << before << " MiB -> " << after << " MiB once idle";
+  EXPECT_GT(held - after, 20.0) << "RSS " << held << " MiB -> " << after
+                                << " MiB: the idle release gave back too little";
+  EXPECT_LT(after - before, 50.0) << "RSS " << before << " MiB -> " << after << " MiB once idle";
 #endif
   const Reply again = c.call(request);  // traced again: answers as before
   EXPECT_TRUE(again.json.value("ok", false)) << again.json.dump().substr(0, 300);
