@@ -7,43 +7,78 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <unistd.h>
 
 #include "shaders/shader_sources.hpp"
 
 namespace beamcast {
 namespace {
 
-// Runs glslangValidator on `src` (stage from the file extension of `name`);
-// returns its exit status and output.
-std::pair<int, std::string> validate(const std::string& name, const std::string& src) {
+// Runs glslangValidator once on every (name, source) of `files` (stage from
+// the file extension of each name); returns its exit status and, per name,
+// what it printed about that file. One process for all files: the validator
+// prints each file's name and then its messages, and goes on after an error.
+// (One process a stage took 58 CPU-s for the 167 stages; one for all, 0.6.)
+std::pair<int, std::map<std::string, std::string>> validate_all(
+    const std::vector<std::pair<std::string, std::string>>& files) {
   const std::string validator = GLSLANG_VALIDATOR;
   if (validator.empty() || validator.ends_with("NOTFOUND")) {
-    return {-1, "glslangValidator not found at configure time (apt-get install glslang-tools)"};
+    return {-1, {{"", "glslangValidator not found at configure time (apt-get install glslang-tools)"}}};
   }
-  const auto dir = std::filesystem::temp_directory_path() / "beamcast_shader_check";
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("beamcast_shader_check_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
-  const auto file = dir / name;
-  std::ofstream(file) << src;
-  const std::string cmd = validator + " " + file.string() + " > " + file.string() + ".log 2>&1";
+  std::string cmd = "cd " + dir.string() + " && " + validator;
+  std::map<std::string, std::string> out;
+  for (const auto& [name, src] : files) {
+    std::ofstream(dir / name) << src;
+    cmd += " " + name;
+    out[name];
+  }
+  cmd += " > validator.log 2>&1";
   const int rc = std::system(cmd.c_str());
-  std::ifstream log(file.string() + ".log");
-  return {rc, std::string((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>())};
+  std::ifstream log(dir / "validator.log");
+  std::string line;
+  std::string* current = nullptr;
+  while (std::getline(log, line)) {
+    if (const auto it = out.find(line); it != out.end()) {
+      current = &it->second;
+    } else if (current != nullptr) {
+      *current += line + "\n";
+    } else {
+      out[""] += line + "\n";
+    }
+  }
+  std::filesystem::remove_all(dir);
+  return {rc, out};
+}
+
+std::pair<int, std::string> validate(const std::string& name, const std::string& src) {
+  auto [rc, logs] = validate_all({{name, src}});
+  return {rc, logs[""] + logs[name]};
 }
 
 // Every program and variant of shaders/programs.txt (the list the renderer builds).
 TEST(Shaders, EveryStageCompilesWithGlslangValidator) {
   ASSERT_GE(shader_programs().size(), 8u);
+  std::vector<std::pair<std::string, std::string>> files;
   for (const ShaderProgramSpec& p : shader_programs()) {
     for (const auto& [parts, ext] : {std::pair{p.vertex, "vert"}, std::pair{p.fragment, "frag"},
                                      std::pair{p.compute, "comp"}}) {
-      if (parts.empty()) continue;
-      const auto [rc, log] = validate(p.name + "." + ext, assemble_shader(parts));
-      EXPECT_EQ(rc, 0) << p.name << "." << ext << ":\n" << log;
+      if (!parts.empty()) files.emplace_back(p.name + "." + ext, assemble_shader(parts));
     }
+  }
+  const auto [rc, logs] = validate_all(files);
+  EXPECT_EQ(rc, 0) << (logs.count("") ? logs.at("") : "");
+  for (const auto& [name, log] : logs) {
+    EXPECT_EQ(log.find("ERROR"), std::string::npos) << name << ":\n" << log;
   }
 }
 
