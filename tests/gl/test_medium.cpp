@@ -58,10 +58,26 @@ Scene example_at(const char* file, int size) {
   return scene;
 }
 
-// The path tracer's image of a lit scene at 1024 paths a pixel.
+// The three comparisons with the path tracer below check accuracy in the
+// release build. Under ASan + UBSan (CI's last stage, which looks for memory
+// errors and undefined behaviour) their 1024-path references cost ~100 CPU-s
+// each in the sanitized Debug build (docs/performance.md, "The test command's
+// time"): there the same code runs at 16 paths a pixel and one photon seed,
+// and only finiteness is checked, since a mean at 16 paths is too noisy to
+// bound.
+#ifdef BEAMCAST_SANITIZE_BUILD
+constexpr bool kCheckAccuracy = false;
+constexpr int kReferencePaths = 16;
+#else
+constexpr bool kCheckAccuracy = true;
+constexpr int kReferencePaths = 1024;
+#endif
+
+// The path tracer's image of a lit scene at 1024 paths a pixel (16 under
+// the sanitizers, above).
 HdrImage path_traced(const Scene& scene) {
   ReferenceOptions ro;
-  ro.gi_spp = 1024;
+  ro.gi_spp = kReferencePaths;
   return render_reference(scene, scene.cameras[0], ro);
 }
 
@@ -164,6 +180,7 @@ TEST(Medium, TheFogStageMatchesThePathTracer) {
     std::printf("estimator %s: mean %.4f (reference %.4f), rel L1 %.3f\n",
                 est == VolumeEstimator::kBeam ? "beam" : "seed", got, want, e.rel_l1);
     EXPECT_EQ(e.nonfinite, 0);
+    if (!kCheckAccuracy) continue;
     EXPECT_NEAR(got / want, 1.0, 0.05);
     EXPECT_LT(e.rel_l1, 0.3);
   }
@@ -271,7 +288,8 @@ TEST(Medium, EmittingBeamsLightTheFogAroundThem) {
   const double got =
       image_mean(renderer().render(scene, FrameOptions{.read_hdr = true})[0].hdr);
   std::printf("beam fog: mean ratio %.4f\n", got / want);
-  EXPECT_NEAR(got / want, 1.0, 0.05);
+  EXPECT_TRUE(std::isfinite(got) && std::isfinite(want));
+  if (kCheckAccuracy) EXPECT_NEAR(got / want, 1.0, 0.05);
 }
 
 // examples/ground_fog.json (the seed's fig 5.9: a dense layer of fog on the
@@ -287,13 +305,14 @@ TEST(Medium, TheGroundFogMatchesThePathTracer) {
   Scene scene = example_at("ground_fog.json", 48);
   const double want = image_mean(path_traced(scene));
   double got = 0.0;
-  constexpr int kSeeds = 4;
+  constexpr int kSeeds = kCheckAccuracy ? 4 : 1;
   for (int seed = 1; seed <= kSeeds; ++seed) {
     scene.gi.seed = static_cast<std::uint64_t>(seed);
     got += image_mean(renderer().render(scene, FrameOptions{.read_hdr = true})[0].hdr) / kSeeds;
   }
   std::printf("ground fog: mean ratio %.4f\n", got / want);
-  EXPECT_NEAR(got / want, 1.0, 0.05);
+  EXPECT_TRUE(std::isfinite(got) && std::isfinite(want));
+  if (kCheckAccuracy) EXPECT_NEAR(got / want, 1.0, 0.05);
 }
 
 // The ground fog's layer bounded by a 12-triangle mesh instead of its box:

@@ -302,12 +302,21 @@ try {
   killC.first_frame_after_up_ms = sinceUp(killC.first_frame_ms);
   result.no_server_for_3s = killC;
   console.log(`no server for 3 s, then s${a + 1} back: ${JSON.stringify(killC)}`);
-  // The next attempt comes within one capped backoff (2 s) of HAProxy having
-  // the server up, then one full-accuracy frame on a fresh server (< 1 s).
+  // The page's part: an attempt already at HAProxy when the server came up
+  // may still be answered 503 after HAProxy's 1 s turn-around, and the next
+  // comes within one capped backoff (2 s): 3 s, plus 500 ms for the
+  // handshake. The server's part: its first frame, bounded as after a kill
+  // (frameAfterKillMs). One 3 s bound on both failed once in CI's ASan stage
+  // (reconnect 1.9 s, then 1.5 s for a fresh server's first frame, which
+  // took 1.3-1.4 s after the other reconnects of the same run too).
   check(upC.seconds !== null && killC.state === 'connected' && killC.reconnects === 3 &&
-        killC.first_frame_after_up_ms !== null && killC.first_frame_after_up_ms <= 3000,
-        `resumed ${killC.reconnected_after_up_ms} ms after s${a + 1} was up again, frame ` +
-        `${killC.first_frame_after_up_ms} ms (bound 3000 ms)`);
+        killC.reconnected_after_up_ms !== null && killC.reconnected_after_up_ms <= 3500,
+        `resumed ${killC.reconnected_after_up_ms} ms after s${a + 1} was up again (bound 3500 ms)`);
+  check(killC.first_frame_after_up_ms !== null &&
+        killC.first_frame_after_up_ms - killC.reconnected_after_up_ms <= frameAfterKillMs,
+        `then a frame ${killC.first_frame_after_up_ms} ms after it was up ` +
+        `(${(killC.first_frame_after_up_ms - killC.reconnected_after_up_ms).toFixed(1)} ms after ` +
+        `the reconnect, bound ${frameAfterKillMs} ms)`);
 
   // 5. The page's own errors.
   const page5 = await page.evaluate(() => ({errors: window.beamcastPreview.errors,
