@@ -1,5 +1,6 @@
 #include "gi/photon_cache.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <functional>
 #include <string_view>
@@ -147,8 +148,8 @@ std::shared_ptr<const PhotonMaps> PhotonCache::get(const Scene& scene, bool* tra
       return entries_.front().maps;
     }
   }
-  const GiScene surfaces(scene);
-  auto maps = std::make_shared<const PhotonMaps>(trace_photons(scene, surfaces));
+  std::shared_ptr<const PhotonMaps> maps = offered_ && offered_key_ == key ? offered_ : nullptr;
+  if (!maps) maps = std::make_shared<const PhotonMaps>(trace_photons(scene, GiScene(scene)));
   if (traced) *traced = true;
   const std::size_t bytes =
       (maps->global.size() + maps->caustic.size() + maps->volume.size()) * sizeof(Photon);
@@ -165,6 +166,10 @@ std::shared_ptr<const PhotonMaps> PhotonCache::get(const Scene& scene, bool* tra
     entries_.pop_back();
   }
   return maps;
+}
+
+bool PhotonCache::holds(const std::string& key) const {
+  return std::any_of(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.key == key; });
 }
 
 void PhotonCache::shrink_to(std::size_t max_bytes) {

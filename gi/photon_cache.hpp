@@ -27,7 +27,17 @@ class PhotonCache {
  public:
   explicit PhotonCache(std::size_t max_bytes = std::size_t{256} << 20) : max_bytes_(max_bytes) {}
   // The scene's maps, traced now (and kept) unless cached; `traced` tells which.
+  // Maps offered for the scene's key (offer) are taken as if traced now.
   std::shared_ptr<const PhotonMaps> get(const Scene& scene, bool* traced = nullptr);
+  // Whether maps for this photon_key are kept.
+  bool holds(const std::string& key) const;
+  // Maps traced elsewhere (another thread: trace_photons over GiScene(scene),
+  // the same maps get() would trace) for the scene of `key`: get() takes them
+  // in place of tracing, until offer() is called again (null: none).
+  void offer(std::string key, std::shared_ptr<const PhotonMaps> maps) {
+    offered_key_ = std::move(key);
+    offered_ = std::move(maps);
+  }
   // The photon search structures over `maps` (which get() returned and
   // which is still cached; else built for this call only), built on first
   // use and kept with the maps: one per skip_direct.
@@ -57,6 +67,8 @@ class PhotonCache {
   std::size_t max_bytes_;
   std::size_t bytes_ = 0;
   std::list<Entry> entries_;  // most recently used first
+  std::string offered_key_;
+  std::shared_ptr<const PhotonMaps> offered_;
 };
 
 }  // namespace beamcast

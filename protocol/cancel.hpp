@@ -1,5 +1,6 @@
 // Cancelling long CPU work from outside it (issue 43): a request's wall-clock
-// deadline (the server's max_render_ms) and the server's shutdown.
+// deadline (the server's max_render_ms), its client going away, and the
+// server's shutdown.
 //
 // The thread that starts a piece of work installs a CancelToken for its scope
 // (CancelScope); every long loop (photon tracing, the CPU gather, the path
@@ -17,7 +18,7 @@ namespace beamcast {
 
 class Cancelled : public std::runtime_error {
  public:
-  enum class Reason { kDeadline, kShutdown };
+  enum class Reason { kDeadline, kShutdown, kClientGone };
   Cancelled(Reason r, const char* what) : std::runtime_error(what), reason_(r) {}
   Reason reason() const { return reason_; }
 
@@ -29,23 +30,28 @@ class CancelToken {
  public:
   using Clock = std::chrono::steady_clock;
   // `stop` (may be null): a flag that cancels the work once set (the
-  // server's drain deadline); it must outlive the token.
+  // server's drain deadline); `alive` (may be null): a flag that cancels it
+  // once cleared (the client's connection closed). Both must outlive the token.
   explicit CancelToken(Clock::time_point deadline = Clock::time_point::max(),
-                       const std::atomic<bool>* stop = nullptr)
-      : deadline_(deadline), stop_(stop) {}
+                       const std::atomic<bool>* stop = nullptr,
+                       const std::atomic<bool>* alive = nullptr)
+      : deadline_(deadline), stop_(stop), alive_(alive) {}
 
   Clock::time_point deadline() const { return deadline_; }
   bool expired() const { return deadline_ != Clock::time_point::max() && Clock::now() >= deadline_; }
   bool stopped() const { return stop_ && stop_->load(std::memory_order_relaxed); }
-  // Throws Cancelled if stopped or past the deadline.
+  bool client_gone() const { return alive_ && !alive_->load(std::memory_order_relaxed); }
+  // Throws Cancelled if stopped, the client has gone or past the deadline.
   void check() const {
     if (stopped()) throw Cancelled(Cancelled::Reason::kShutdown, "cancelled: the server is stopping");
+    if (client_gone()) throw Cancelled(Cancelled::Reason::kClientGone, "cancelled: the client has gone");
     if (expired()) throw Cancelled(Cancelled::Reason::kDeadline, "cancelled: past the deadline");
   }
 
  private:
   Clock::time_point deadline_;
   const std::atomic<bool>* stop_;
+  const std::atomic<bool>* alive_;
 };
 
 namespace detail {

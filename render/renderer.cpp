@@ -535,9 +535,24 @@ HdrImage box_downsample(const HdrImage& big, int k) {
 
 }  // namespace
 
+bool Renderer::needs_photon_trace(const Scene& scene, const FrameOptions& opts) const {
+  if (opts.photon_maps || scene.lights.empty()) return false;
+  const FramePlan plan = make_plan(PlanInput{scene, opts.resolution_scale});
+  const bool uses = plan.uploads_group("photons") || plan.uploads_group("volume_photons") ||
+                    plan.uploads_group("specular");
+  return uses && !impl_->photons.holds(photon_key(scene));
+}
+
 std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<Camera>& cameras,
                                           const FrameOptions& opts) {
   const EglContext::Current current(*impl_->context);
+  // Maps traced before the render are taken by the photon cache in place of
+  // tracing; offered for this call only.
+  struct Offer {
+    PhotonCache& cache;
+    ~Offer() { cache.offer({}, nullptr); }
+  } offer{impl_->photons};
+  if (opts.photon_maps) impl_->photons.offer(photon_key(scene), opts.photon_maps);
   const int k = scene.output.supersample;
   // Supersampled: every camera at k times the size, its HDR box-filtered
   // back and tone-mapped here (render/image.hpp's tone_map, the same curve

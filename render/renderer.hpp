@@ -15,6 +15,8 @@
 
 namespace beamcast {
 
+struct PhotonMaps;
+
 struct RendererOptions {
   EglOptions egl;
   std::size_t table_cache_entries = 64;  // CPU-side line-integral tables kept
@@ -66,6 +68,10 @@ struct FrameOptions {
   // plan (render size, RGBA float, rows top-down) into FrameResult::targets;
   // names the plan does not use are skipped. For tests and benches.
   std::vector<std::string> read_targets{};
+  // The scene's photon maps, traced before the render on another thread
+  // (trace_photons over GiScene(scene): what the render would trace itself;
+  // Renderer::needs_photon_trace): used, and cached, in place of tracing.
+  std::shared_ptr<const PhotonMaps> photon_maps{};
 };
 
 // The GPU work a frame was part of: a multi-view batch of `views` cameras, or
@@ -145,6 +151,11 @@ class Renderer {
   // invalid GL call after uploading its scene and throws the GlError that
   // gl_check reports, as a driver fault mid-frame would.
   void fail_next_render_for_test();
+  // Whether render(scene, cameras, opts) would trace photon maps (its passes
+  // use them and this renderer's cache has none for the scene), so that a
+  // caller may trace them on another thread first (FrameOptions::photon_maps).
+  // No GL; on the renderer's thread, as render().
+  bool needs_photon_trace(const Scene& scene, const FrameOptions& opts) const;
   // Gives back what the renderer keeps for the next frame beyond
   // `keep_photon_bytes` of photon maps (least recently used first): the
   // other photon maps, textures of volumes whose scene is gone, the frame

@@ -265,10 +265,12 @@ void SceneResources::upload_beams(TableCache& tables) {
 // relative to the centre of their bounds; photons straight from the lights
 // are marked (position.w = 1).
 void SceneResources::upload_photons(PhotonCache& cache, bool skip_direct) {
-  const auto t0 = std::chrono::steady_clock::now();
   bool traced = false;
   maps_ = cache.get(scene_, &traced);
   photon_trace_ms_ = traced ? maps_->trace_ms : 0.0;
+  // Upload time from here: the maps may have been traced before the render
+  // (FrameOptions::photon_maps), so their trace time is not part of get().
+  const auto t0 = std::chrono::steady_clock::now();
   // A share of the maps drawn (gi.display_fraction, their first photons, power
   // scaled up): the default radii at the drawn photon counts. The disks
   // (clustered by gi.cluster) are kept with the maps.
@@ -285,20 +287,17 @@ void SceneResources::upload_photons(PhotonCache& cache, bool skip_direct) {
     glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(SplatDisk)), data.data(), 0);
   }
   photon_upload_ms_ =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() -
-      photon_trace_ms_;
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   gl_check("upload photons");
 }
 
 void SceneResources::upload_volume_photons(PhotonCache& cache) {
-  const auto t0 = std::chrono::steady_clock::now();
-  double traced_ms = 0.0;
   if (!maps_) {
     bool traced = false;
     maps_ = cache.get(scene_, &traced);
-    traced_ms = traced ? maps_->trace_ms : 0.0;
-    photon_trace_ms_ += traced_ms;
+    photon_trace_ms_ += traced ? maps_->trace_ms : 0.0;
   }
+  const auto t0 = std::chrono::steady_clock::now();  // as in upload_photons
   Aabb box;
   for (const Photon& p : maps_->volume) box.grow(Vec3{p.p[0], p.p[1], p.p[2]});
   volume_anchor_ = box.empty() ? Vec3{0.0, 0.0, 0.0} : box.centre();
@@ -338,8 +337,7 @@ void SceneResources::upload_volume_photons(PhotonCache& cache) {
                        ? scene_.medium->radius
                        : default_volume_radius(scene_, drawn);
   photon_upload_ms_ +=
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() -
-      traced_ms;
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   gl_check("upload volume photons");
 }
 

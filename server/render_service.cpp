@@ -8,11 +8,12 @@
 #include <cmath>
 #include <limits>
 #include <cstdio>
+#include <exception>
 #include <iterator>
 #include <optional>
-#include <tuple>
 #include <utility>
 
+#include "gi/gi_scene.hpp"
 #include "gi/photon_map.hpp"
 #include "protocol/cancel.hpp"
 #include "protocol/check.hpp"
@@ -57,6 +58,9 @@ class GlFrameRenderer final : public FrameRenderer {
     return renderer_.render(scene, cameras, options);
   }
   void fail_next_render_for_test() override { renderer_.fail_next_render_for_test(); }
+  bool needs_photon_trace(const Scene& scene, const FrameOptions& options) override {
+    return renderer_.needs_photon_trace(scene, options);
+  }
   void release_idle_memory() override { renderer_.release_idle_memory(kIdlePhotonCacheBytes); }
 
  private:
@@ -96,6 +100,13 @@ struct RenderService::Task {
   std::size_t next_slice = 0;  // slices before it have been taken by a worker
   bool started = false;
   Clock::time_point start;
+  // Photon tracing before the first slice: checked by a worker (once), then
+  // traced on the CPU pool; meanwhile the task is held (its connection's
+  // work waits, the workers serve others). The maps go to options, a
+  // failure to prep_error (rethrown where the first slice would render).
+  bool prep_checked = false;
+  bool held = false;
+  std::exception_ptr prep_error;
 
   // Guarded by mu (frames, images: each element is written by one thread at
   // a time, handed over through the queues).
@@ -166,6 +177,15 @@ RendererFactory gl_renderer_factory(const RendererOptions& opts) {
 }
 
 
+// Photon traces that run at once off the render workers: one connection
+// traces one job at a time (its connection is held meanwhile), so a second
+// tracer lets another connection's trace start beside a long one.
+constexpr int kPhotonTracers = 2;
+
+// Connections whose used render time differs by less than this take plain
+// turns (RenderService::pick_locked).
+constexpr double kTurnQuantumMs = 5.0;
+
 RenderService::RenderService(RendererFactory factory, int workers, int encode_threads,
                              PngSettings png, int max_inflight)
     : factory_(std::move(factory)),
@@ -176,6 +196,7 @@ RenderService::RenderService(RendererFactory factory, int workers, int encode_th
   for (int i = 0; i < std::max(1, workers); ++i) {
     workers_.emplace_back([this, i] { worker_main(i); });
   }
+  for (int i = 0; i < kPhotonTracers; ++i) tracers_.emplace_back([this] { prep_main(); });
 }
 
 RenderService::~RenderService() { stop(); }
@@ -279,51 +300,65 @@ void RenderService::enqueue_locked(const TaskPtr& task, bool front) {
   }
 }
 
-bool RenderService::has_work_locked() const {
-  return std::any_of(queues_.begin(), queues_.end(),
-                     [](const ClassQueue& q) { return !q.turns.empty(); });
+namespace {
+
+// Whether a connection of the class has queued work that is not held
+// (photon tracing off the workers).
+template <class Queue>
+bool has_ready_work(const Queue& q) {
+  return std::any_of(q.turns.begin(), q.turns.end(), [&](std::uint64_t client) {
+    const auto it = q.by_client.find(client);
+    return it != q.by_client.end() && !it->second.empty() && !it->second.front()->held;
+  });
 }
 
-// The next slice: the first class with queued work (interactive before
-// batch); in it, the connection whose turn it is; of that connection's tasks,
-// the oldest. The connection then goes to the back of the turns, so a
-// connection with a deep pipeline gets one slice per round like any other.
-std::pair<RenderService::TaskPtr, std::size_t> RenderService::pick_locked(
-    std::unique_lock<std::mutex>& lock) {
+}  // namespace
+
+bool RenderService::has_work_locked() const {
+  return std::any_of(queues_.begin(), queues_.end(),
+                     [](const ClassQueue& q) { return has_ready_work(q); });
+}
+
+void RenderService::charge_locked(const Task& task, double ms) {
+  ClassQueue& q = queues_[static_cast<int>(task.cls)];
+  q.used.try_emplace(task.client, q.vtime).first->second += ms;
+}
+
+// The next slice: the first class with queued work that is not held
+// (interactive before batch); in it, the connection that has used the least
+// render time (ClassQueue::used; ties in turn order); of that connection's
+// tasks, the oldest. The connection then goes to the back of the turns.
+// A task's first slice is preceded by a check for photon tracing
+// (Pick::check), which holds its connection until the worker answers.
+RenderService::Pick RenderService::pick_locked(std::unique_lock<std::mutex>& lock) {
   for (;;) {
     ClassQueue* q = nullptr;
     for (ClassQueue& c : queues_) {
-      if (!c.turns.empty()) {
+      if (has_ready_work(c)) {
         q = &c;
         break;
       }
     }
-    if (q == nullptr) return {nullptr, 0};
-    // The connection whose next slice would end first in virtual time (its
-    // start: the later of the class's virtual time and the connection's last
-    // finish); ties go by turn order, so equal costs take turns.
-    std::size_t best = 0;
-    double best_start = 0.0, best_finish = 0.0;
+    if (q == nullptr) return {};
+    // Starts within kTurnQuantumMs of the least count as equal: of those,
+    // the first in turn order goes (equal costs take plain turns whatever
+    // the timing noise).
+    std::vector<double> starts(q->turns.size(), std::numeric_limits<double>::infinity());
+    double least = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < q->turns.size(); ++i) {
       const auto queued = q->by_client.find(q->turns[i]);
       BEAMCAST_CHECK(queued != q->by_client.end() && !queued->second.empty(),
                      "a connection in the turns has queued work");
-      const Task& head = *queued->second.front();
-      const auto last = q->finish.find(q->turns[i]);
-      const double start = std::max(q->vtime, last == q->finish.end() ? 0.0 : last->second);
-      const std::size_t cameras =
-          head.next_slice < head.slices.size() ? head.slices[head.next_slice].size() : 1;
-      const double finish = start + head.cost_per_camera * static_cast<double>(cameras);
-      if (i == 0 || finish < best_finish) {
-        best = i;
-        best_start = start;
-        best_finish = finish;
-      }
+      if (queued->second.front()->held) continue;
+      const auto used = q->used.find(q->turns[i]);
+      starts[i] = std::max(q->vtime, used == q->used.end() ? 0.0 : used->second);
+      least = std::min(least, starts[i]);
     }
+    const auto at = std::find_if(starts.begin(), starts.end(),
+                                 [&](double v) { return v <= least + kTurnQuantumMs; });
+    const auto best = static_cast<std::size_t>(at - starts.begin());
+    const double best_start = *at;
     const std::uint64_t client = q->turns[best];
-    q->turns.erase(q->turns.begin() + static_cast<std::ptrdiff_t>(best));
-    q->vtime = std::max(q->vtime, best_start);
-    q->finish[client] = best_finish;
     auto it = q->by_client.find(client);
     TaskPtr task = it->second.front();
     if (!task->started) {
@@ -331,6 +366,7 @@ std::pair<RenderService::TaskPtr, std::size_t> RenderService::pick_locked(
       if (task->batch_key != nullptr && batch_window_.count() > 0) {
         // Out of the queue while its window runs (no other worker takes a
         // slice of it meanwhile); back at the head of its turn after merging.
+        q->turns.erase(q->turns.begin() + static_cast<std::ptrdiff_t>(best));
         it->second.pop_front();
         --q->tasks;
         if (it->second.empty()) {
@@ -342,7 +378,7 @@ std::pair<RenderService::TaskPtr, std::size_t> RenderService::pick_locked(
         task->start = Clock::now();
         if (stopping_) {  // stop() drops it with the rest of the queue
           enqueue_locked(task, true);
-          return {nullptr, 0};
+          return {};
         }
         task->prepare();
         enqueue_locked(task, true);
@@ -351,6 +387,17 @@ std::pair<RenderService::TaskPtr, std::size_t> RenderService::pick_locked(
       task->start = Clock::now();
       task->prepare();
     }
+    if (!task->prep_checked) {
+      // Nothing taken or charged yet: the worker checks, then picks again.
+      task->prep_checked = true;
+      task->held = true;
+      return {task, 0, true};
+    }
+    q->turns.erase(q->turns.begin() + static_cast<std::ptrdiff_t>(best));
+    q->vtime = std::max(q->vtime, best_start);
+    const std::size_t cameras =
+        task->next_slice < task->slices.size() ? task->slices[task->next_slice].size() : 1;
+    q->used[client] = best_start + task->cost_per_camera * static_cast<double>(cameras);
     const std::size_t slice = task->next_slice++;
     if (task->next_slice == task->slices.size()) {
       it->second.pop_front();
@@ -358,12 +405,84 @@ std::pair<RenderService::TaskPtr, std::size_t> RenderService::pick_locked(
     }
     if (it->second.empty()) {
       q->by_client.erase(it);
-      q->finish.erase(client);
     } else {
       q->turns.push_back(client);
     }
-    return {task, slice};
+    // Tags the clock has passed, of connections without queued work, mean
+    // nothing any more (such a connection starts at the clock).
+    for (auto u = q->used.begin(); u != q->used.end();) {
+      if (u->second <= q->vtime && q->by_client.count(u->first) == 0) {
+        u = q->used.erase(u);
+      } else {
+        ++u;
+      }
+    }
+    return {task, slice, false};
   }
+}
+
+void RenderService::after_check(const TaskPtr& task, bool trace) {
+  {
+    std::lock_guard lock(mu_);
+    if (trace && !stopping_) {
+      trace_queue_.push_back(task);
+    } else {
+      task->held = false;
+    }
+  }
+  if (trace) trace_cv_.notify_one();
+  cv_.notify_all();
+}
+
+void RenderService::prep_main() {
+  for (;;) {
+    TaskPtr task;
+    {
+      std::unique_lock lock(mu_);
+      trace_cv_.wait(lock, [&] { return tracers_stopping_ || !trace_queue_.empty(); });
+      if (tracers_stopping_) return;  // stop() drops the held tasks with the queue
+      task = std::move(trace_queue_.front());
+      trace_queue_.pop_front();
+    }
+    trace_for(*task);
+    cv_.notify_all();
+  }
+}
+
+// The task's photon maps, traced here with the cores less one (a render
+// beside it keeps a core), under the task's cancel token: its deadline, its
+// client leaving (a single job) and the server's shutdown stop it within one
+// check interval (gi/photon_map.hpp). The maps are those the renderer would
+// trace (the same function over the same scene; any thread count).
+void RenderService::trace_for(Task& task) {
+  const RenderJob& first = task.members.front();
+  Clock::time_point deadline = Clock::time_point::max();
+  for (const RenderJob& j : task.members) deadline = std::min(deadline, j.deadline);
+  const CancelToken token(deadline, &cancel_all_,
+                          task.members.size() == 1 ? first.client_alive.get() : nullptr);
+  const auto t0 = Clock::now();
+  std::shared_ptr<const PhotonMaps> maps;
+  std::exception_ptr error;
+  photon_traces_.fetch_add(1);
+  try {
+    const CancelScope scope(&token);
+    PhotonTraceOptions options;
+    options.threads = std::max(1, usable_cores() - 1);
+    maps = std::make_shared<const PhotonMaps>(
+        trace_photons(*first.scene, GiScene(*first.scene), options));
+  } catch (const Cancelled&) {
+    photon_traces_cancelled_.fetch_add(1);
+    error = std::current_exception();
+  } catch (...) {
+    error = std::current_exception();
+  }
+  const double ms = ms_between(t0, Clock::now());
+  if (error) malloc_trim(0);
+  std::lock_guard lock(mu_);
+  task.options.photon_maps = std::move(maps);
+  task.prep_error = error;
+  task.held = false;
+  charge_locked(task, ms);
 }
 
 // Takes the task's untaken slices out of the queue; returns how many.
@@ -382,7 +501,6 @@ std::size_t RenderService::withdraw_locked(Task& task) {
   --q.tasks;
   if (mine.empty()) {
     q.by_client.erase(it);
-    q.finish.erase(task.client);
     q.turns.erase(std::find(q.turns.begin(), q.turns.end(), task.client));
   }
   return left;
@@ -399,8 +517,7 @@ void RenderService::worker_main(int index) {
 
   bool released = true;  // nothing rendered since the last idle release
   for (;;) {
-    TaskPtr task;
-    std::size_t slice = 0;
+    Pick pick;
     {
       std::unique_lock lock(mu_);
       const auto woken = [&] { return stopping_ || has_work_locked(); };
@@ -415,10 +532,27 @@ void RenderService::worker_main(int index) {
       }
       cv_.wait(lock, woken);
       if (stopping_) return;  // stop() drops what is still queued
-      std::tie(task, slice) = pick_locked(lock);
+      pick = pick_locked(lock);
     }
     released = false;
+    const TaskPtr& task = pick.task;
+    const std::size_t slice = pick.slice;
     if (!task) continue;
+    if (pick.check) {
+      // Photon tracing goes to the CPU pool (the job's connection waits,
+      // this worker serves others); a job whose clients have gone is
+      // dropped at its slice, below, after the next pick.
+      bool trace = false;
+      try {
+        trace = renderer && task->any_alive() && !cancel_all_.load() &&
+                renderer->needs_photon_trace(*task->members.front().scene, task->options);
+      } catch (const std::exception& e) {
+        // The render itself reports what went wrong.
+        std::fprintf(stderr, "beamcast-server: render worker %d: %s\n", index, e.what());
+      }
+      after_check(task, trace);
+      continue;
+    }
     // Between slices: a job whose clients have all gone costs no more GPU
     // time. Its remaining slices leave the queue; nothing is answered.
     if (!task->any_alive()) {
@@ -521,8 +655,10 @@ void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer
   // Merged jobs share the render: the earliest deadline holds for it.
   Clock::time_point deadline = Clock::time_point::max();
   for (const RenderJob& j : task.members) deadline = std::min(deadline, j.deadline);
-  const CancelToken token(deadline, &cancel_all_);
   const RenderJob& first = task.members.front();
+  const CancelToken token(deadline, &cancel_all_,
+                          task.members.size() == 1 ? first.client_alive.get() : nullptr);
+  bool rendering = false;  // past the photon maps traced for it (Task::prep_error)
   if (token.stopped()) {
     error = ErrorInfo{"shutting_down", "the server is stopping: the render was cancelled", ""};
   } else if (token.expired()) {
@@ -537,6 +673,8 @@ void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer
       while (inject > 0 && !inject_failures_.compare_exchange_weak(inject, inject - 1)) {
       }
       if (inject > 0) renderer->fail_next_render_for_test();
+      if (task.prep_error) std::rethrow_exception(task.prep_error);
+      rendering = true;
       InteractiveRender hold(this, task.cls == WorkClass::kInteractive);
       // Merged jobs share a render only with the same stored scene and default
       // options (RenderJob::batch_key), so the first job's options hold for all.
@@ -546,12 +684,19 @@ void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer
       // Stopped inside a CPU loop, perhaps mid-frame: the context is
       // rebuilt before the next slice, as after a GL error, so no state of
       // the abandoned frame reaches another (not when shutting down).
-      error = e.reason() == Cancelled::Reason::kDeadline
-                  ? deadline_error(first, "while rendering slice " + std::to_string(slice + 1) +
-                                              " of " + std::to_string(task.slices.size()))
-                  : ErrorInfo{"shutting_down", "the server is stopping: the render was cancelled",
-                              ""};
-      *gl_failed = e.reason() == Cancelled::Reason::kDeadline;
+      if (e.reason() == Cancelled::Reason::kShutdown) {
+        error = ErrorInfo{"shutting_down", "the server is stopping: the render was cancelled", ""};
+      } else if (e.reason() == Cancelled::Reason::kClientGone) {
+        // Never sent: the job completes as dropped (RenderService::complete).
+        error = ErrorInfo{"internal", "the client has gone", ""};
+        cancelled_.fetch_add(1);
+      } else {
+        const std::string where =
+            rendering ? "while rendering slice " : "while tracing photons for slice ";
+        error = deadline_error(first, where + std::to_string(slice + 1) + " of " +
+                                          std::to_string(task.slices.size()));
+      }
+      *gl_failed = rendering && e.reason() != Cancelled::Reason::kShutdown;
     } catch (const PhotonEventLimit& e) {
       error = ErrorInfo{"limit_exceeded", e.what(),
                         first.scene_path == "/params/scene" ? "/params/scene/gi/photons"
@@ -572,6 +717,12 @@ void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer
     }
   }
   const double render_ms = ms_between(start, Clock::now());
+  {
+    // The estimate charged when the slice was taken, corrected to the time
+    // measured.
+    std::lock_guard lock(mu_);
+    charge_locked(task, render_ms - task.cost_per_camera * static_cast<double>(idx.size()));
+  }
   if (error || render_ms >= kTrimAfterRenderMs) malloc_trim(0);
   if (error) {
     // The job is answered with the error: its other slices are not rendered.
@@ -842,6 +993,15 @@ void RenderService::stop() {
   window_cv_.notify_all();
   for (auto& t : workers_) t.join();
   workers_.clear();
+  // A trace in progress finishes (or its token stops it: cancel_all);
+  // queued ones are dropped with their tasks below.
+  {
+    std::lock_guard lock(mu_);
+    tracers_stopping_ = true;
+    trace_queue_.clear();
+  }
+  trace_cv_.notify_all();
+  tracers_.clear();  // SizedThread joins
   // What is still queued is dropped (slices of a job being encoded included:
   // that job completes as dropped when its encodes are done).
   std::vector<std::pair<TaskPtr, std::size_t>> left;

@@ -3,8 +3,10 @@
 // parallel. A job is rendered in slices of at most FrameOptions::max_batch_views
 // cameras (one GPU batch each); each slice's frames are encoded while the next
 // slice renders, and between slices the scheduler picks what runs next:
-// interactive work before batch work, connections of one class in turn, and a
-// job whose client has gone stops (PROTOCOL.md, "Scheduling").
+// interactive work before batch work, connections of one class by the render
+// time each has used, and a job whose client has gone stops (PROTOCOL.md,
+// "Scheduling"). A job's photon tracing runs before its first slice on a CPU
+// pool of its own, off the render workers, which serve other jobs meanwhile.
 // Sockets never reach here; GL never leaves the renderer behind FrameRenderer.
 #pragma once
 
@@ -53,6 +55,15 @@ class FrameRenderer {
   // Test hook (RenderService::fail_next_render_for_test): the next render
   // throws GlError from inside the renderer.
   virtual void fail_next_render_for_test() = 0;
+  // Whether render(scene, cameras, options) would trace photon maps, which
+  // the service then traces first off the render worker and hands over in
+  // FrameOptions::photon_maps (Renderer::needs_photon_trace). Called on the
+  // renderer's thread.
+  virtual bool needs_photon_trace(const Scene& scene, const FrameOptions& options) {
+    (void)scene;
+    (void)options;
+    return false;
+  }
   // The worker has been idle a while (RenderService::set_idle_release): give
   // back what is kept for later renders (caches, targets), as far as
   // repeating the last render stays cheap.
@@ -132,8 +143,9 @@ struct RenderJob {
   WorkClass work_class = WorkClass::kBatch;
   // The connection it came from: connections of one class take turns.
   std::uint64_t client = 0;
-  // Estimated cost (protocol/request_cost.hpp): turns go by it (weighted fair
-  // queueing; PROTOCOL.md, "Scheduling"), so cheap renders pass costly ones.
+  // Estimated cost (protocol/request_cost.hpp): a slice is charged its share
+  // of it when taken, corrected to the measured time when done (PROTOCOL.md,
+  // "Scheduling"), so cheap renders pass costly ones.
   double cost = 0.0;
   // Streaming (render param "stream"): if set, called for every slice but the
   // last, in slice order, with that slice's frames (RenderOutcome::part,
@@ -200,6 +212,10 @@ class RenderService {
   // (on whichever worker takes it) fails with a real GL error
   // (Renderer::fail_next_render_for_test).
   void fail_next_render_for_test() { inject_failures_.fetch_add(1); }
+  // Photon traces run off the render workers (started, and stopped by their
+  // cancel token: deadline, client gone, cancel_all).
+  std::uint64_t photon_traces() const { return photon_traces_.load(); }
+  std::uint64_t photon_traces_cancelled() const { return photon_traces_cancelled_.load(); }
   // Stops the workers; jobs still queued are dropped (their `done` is called
   // with dropped = true).
   void stop();
@@ -221,7 +237,23 @@ class RenderService {
   // remaining slices out of the queue.
   void enqueue_locked(const TaskPtr& task, bool front);
   bool has_work_locked() const;
-  std::pair<TaskPtr, std::size_t> pick_locked(std::unique_lock<std::mutex>& lock);
+  // What a worker does next: render `slice` of `task`, or (check) find out
+  // whether the task needs photon tracing before its first slice (its
+  // connection waits meanwhile: Task::held).
+  struct Pick {
+    TaskPtr task;
+    std::size_t slice = 0;
+    bool check = false;
+  };
+  Pick pick_locked(std::unique_lock<std::mutex>& lock);
+  // The worker's answer to a Pick::check: traces the maps on the CPU pool
+  // (the task's connection still waits) or lets the task's slices be taken.
+  void after_check(const TaskPtr& task, bool trace);
+  void prep_main();
+  void trace_for(Task& task);
+  // Charges `ms` (may be negative: a correction) of render time to the
+  // task's connection, with mu_ held.
+  void charge_locked(const Task& task, double ms);
   std::size_t withdraw_locked(Task& task);
   // Merges the queued tasks that may join `first` (same batch key) once its
   // window has passed; called with `lock` held, may wait on it.
@@ -258,6 +290,8 @@ class RenderService {
   std::atomic<std::int64_t> idle_release_ms_;
   std::atomic<std::uint64_t> idle_releases_{0};
   std::atomic<std::uint64_t> idle_rebuilds_{0};
+  std::atomic<std::uint64_t> photon_traces_{0};
+  std::atomic<std::uint64_t> photon_traces_cancelled_{0};
   // The lowest RSS after an idle release; set by wait_ready to the size at
   // start plus kRebuildWhenIdleAboveBytes.
   std::atomic<std::uint64_t> idle_rss_floor_{~std::uint64_t{0}};
@@ -271,12 +305,16 @@ class RenderService {
     std::map<std::uint64_t, std::deque<TaskPtr>> by_client;
     std::deque<std::uint64_t> turns;
     int tasks = 0;
-    // Weighted fair queueing by estimated cost: the class's virtual time and
-    // each connection with queued work's finish tag (where its last taken
-    // slice ends in virtual time). A connection whose queue empties starts
-    // again at the virtual time.
+    // Start-time fair queueing by render time: each connection's tag is the
+    // render time (ms) it has been charged, on a clock shared by the class;
+    // the next slice goes to the connection with queued work whose start
+    // (the later of its tag and the class's virtual time, the start of the
+    // last slice taken) is least. A slice is charged its estimate when
+    // taken and corrected to the measured time when done; photon tracing
+    // off the workers is charged too. Idle connections bank nothing: their
+    // start is the virtual time; their tags go once the clock passes them.
     double vtime = 0.0;
-    std::map<std::uint64_t, double> finish;
+    std::map<std::uint64_t, double> used;
   };
   std::array<ClassQueue, kWorkClasses> queues_;
   bool stopping_ = false;
@@ -285,6 +323,12 @@ class RenderService {
   std::string failure_;
   std::condition_variable ready_cv_;
   std::vector<SizedThread> workers_;  // each owns a GL context
+  // Photon tracing off the workers: tasks waiting for a tracer, and the
+  // tracers (kPhotonTracers, each tracing with the cores less one).
+  std::deque<TaskPtr> trace_queue_;  // guarded by mu_
+  bool tracers_stopping_ = false;    // guarded by mu_
+  std::condition_variable trace_cv_;
+  std::vector<SizedThread> tracers_;
   std::mutex encode_mu_;
   std::condition_variable encode_cv_;  // batch encodes wait here for interactive renders
   std::array<std::deque<std::function<void()>>, kWorkClasses> encode_queue_;

@@ -8,12 +8,14 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 #include <stdexcept>
 #include <utility>
@@ -63,14 +65,27 @@ struct FakeRendererControl {
     std::lock_guard lock(mu);
     return calls;
   }
+  // Render calls whose first camera's name starts with `prefix` take at
+  // least `ms` (a costly render, as the scheduler measures it).
+  void slow_renders(std::string prefix, int ms) {
+    std::lock_guard lock(mu);
+    slow_prefix = std::move(prefix);
+    slow_ms = ms;
+  }
   // Called by the renderer: records the call and waits while it is held.
   void enter(const std::vector<Camera>& cameras) {
     std::unique_lock lock(mu);
     std::vector<std::string> names;
     for (const Camera& c : cameras) names.push_back(c.name);
+    const bool slow = !slow_prefix.empty() && !names.empty() && names[0].rfind(slow_prefix, 0) == 0;
     calls.push_back(std::move(names));
     const std::size_t me = calls.size();
     cv.wait(lock, [&] { return me <= allowed && held.count(me) == 0; });
+    if (slow) {
+      const int ms = slow_ms;
+      lock.unlock();
+      std::this_thread::sleep_for(std::chrono::milliseconds(ms));
+    }
   }
 
   std::mutex mu;
@@ -78,6 +93,8 @@ struct FakeRendererControl {
   std::vector<std::vector<std::string>> calls;
   std::size_t allowed = std::numeric_limits<std::size_t>::max();
   std::set<std::size_t> held;
+  std::string slow_prefix;
+  int slow_ms = 0;
 };
 
 class FakeFrameRenderer final : public FrameRenderer {

@@ -15,6 +15,9 @@
 #include <string>
 #include <thread>
 
+#include "gi/gi_scene.hpp"
+#include "gi/photon_map.hpp"
+#include "protocol/scene_json.hpp"
 #include "tests/server/server_fixture.hpp"
 
 namespace beamcast::test {
@@ -256,6 +259,70 @@ TEST(HostileRenders, DeadlineExceededFreesTheWorker) {
   // sanitizers' slowdown: without the deadline the render runs for minutes.
   EXPECT_LT(s, 1.5 + 6.0) << s << " s";
   expect_alive(c);
+}
+
+// Fair shares (PROTOCOL.md, "Scheduling"): a costly legal render's photon
+// tracing (tens of seconds: 4e6 photons in closed fog until
+// max_photon_events) runs off the render worker, so a small render beside it
+// is answered while it traces; and once its client has gone the trace stops
+// at its next check (every 64 photons) instead of running on.
+TEST(HostileRenders, ASmallRenderPassesACostlyTraceThatStopsWhenItsClientGoes) {
+  ServerConfig cfg;
+  // Admitted whatever its estimate: the scheduling is what is under test.
+  cfg.max_request_cost = std::numeric_limits<std::int64_t>::max();
+  LocalServer server(cfg);
+  Conn small(server.port(), 60);
+  expect_alive(small);  // shaders compiled
+  {
+    Conn costly(server.port(), 60);
+    costly.send(costly_request("costly"));
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));  // tracing by now
+    const Reply r = small.call(small_render("beside"));
+    EXPECT_TRUE(r.json.value("ok", false)) << r.json.dump();
+    // Answered while the costly render is still in flight (not after it).
+    EXPECT_EQ(server.core().renders->inflight(), 1);
+  }
+  // The costly client has gone: its trace stops well within the bound (the
+  // check interval is milliseconds; the whole trace takes tens of seconds,
+  // and minutes under the sanitizers).
+  const auto t0 = Clock::now();
+  while (server.core().renders->inflight() > 0 && Clock::now() - t0 < std::chrono::seconds(15)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_EQ(server.core().renders->inflight(), 0)
+      << "the trace ran on after its client had gone";
+  expect_alive(small);
+}
+
+// The server traces photon maps off the render worker and hands them to the
+// renderer (FrameOptions::photon_maps): the frames are bit for bit those of
+// a renderer that traces them itself, for surface photons, caustics and
+// media (the maps do not depend on the thread count; traced here on one).
+TEST(HostileRenders, MapsTracedOffTheRendererGiveTheSameFrames) {
+  for (const char* name : {"cornell_caustic", "ground_fog"}) {
+    SCOPED_TRACE(name);
+    Scene scene = load_scene_file(std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples" /
+                                      (std::string(name) + ".json"),
+                                  {});
+    scene.cameras.resize(1);
+    scene.cameras[0].width = scene.cameras[0].height = 32;
+    scene.gi.photons = scene.gi.caustic_photons = 20000;  // a cheap test (the maps' rule is the same)
+    FrameOptions traced_before;
+    traced_before.photon_maps = std::make_shared<const PhotonMaps>(
+        trace_photons(scene, GiScene(scene), PhotonTraceOptions{1}));
+    Renderer itself, given;
+    ASSERT_TRUE(itself.needs_photon_trace(scene, {}));
+    ASSERT_FALSE(given.needs_photon_trace(scene, traced_before));
+    const std::vector<FrameResult> a = itself.render(scene, scene.cameras);
+    const std::vector<FrameResult> b = given.render(scene, scene.cameras, traced_before);
+    ASSERT_EQ(a.size(), 1u);
+    ASSERT_EQ(b.size(), 1u);
+    EXPECT_GT(b[0].photons, 0);
+    EXPECT_TRUE(a[0].image.rgb == b[0].image.rgb);
+    // Cached now: neither traces again.
+    EXPECT_FALSE(itself.needs_photon_trace(scene, {}));
+    EXPECT_FALSE(given.needs_photon_trace(scene, {}));
+  }
 }
 
 // SIGTERM while a costly render runs: the process exits within the drain
