@@ -83,6 +83,8 @@ json to_json(const QualityReport& q) {
             {"budget_ms", q.budget_ms}, {"estimate_ms", q.estimate_ms},
             {"frame_ms", q.frame_ms}};
   if (q.jpeg_quality) j["jpeg_quality"] = *q.jpeg_quality;
+  if (q.bitrate_kbps) j["bitrate_kbps"] = *q.bitrate_kbps;
+  if (q.keyframe) j["keyframe"] = *q.keyframe;
   return j;
 }
 
@@ -207,6 +209,8 @@ QualityReport read_quality(const Node& n) {
   q.samples = read_int(r.required("samples"));
   q.format = read_string(r.required("format"));
   q.jpeg_quality = read_optional<int>(r, "jpeg_quality", read_int);
+  q.bitrate_kbps = read_optional<int>(r, "bitrate_kbps", read_int);
+  q.keyframe = read_optional<bool>(r, "keyframe", read_bool);
   q.budget_ms = read_number(r.required("budget_ms"));
   q.estimate_ms = read_number(r.required("estimate_ms"));
   q.frame_ms = read_number(r.required("frame_ms"));

@@ -94,6 +94,8 @@ struct QualityReport {
   int samples = 0;
   std::string format;               // "png" or "jpeg"
   std::optional<int> jpeg_quality;  // JPEG frames only
+  std::optional<int> bitrate_kbps;  // video frames only: the stream's target
+  std::optional<bool> keyframe;     // video frames only
   double budget_ms = 0.0, estimate_ms = 0.0, frame_ms = 0.0;
   bool operator==(const QualityReport&) const = default;
 };

@@ -181,6 +181,22 @@ const nlohmann::json& object_at(const json_read::Node& n, std::string_view what)
   return n.json();
 }
 
+// "video": {"codec": "vp8"|"vp9", "bitrate_kbps": N, "keyframe": bool}.
+VideoParams parse_video_params(const json_read::Node& n) {
+  static constexpr std::string_view kKeys[] = {"codec", "bitrate_kbps", "keyframe"};
+  const json_read::ObjectReader r(n, "video");
+  r.allow_only(kKeys);
+  VideoParams v;
+  v.codec = read_choice(r.required("codec"), {"vp8", "vp9"});
+  if (auto b = r.optional("bitrate_kbps")) {
+    v.bitrate_kbps = static_cast<int>(json_read::check_closed(
+        *b, static_cast<double>(json_read::read_integer(*b)), kMinVideoBitrateKbps,
+        kMaxVideoBitrateKbps));
+  }
+  if (auto k = r.optional("keyframe")) v.keyframe = json_read::read_bool(*k);
+  return v;
+}
+
 }  // namespace
 
 RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits& limits) {
@@ -188,13 +204,13 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
       json_read::read_bool, json_read::read_number;
   static constexpr std::string_view kKeys[] = {
       "scene",   "scene_id",  "cameras",  "output", "encoding",          "atlas",
-      "quality", "budget_ms", "still_ms", "motion", "interactive_format", "stream"};
+      "quality", "budget_ms", "still_ms", "motion", "interactive_format", "stream", "video"};
   const ObjectReader r(Node{&params, "/params"}, "render params");
   r.allow_only(kKeys);
   RenderParams rp;
   const auto quality = r.optional("quality");
   const bool automatic = quality && read_choice(*quality, {"auto", "full"}) == "auto";
-  for (const char* key : {"budget_ms", "still_ms", "motion", "interactive_format"}) {
+  for (const char* key : {"budget_ms", "still_ms", "motion", "interactive_format", "video"}) {
     if (r.optional(key) && !automatic) {
       fail("invalid_value", r.path_of(key),
            std::string(key) + " applies only with \"quality\": \"auto\"");
@@ -212,6 +228,7 @@ RenderParams parse_render_params(const nlohmann::json& params, const SceneLimits
     if (auto n = r.optional("interactive_format")) {
       qp.jpeg = read_choice(*n, {"jpeg", "png"}) == "jpeg";
     }
+    if (auto v = r.optional("video")) qp.video = parse_video_params(*v);
     rp.quality = qp;
   }
   const auto scene = r.optional("scene");

@@ -63,11 +63,22 @@ ErrorInfo with_path_prefix(ErrorInfo e, std::string_view prefix);
 
 // `quality: "auto"` (PROTOCOL.md, "Interactive quality"): the server's accuracy
 // controller picks each frame's settings from a frame-time budget.
+// The preview's moving frames as a video stream (PROTOCOL.md, "Video
+// preview"): the connection's encoder, kept from request to request.
+struct VideoParams {
+  std::string codec;                // "vp8" or "vp9"
+  std::optional<int> bitrate_kbps;  // the target; none: the server's --preview-bitrate
+  bool keyframe = false;            // this frame a key frame (a decoder recovering)
+};
+inline constexpr int kMinVideoBitrateKbps = 50;
+inline constexpr int kMaxVideoBitrateKbps = 50000;
+
 struct QualityParams {
   double budget_ms = 33.0;  // frame-time budget while the camera moves
   double still_ms = 300.0;  // still this long -> a full-accuracy PNG frame
   std::string motion = "infer";  // "infer" (from successive poses), "moving", "still"
   bool jpeg = true;              // interactive frames as JPEG ("interactive_format")
+  std::optional<VideoParams> video;  // moving frames as video ("video")
 };
 
 // `render` params, validated except for the scene itself (which may be stored).

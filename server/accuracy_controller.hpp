@@ -29,7 +29,10 @@ struct AccuracyLevel {
   std::string label;      // e.g. "full", "table32", "table32@1/2"
   double scale = 1.0;     // resolution scale: render smaller, upscale bilinearly on the GPU
   RenderSettings render;  // integration settings
-  int jpeg_quality = 90;  // interactive frames are JPEG at this quality
+  // Interactive JPEG frames are encoded at this quality. A connection that
+  // streams video (render param "video", server/video_stream.hpp) ignores it:
+  // its encoder's rate control holds the bitrate target at every level.
+  int jpeg_quality = 90;
   // Lit scenes: the share of the cached photon maps splatted
   // (GiSettings::display_fraction; nothing is traced again).
   double photon_fraction = 1.0;
@@ -116,7 +119,10 @@ class AccuracyController {
   // the camera pose `pose`; with Motion::kInfer motion is a pose change since
   // the previous frame.
   ControllerDecision decide(double now_ms, const PoseKey& pose, Motion motion);
-  // Reports the measured cost of a frame rendered at `level`.
+  // Reports the measured cost of a frame rendered at `level`: render with
+  // read-back plus the frame's encode (JPEG, or the video encoder's, which
+  // works at the output size whatever the level and so lands in the fit's
+  // fixed part), so the budget covers the encoder.
   void observe(int level, double frame_ms, double now_ms);
 
   // Predicted frame time of `level` at `now_ms`: its own recent measurement,

@@ -56,6 +56,9 @@ struct ServerConfig {
   // (docs/performance.md, "Frame encoders"): libdeflate level 1, SUB. The
   // setting before issue 39 is --png-encoder libpng (zlib level 2, SUB).
   PngSettings png;
+  // Target bitrate of the preview's video stream when a request names none
+  // (render param "video"; PROTOCOL.md, "Video preview").
+  int preview_bitrate_kbps = 1000;
   std::filesystem::path assets_dir;
 
   SceneLimits scene_limits = kServerSceneLimits;

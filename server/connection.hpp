@@ -17,6 +17,7 @@
 #include "protocol/errors.hpp"
 #include "protocol/frame_format.hpp"
 #include "server/accuracy_controller.hpp"
+#include "server/video_stream.hpp"
 
 namespace beamcast {
 
@@ -27,6 +28,7 @@ struct InteractiveState {
   std::mutex mu;
   std::unique_ptr<AccuracyController> controller;
   std::string scene_key;  // the scene the controller's costs were measured on
+  VideoStream video;      // moving frames as video (own lock: VideoStream::mu)
 };
 
 // The write side both transports share: responses in order, and the pause

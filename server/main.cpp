@@ -9,6 +9,7 @@
 #include "protocol/scene_json.hpp"
 #include "protocol/bounded_json.hpp"
 #include "protocol/data_dir.hpp"
+#include "protocol/request.hpp"
 #include "server/demo_scene.hpp"
 #include "server/limits.hpp"
 #include "server/server.hpp"
@@ -63,6 +64,10 @@ int main(int argc, char** argv) {
   app.add_option("--slice-pixels", c.slice_pixels,
                  "Pixels per slice at most (cameras x width x height; at least one camera)")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 30))->capture_default_str();
+  app.add_option("--preview-bitrate", c.preview_bitrate_kbps,
+                 "Target bitrate in kbit/s of the preview's video stream (render param \"video\") "
+                 "when a request names none")
+      ->check(CLI::Range(kMinVideoBitrateKbps, kMaxVideoBitrateKbps))->capture_default_str();
   bool no_encode_hold = false;
   app.add_flag("--no-encode-hold", no_encode_hold,
                "Let batch frames' encodes run while an interactive frame renders");

@@ -49,8 +49,12 @@ RenderResponse build_render_response(const RenderOutcome& out, const RenderResul
   BEAMCAST_CHECK(out.pngs.size() == (out.atlas ? 1 : out.frames.size()),
                  "one image per frame, or one atlas");
   auto image = [&](RenderFrame& f, std::size_t i) {
-    f.format = out.is_jpeg[i] ? "jpeg" : std::string(frame_format_name(out.frame_format));
-    f.bit_depth = out.is_jpeg[i] ? 8 : ctx.bit_depth;  // JPEG has 8 bits per channel
+    const bool video = !ctx.video_codec.empty();
+    f.format = video           ? ctx.video_codec
+               : out.is_jpeg[i] ? "jpeg"
+                                : std::string(frame_format_name(out.frame_format));
+    // JPEG and video have 8 bits per channel.
+    f.bit_depth = out.is_jpeg[i] || video ? 8 : ctx.bit_depth;
     f.encode_ms = out.encode_ms[i];
     const std::vector<std::uint8_t>& png = out.pngs[i];
     if (ctx.base64) {

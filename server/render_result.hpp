@@ -23,6 +23,7 @@ struct RenderResultContext {
   bool base64 = false;                      // data_base64 instead of attachments
   bool stream = false;                      // "stream": true: each part carries "stream"
   std::optional<QualityReport> quality;     // "quality": "auto" only
+  std::string video_codec;                  // set: the frame is a video frame of this codec
   double server_ms = 0.0;                   // arrival to response, measured by the caller
 };
 

@@ -94,6 +94,10 @@ json hello_result(const ServerCore& core, const json& params, FrameFormat format
                                            ? "libdeflate"
                                            : "libpng"},
                        {"quality", {"full", "auto"}},
+                       {"video", {{"codecs", {"vp8", "vp9"}},
+                                  {"bitrate_kbps", core.config.preview_bitrate_kbps},
+                                  {"min_bitrate_kbps", kMinVideoBitrateKbps},
+                                  {"max_bitrate_kbps", kMaxVideoBitrateKbps}}},
                        {"encodings", {"binary", "base64"}},
                        {"batch_window_ms", core.config.batch_window_ms},
                        {"stream", true},
@@ -200,6 +204,11 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
                      "/params/atlas", "the atlas");
   }
 
+  // A video stream is one picture a frame.
+  const std::optional<VideoParams> video = rp.quality ? rp.quality->video : std::nullopt;
+  if (video && (cameras.size() != 1 || rp.atlas)) {
+    fail("invalid_value", "/params/video", "video frames need exactly one camera and no atlas");
+  }
   // quality "auto": the connection's accuracy controller picks this frame's level.
   std::optional<ControllerDecision> decision;
   AccuracyLevel level;
@@ -264,8 +273,10 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   job.options.max_batch_pixels = core.config.slice_pixels;
   if (decision) {
     job.options.resolution_scale = decision->still ? 1.0 : level.scale;
-    job.jpeg = !decision->still && rp.quality->jpeg;
+    job.jpeg = !decision->still && rp.quality->jpeg && !video;
     job.jpeg_quality = level.jpeg_quality;
+    // A moving video frame comes back as raw samples, encoded in `done`.
+    if (video && !decision->still) job.frame_format = FrameFormat::kRaw;
   }
   // Only an unmodified stored scene at full quality may share a render with
   // other requests (a batch renders with one set of options); a streamed
@@ -294,9 +305,27 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   }
   job.done = [&core, session, id, arrived, ctx, send_result, decision, level, ladder_size,
               budget_ms, jpeg = job.jpeg, jpeg_quality = job.jpeg_quality,
-              work_class = job.work_class](RenderOutcome&& out) mutable {
+              work_class = job.work_class, video](RenderOutcome&& out) mutable {
     session->end_render();
     if (out.dropped) return;
+    // Video: this frame's encode and send under the stream's lock.
+    std::unique_lock<std::mutex> video_order;
+    std::optional<VideoFrameReport> video_frame;
+    if (video && !out.error) {
+      VideoStream& vs = session->interactive().video;
+      video_order = std::unique_lock(vs.mu);
+      note_video_request(vs, *video);
+      if (!decision->still) {
+        try {
+          video_frame = encode_video_frame(vs, *video, core.config.preview_bitrate_kbps,
+                                           ctx->cameras[0].width, ctx->cameras[0].height,
+                                           ctx->bit_depth, steady_ms(arrived), &out);
+          ctx->video_codec = video_frame->codec;
+        } catch (const std::exception& e) {
+          out.error = ErrorInfo{"internal", std::string("video encode failed: ") + e.what(), ""};
+        }
+      }
+    }
     if (out.error) {
       core.metrics.count_request("render", false);
       log_request(core, id, "render", out.error->code);
@@ -315,6 +344,7 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
       }
       ctx->quality =
           quality_report(*decision, level, ladder_size, budget_ms, jpeg, jpeg_quality, frame_ms);
+      if (video_frame) set_video_report(*video_frame, &*ctx->quality);
     }
     core.metrics.count_request("render", true);
     core.metrics.observe(Metrics::kQueue, out.queue_ms);

@@ -5,7 +5,16 @@
 // URL parameters: scene (stored id, or an example file name), size (canvas
 // pixels, default 512), budget (frame-time budget in ms, default 33), still
 // (ms of rest before the full-accuracy frame, default 300), inflight (requests
-// kept in flight, default 2).
+// kept in flight, default 2), video (moving frames as a video stream: vp8,
+// the default, vp9, or off for JPEG), bitrate (the stream's target in kbit/s;
+// default: the server's --preview-bitrate).
+//
+// Video (issue 42; PROTOCOL.md, "Video preview"): where WebCodecs has the
+// codec (VideoDecoder.isConfigSupported; WebCodecs needs a secure context:
+// https, or http to localhost), moving frames are asked for as video and
+// decoded into the canvas; else, or when the server refuses, they are JPEG.
+// The overlay says which. A decoder error opens a new decoder and asks for a
+// key frame; frames until then are dropped.
 //
 // Behind HAProxy (deploy/haproxy.cfg.in, `balance url_param scene`) a session
 // sticks to one server by the `scene` query parameter, so the WebSocket and the
@@ -19,6 +28,8 @@ const size = Math.max(16, Math.min(2048, parseInt(params.get('size') || '512', 1
 const budgetMs = parseFloat(params.get('budget') || '33');
 const stillMs = parseFloat(params.get('still') || '300');
 const maxInflight = Math.max(1, parseInt(params.get('inflight') || '2', 10));
+const videoParam = (params.get('video') || 'vp8').toLowerCase();
+const bitrateKbps = params.get('bitrate') ? parseInt(params.get('bitrate'), 10) : null;
 
 const canvas = document.getElementById('canvas');
 const ctx2d = canvas.getContext('2d');
@@ -45,6 +56,19 @@ const preview = {
   reconnects: 0,       // WebSockets opened again after a loss
   failedAttempts: 0,   // connection attempts that closed before opening
   abandoned: 0,        // requests whose WebSocket closed before their answer
+  // The moving frames' path: codec null is JPEG, for `reason`.
+  video: {
+    want: videoParam === 'off' ? null : videoParam,
+    codec: null, reason: 'starting', bitrate_kbps: null,
+    received: 0,     // video frames in
+    decoded: 0,      // pictures out of the decoder
+    keyframes: 0,    // key frames in
+    dropped: 0,      // delta frames dropped while waiting for a key frame
+    errors: [],      // decoder errors (messages)
+    recoveries: 0,   // key frames decoded after a decoder error
+    decode_ms: [],   // decode() to the picture, per frame (the latest 200)
+    corruptNext: false,  // test hook: the next delta frame is fed as garbage
+  },
 };
 window.beamcastPreview = preview;
 preview.view = () => (orbit ? cameraFromOrbit(orbit) : null);  // the camera the page shows next
@@ -66,6 +90,8 @@ let viewOf = null;          // the picker value whose view `orbit` holds
 let sceneJson = null;       // the selected scene (the overlay leaves out what it lacks)
 let selectSeq = 0;          // the latest selectScene call; earlier ones give way
 let attempt = 0;            // connection attempts since a scene was last established
+let arrivals = 0;           // responses with a picture, numbered as they arrive
+let lastImageSeq = 0;       // the arrival number of the latest PNG/JPEG drawn
 
 // Backoff before connection attempt n (0, 1, ...): 100 ms doubling to a 2 s
 // cap, uniform in [half, whole] so pages that lost the same server do not all
@@ -146,8 +172,15 @@ function connect() {
         msg.result.frames.some((f) => f.attachment && f.attachment.length > 0);
     const received = performance.now();
     if (hasAttachments) {
-      awaitingBinary = {finish: (bytes) => p.resolve({msg, bytes, sent: p.sent, received}),
-                        fail: p.reject};
+      const seq = ++arrivals;
+      awaitingBinary = {
+        finish: (bytes) => {
+          // Video frames go to the decoder in the order they arrive: the
+          // order the server encoded them.
+          if (isVideoFormat(msg.result.frames[0].format)) feedVideo(msg.result.frames[0], bytes, seq);
+          p.resolve({msg, bytes, sent: p.sent, received, seq});
+        },
+        fail: p.reject};
     } else if (msg.ok) {
       p.resolve({msg, bytes: null, sent: p.sent, received});
     } else {
@@ -169,6 +202,7 @@ function lost() {
   preview.ready = false;
   preview.sceneId = null;
   failPending();
+  needKey = true;  // the next server's stream starts with a key frame
   setStatus(preview.disconnects > 0 ? 'reconnecting…' : 'connecting…', 'warn');
   setTimeout(connect, backoffMs(attempt++));
 }
@@ -304,23 +338,137 @@ function renderRequest(camera, motion) {
   const r = {scene_id: preview.sceneId, cameras: [camera], quality: 'auto', budget_ms: budgetMs,
              still_ms: stillMs};
   if (motion) r.motion = motion;
+  const v = preview.video;
+  if (v.codec) {
+    r.video = {codec: v.codec};
+    if (bitrateKbps) r.video.bitrate_kbps = bitrateKbps;
+    if (needKey) r.video.keyframe = true;
+  }
   return r;
 }
 
+// --- video ------------------------------------------------------------------
+
+const isVideoFormat = (format) => format === 'vp8' || format === 'vp9' || format === preview.video.codec;
+// WebCodecs codec strings (vp9: profile 0, level 4.1, 8 bits); other names
+// are tried as they are, and the server refuses what it does not encode.
+const codecStrings = {vp8: 'vp8', vp9: 'vp09.00.41.08', av1: 'av01.0.08M.08'};
+let decoder = null;
+let decoderConfig = null;
+let needKey = true;        // drop delta frames until a key frame (at start and after an error)
+let recovering = false;    // a decoder error happened; the next key frame is the recovery
+const decodeStarted = new Map();  // chunk timestamp -> {t, recovery}
+
+// Picks the moving frames' path: video where WebCodecs decodes the codec.
+async function setupVideo() {
+  const v = preview.video;
+  if (!v.want) { v.reason = 'video off (?video=off)'; return; }
+  if (typeof VideoDecoder === 'undefined') {
+    v.reason = 'no WebCodecs in this browser' + (window.isSecureContext ? '' : ' (needs https or localhost)');
+    return;
+  }
+  const config = {codec: codecStrings[v.want] || v.want, codedWidth: size, codedHeight: size,
+                  optimizeForLatency: true};
+  let ok = false;
+  try {
+    ok = (await VideoDecoder.isConfigSupported(config)).supported;
+  } catch {
+    ok = false;
+  }
+  if (!ok) { v.reason = `this browser cannot decode ${v.want}`; return; }
+  decoderConfig = config;
+  v.codec = v.want;
+  v.reason = '';
+  openDecoder();
+}
+
+function openDecoder() {
+  decoder = new VideoDecoder({output: onVideoFrame, error: onDecoderError});
+  decoder.configure(decoderConfig);
+  needKey = true;
+}
+
+// A decoder error closes the decoder: a new one, a key frame asked for with
+// the next request, and frames dropped until it comes.
+function onDecoderError(e) {
+  preview.video.errors.push(String(e && e.message || e));
+  console.warn('preview: video decoder error, asking for a key frame: ' + (e && e.message || e));
+  recovering = true;
+  decodeStarted.clear();
+  if (preview.video.codec) openDecoder();
+}
+
+// The server refused video (an unknown codec, an older server): JPEG from now on.
+function refuseVideo(e) {
+  const v = preview.video;
+  v.reason = `server refused ${v.codec}: ${e.code}: ${e.message}`;
+  v.codec = null;
+  if (decoder && decoder.state !== 'closed') decoder.close();
+  decoder = null;
+  lastSentKey = null;  // ask for the pose again, as JPEG
+  updateOverlay();
+}
+
+function feedVideo(f, bytes, seq) {
+  const v = preview.video;
+  const all = bytes.subarray(f.attachment.offset, f.attachment.offset + f.attachment.length);
+  ++v.received;
+  if (!decoder || decoder.state !== 'configured' || all.length < 12) return;
+  // The 12-byte header: "BCV1", flags (bit 0: key frame), codec, 2 zero bytes, pts.
+  const key = (all[4] & 1) === 1;
+  let data = all.subarray(12);
+  if (key) ++v.keyframes;
+  if (needKey && !key) { ++v.dropped; return; }
+  if (key) needKey = false;
+  if (v.corruptNext && !key) {
+    v.corruptNext = false;
+    data = new Uint8Array([0xff, 0xff, 0xff]);  // not a frame: the decoder must fail on it
+  }
+  decodeStarted.set(seq, {t: performance.now(), recovery: recovering && key});
+  if (key) recovering = false;
+  try {
+    decoder.decode(new EncodedVideoChunk({type: key ? 'key' : 'delta', timestamp: seq, data}));
+  } catch (e) {
+    onDecoderError(e);
+  }
+}
+
+function onVideoFrame(frame) {
+  const v = preview.video;
+  const seq = frame.timestamp;
+  // A PNG or JPEG that arrived later is already on the canvas.
+  if (seq > lastImageSeq) ctx2d.drawImage(frame, 0, 0, canvas.width, canvas.height);
+  frame.close();
+  ++v.decoded;
+  const started = decodeStarted.get(seq);
+  decodeStarted.delete(seq);
+  if (started) {
+    v.decode_ms.push(performance.now() - started.t);
+    if (v.decode_ms.length > 200) v.decode_ms.shift();
+    if (started.recovery) ++v.recoveries;
+  }
+}
+
 async function show(res, camera, socket) {
-  const {msg, bytes, sent, received} = res;
+  const {msg, bytes, sent, received, seq} = res;
   const r = msg.result;
   const f = r.frames[0];
   const data = bytes.subarray(f.attachment.offset, f.attachment.offset + f.attachment.length);
-  const type = f.format === 'jpeg' ? 'image/jpeg' : 'image/png';
-  const bitmap = await createImageBitmap(new Blob([data], {type}));
-  ctx2d.drawImage(bitmap, 0, 0, canvas.width, canvas.height);
-  bitmap.close();
+  if (!isVideoFormat(f.format)) {
+    // Video frames went to the decoder as they came (feedVideo).
+    const type = f.format === 'jpeg' ? 'image/jpeg' : 'image/png';
+    const bitmap = await createImageBitmap(new Blob([data], {type}));
+    ctx2d.drawImage(bitmap, 0, 0, canvas.width, canvas.height);
+    bitmap.close();
+    lastImageSeq = Math.max(lastImageSeq, seq);
+  }
   const q = r.quality || {};
+  if (q.bitrate_kbps) preview.video.bitrate_kbps = q.bitrate_kbps;
   const now = performance.now();
   preview.frames.push({
     t: now, latency_ms: received - sent, level: q.level, levels: q.levels, still: !!q.still,
     reason: q.reason, label: q.label, scale: q.scale, format: f.format, bytes: data.length,
+    keyframe: q.keyframe,
     frame_ms: q.frame_ms, budget_ms: q.budget_ms,
     server_ms: r.timings.server_ms, passes: r.passes, socket,
   });
@@ -392,9 +540,15 @@ function updateOverlay() {
   } else {
     overlay.classList.remove('over');
   }
+  const v = preview.video;
+  const path = v.codec
+      ? `moving frames: ${v.codec} video (WebCodecs)` +
+        (v.bitrate_kbps ? ` ${v.bitrate_kbps} kbit/s` : '') + `, ${v.decoded} decoded` +
+        (v.errors.length ? `, ${v.errors.length} decoder errors, ${v.recoveries} recovered` : '')
+      : `moving frames: JPEG (${v.reason})`;
   overlay.textContent =
       `${n} frames/s  latency ${latency.toFixed(0)} ms\n${accuracy}\n${budget}` +
-      `${last.format} ${(last.bytes / 1024).toFixed(0)} KiB  server ${last.server_ms.toFixed(0)} ms`;
+      `${last.format} ${(last.bytes / 1024).toFixed(1)} KiB  server ${last.server_ms.toFixed(0)} ms\n${path}`;
 }
 
 function tick() {
@@ -439,7 +593,12 @@ function maybeSend() {
   drawing = drawing.then(() => req).then((res) => show(res, camera, socket))
       .catch((e) => {
         // A lost WebSocket is the reconnection's to mend, not an error of the frame.
-        if (e.code !== 'disconnected') setStatus(`render: ${e.code || ''} ${e.message || e}`, 'error');
+        if (e.code === 'disconnected') return;
+        if (preview.video.codec && typeof e.path === 'string' && e.path.startsWith('/params/video')) {
+          refuseVideo(e);
+          return;
+        }
+        setStatus(`render: ${e.code || ''} ${e.message || e}`, 'error');
       })
       .finally(() => { --inflight; maybeSend(); });
 }
@@ -576,4 +735,4 @@ async function establish(sock) {
   }
 }
 
-connect();
+setupVideo().finally(connect);

@@ -16,6 +16,7 @@
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
 #include "render/jpeg.hpp"
+#include "render/video.hpp"
 #include "server/server.hpp"
 
 namespace beamcast {
@@ -264,6 +265,97 @@ TEST(InteractiveQuality, MovingFramesAreReducedAndTheStillFrameIsExact) {
   const Image reference = decode_png(ws.frame(full));
   // Same renderer, same settings, same device: exactly equal.
   EXPECT_EQ(still.rgb, reference.rgb);
+}
+
+// Video (issue 42): moving frames of a connection that asks for "video" are
+// one VP8 stream (a key frame first, then predicted frames, a key frame on
+// request and on a new frame size), the still frame stays PNG and exact, and
+// bad video params are errors naming the field. Costs ~1 s (llvmpipe, 64x64).
+TEST(InteractiveQuality, VideoFramesAreOneStreamAndTheStillFrameStaysExact) {
+  HttpTestServer s;
+  store_demo(s.core());
+  WsClient ws(s.http_port());
+  const int size = 64;
+  const json video = {{"budget_ms", 10000}, {"still_ms", 60000},
+                      {"video", {{"codec", "vp8"}, {"bitrate_kbps", 400}}}};
+  auto r = ws.call(auto_render(1, 0.0, size, video));
+  ASSERT_TRUE(r.j["ok"]) << r.j.dump();
+  EXPECT_EQ(r.j["result"]["frames"][0]["format"], "png") << "the first frame is the still one";
+  VideoDecoder dec(VideoCodec::kVp8);
+  for (int i = 0; i < 5; ++i) {
+    json opts = video;
+    if (i == 3) opts["video"]["keyframe"] = true;
+    r = ws.call(auto_render(2 + i, 0.05 * (i + 1), size, opts));
+    ASSERT_TRUE(r.j["ok"]) << r.j.dump();
+    const json& q = r.j["result"]["quality"];
+    EXPECT_FALSE(q["still"]);
+    EXPECT_EQ(q["format"], "vp8");
+    EXPECT_EQ(q["bitrate_kbps"], 400);
+    EXPECT_FALSE(q.contains("jpeg_quality"));
+    EXPECT_EQ(r.j["result"]["frames"][0]["format"], "vp8");
+    EXPECT_EQ(r.j["result"]["frames"][0]["bit_depth"], 8);
+    const std::vector<std::uint8_t> bytes = ws.frame(r);
+    const VideoFrameView v = unpack_video_frame(bytes);
+    const bool key = i == 0 || i == 3;
+    EXPECT_EQ(v.key, key) << "frame " << i;
+    EXPECT_EQ(q["keyframe"], key);
+    EXPECT_EQ(v.pts, static_cast<std::uint32_t>(i));
+    const Image img = dec.decode(v.data);
+    EXPECT_EQ(img.width, size);
+    EXPECT_EQ(img.height, size);
+  }
+  // A new size: a new stream, starting with a key frame.
+  r = ws.call(auto_render(10, 0.4, 48, video));
+  ASSERT_TRUE(r.j["ok"]) << r.j.dump();
+  const std::vector<std::uint8_t> resized_bytes = ws.frame(r);
+  const VideoFrameView resized = unpack_video_frame(resized_bytes);
+  EXPECT_TRUE(resized.key);
+  EXPECT_EQ(resized.pts, 0u);
+  EXPECT_EQ(dec.decode(resized.data).width, 48);
+
+  // The still frame: PNG, equal to a plain render of the pose.
+  r = ws.call(auto_render(20, 0.4, size, {{"motion", "still"}, {"video", video["video"]}}));
+  ASSERT_TRUE(r.j["ok"]) << r.j.dump();
+  EXPECT_TRUE(r.j["result"]["quality"]["still"]);
+  EXPECT_EQ(r.j["result"]["frames"][0]["format"], "png");
+  const Image still = decode_png(ws.frame(r));
+  auto full = ws.call({{"id", 21}, {"method", "render"},
+                       {"params", {{"scene_id", "demo"}, {"cameras", {camera(0.4, size)}}}}});
+  EXPECT_EQ(still.rgb, decode_png(ws.frame(full)).rgb);
+
+  // Bad video params: code, message, path; the connection carries on.
+  const auto refused = [&](int id, json params, const std::string& code, const std::string& path) {
+    json req = auto_render(id, 0.5, size, std::move(params));
+    auto e = ws.call(req);
+    ASSERT_FALSE(e.j["ok"]) << e.j.dump();
+    EXPECT_EQ(e.j["error"]["code"], code) << e.j.dump();
+    EXPECT_EQ(e.j["error"]["path"], path) << e.j.dump();
+    EXPECT_FALSE(e.j["error"]["message"].get<std::string>().empty());
+  };
+  refused(30, {{"video", {{"codec", "h264"}}}}, "invalid_value", "/params/video/codec");
+  refused(31, {{"video", {{"codec", "vp9"}, {"bitrate_kbps", 10}}}}, "out_of_range",
+          "/params/video/bitrate_kbps");
+  refused(32, {{"video", {{"codec", "vp9"}, {"bitrate_kbps", "fast"}}}}, "wrong_type",
+          "/params/video/bitrate_kbps");
+  refused(33, {{"video", {{"bitrate_kbps", 500}}}}, "missing_field", "/params/video/codec");
+  refused(34, {{"video", {{"codec", "vp8"}, {"gop", 5}}}}, "unknown_field", "/params/video/gop");
+  refused(35, {{"video", "vp8"}}, "wrong_type", "/params/video");
+  json two = auto_render(36, 0.5, size, video);
+  json second = camera(0.6, size);
+  second["name"] = "second";
+  two["params"]["cameras"].push_back(second);
+  auto e = ws.call(two);
+  EXPECT_EQ(e.j["error"]["code"], "invalid_value") << e.j.dump();
+  EXPECT_EQ(e.j["error"]["path"], "/params/video");
+  json batch = {{"id", 37}, {"method", "render"},
+                {"params", {{"scene_id", "demo"}, {"video", {{"codec", "vp8"}}}}}};
+  e = ws.call(batch);
+  EXPECT_EQ(e.j["error"]["code"], "invalid_value") << e.j.dump();
+  EXPECT_EQ(e.j["error"]["path"], "/params/video");
+  // The stream goes on after the refusals.
+  r = ws.call(auto_render(40, 0.7, size, video));
+  ASSERT_TRUE(r.j["ok"]) << r.j.dump();
+  EXPECT_EQ(r.j["result"]["frames"][0]["format"], "vp8");
 }
 
 TEST(InteractiveQuality, StillTimeElapsesOnTheServerClock) {

@@ -1,0 +1,79 @@
+#!/usr/bin/python3
+"""Plots beamcast_bench_video's CSV (--csv): bytes a second against PSNR of
+the displayed frames, JPEG at its qualities and VP8/VP9 at their bitrates, one
+panel per scene and size (docs/performance.md, "Video preview").
+
+Usage: plot_video.py video.csv video.png
+"""
+import csv
+import math
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+FIELDS = ["scene", "size", "path", "setting", "bytes_per_s", "psnr", "ssim",
+          "encode_ms", "decode_ms", "raw_psnr", "raw_ssim"]
+
+
+def main():
+    src, dst = sys.argv[1], sys.argv[2]
+    panels = defaultdict(lambda: defaultdict(list))
+    ceiling = {}
+    settings = defaultdict(lambda: defaultdict(list))
+    with open(src, newline="") as f:
+        for row in csv.DictReader(f, fieldnames=FIELDS):
+            key = (row["scene"], row["size"])
+            panels[key][row["path"]].append((float(row["bytes_per_s"]), float(row["psnr"])))
+            settings[key][row["path"]].append(float(row["setting"]))
+            ceiling[key] = float(row["raw_psnr"])
+    keys = sorted(panels)
+    fig, axes = plt.subplots(1, len(keys), figsize=(4.2 * len(keys), 3.6), squeeze=False)
+    styles = {"jpeg": ("C0", "o", "JPEG (q50-92)"), "vp8": ("C1", "s", "VP8"),
+              "vp9": ("C2", "^", "VP9")}
+    for ax, key in zip(axes[0], keys):
+        for path, pts in panels[key].items():
+            pts.sort()
+            color, marker, label = styles[path]
+            ax.plot([b * 8 / 1e6 for b, _ in pts], [p for _, p in pts], marker=marker,
+                    color=color, label=label)
+        ax.axhline(ceiling[key], color="0.5", ls=":", lw=1, label="level without compression")
+        ax.set_xscale("log")
+        ax.set_xlabel("Mbit/s at 30 frames/s")
+        ax.set_ylabel("PSNR dB vs full accuracy")
+        ax.set_title(f"{key[0]} {key[1]}", fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(dst, dpi=110)
+    # Bytes at equal PSNR: each JPEG point against the video curve,
+    # interpolated linearly in PSNR against log(bytes); none where the
+    # codec's curve does not reach the JPEG point's PSNR.
+    print("| scene | size | JPEG | JPEG PSNR | JPEG KiB/s | VP8 KiB/s (ratio) | VP9 KiB/s (ratio) |")
+    print("|---|---|---|---|---|---|---|")
+    for key in keys:
+        jpeg = sorted(zip(panels[key]["jpeg"], settings[key]["jpeg"]))
+        cells = []
+        for (jb, jp), q in jpeg:
+            row = [key[0], key[1], f"q{q:g}", f"{jp:.2f}", f"{jb / 1024:.0f}"]
+            for codec in ("vp8", "vp9"):
+                pts = sorted(panels[key][codec])
+                found = None
+                for (b0, p0), (b1, p1) in zip(pts, pts[1:]):
+                    if p0 <= jp <= p1 and p1 > p0:
+                        f = (jp - p0) / (p1 - p0)
+                        found = math.exp(math.log(b0) + f * (math.log(b1) - math.log(b0)))
+                        break
+                if found is None and pts and pts[0][1] >= jp:
+                    found = pts[0][0]
+                row.append("not reached" if found is None
+                           else f"{found / 1024:.0f} ({found / jb:.2f})")
+            cells.append("| " + " | ".join(row) + " |")
+        print("\n".join(cells))
+
+
+if __name__ == "__main__":
+    main()

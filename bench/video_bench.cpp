@@ -1,0 +1,248 @@
+// The preview's moving frames as JPEG against a VP8/VP9 stream (issue 42;
+// docs/performance.md, "Video preview"). One drag is replayed: the browser
+// test's pointer path (tests/preview/browser.mjs, pointerMoves: 2 s, radius
+// 100 px on a 512 px canvas) through the page's orbit (a drag across the
+// canvas turns half a turn), 30 frames a second, from the scene's camera.
+// Every pose is rendered at full accuracy (the reference) and at one
+// accuracy level of the preview's ladder (the moving frame); the moving
+// frames go through JPEG at several qualities and through the video encoder
+// at several bitrates (frames timed at 30 frames/s), are decoded, and each
+// displayed frame is compared with the full-accuracy frame of its pose:
+// PSNR (RGB, 8 bits) and SSIM (luma, 8x8 windows at a stride of 4, the
+// usual constants). Encode and decode are timed per frame in this thread's
+// CPU time (one encoder thread, as the server runs it); decode includes the
+// conversion to RGB.
+//
+// Not a test: prints a markdown table, and CSV with --csv FILE (for
+// bench/plot_video.py). Usage:
+//   beamcast_bench_video [--scene NAME] [--size WxH] [--level L] [--frames N] [--csv FILE]
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <string>
+#include <vector>
+
+#include "protocol/data_dir.hpp"
+#include "protocol/scene_json.hpp"
+#include "render/image.hpp"
+#include "render/jpeg.hpp"
+#include "render/renderer.hpp"
+#include "render/video.hpp"
+#include "server/accuracy_controller.hpp"
+
+namespace {
+
+using namespace beamcast;
+// CPU time of this thread, ms: the encoders' cost on a shared machine whose
+// load makes wall-clock numbers noisy.
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+double mean(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x;
+  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+}
+
+Vec3 rotate_about(const Vec3& v, const Vec3& axis, double angle) {
+  // Rodrigues' formula, axis of unit length.
+  const double c = std::cos(angle), s = std::sin(angle);
+  return c * v + s * cross(axis, v) + (dot(axis, v) * (1.0 - c)) * axis;
+}
+
+// The drag's poses: the page's orbit about the camera's up axis, driven by the
+// browser test's pointer path, sampled at 30 frames/s.
+std::vector<Camera> drag_path(const Camera& cam0, int frames) {
+  const Vec3 target = cam0.target.value_or(cam0.position + Vec3{0, 0, -5});
+  const Vec3 up = normalize(cam0.up);
+  const double canvas = 512.0, radius = 100.0, k = 3.14159265358979 / canvas;
+  std::vector<Camera> out;
+  for (int i = 0; i < frames; ++i) {
+    const double t = i / (frames - 1.0);
+    const double a = 1.5 * 3.14159265358979 * t;
+    const double yaw = -radius * std::sin(a) * k;
+    const double pitch = 0.4 * radius * std::sin(2 * a) * k;
+    Vec3 d = rotate_about(cam0.position - target, up, yaw);
+    const Vec3 side = normalize(cross(up, d));
+    d = rotate_about(d, side, -pitch);
+    Camera c = cam0;
+    c.rotation.reset();
+    c.target = target;
+    c.position = target + d;
+    out.push_back(c);
+  }
+  return out;
+}
+
+// Luma of an 8-bit RGB image (BT.601).
+std::vector<double> luma(const Image& img) {
+  std::vector<double> y(static_cast<std::size_t>(img.width) * img.height);
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    y[i] = 0.299 * img.rgb[3 * i] + 0.587 * img.rgb[3 * i + 1] + 0.114 * img.rgb[3 * i + 2];
+  }
+  return y;
+}
+
+double ssim(const Image& a, const Image& b) {
+  const std::vector<double> x = luma(a), y = luma(b);
+  const int w = a.width, h = a.height, n = 8, stride = 4;
+  const double c1 = std::pow(0.01 * 255, 2), c2 = std::pow(0.03 * 255, 2);
+  double sum = 0.0;
+  int windows = 0;
+  for (int wy = 0; wy + n <= h; wy += stride) {
+    for (int wx = 0; wx + n <= w; wx += stride) {
+      double mx = 0, my = 0, sxx = 0, syy = 0, sxy = 0;
+      for (int j = 0; j < n; ++j) {
+        for (int i = 0; i < n; ++i) {
+          const std::size_t p = static_cast<std::size_t>(wy + j) * w + wx + i;
+          mx += x[p];
+          my += y[p];
+          sxx += x[p] * x[p];
+          syy += y[p] * y[p];
+          sxy += x[p] * y[p];
+        }
+      }
+      const double m = n * n;
+      mx /= m;
+      my /= m;
+      const double vx = sxx / m - mx * mx, vy = syy / m - my * my, cxy = sxy / m - mx * my;
+      sum += ((2 * mx * my + c1) * (2 * cxy + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2));
+      ++windows;
+    }
+  }
+  return windows ? sum / windows : 1.0;
+}
+
+Image to8(const Image& img) {
+  if (img.bit_depth == 8) return img;
+  Image o = img;
+  o.bit_depth = 8;
+  for (auto& s : o.rgb) s = static_cast<std::uint16_t>(s >> 8);
+  return o;
+}
+
+struct Result {
+  std::string path;
+  double setting = 0;  // JPEG quality or kbit/s
+  std::vector<double> psnr, ssim, encode_ms, decode_ms;
+  std::size_t bytes = 0, key_bytes = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string name = "paper_10sets", csv_path;
+  int width = 512, height = 512, level_index = 3, frames = 60;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string a = argv[i], v = argv[i + 1];
+    if (a == "--scene") name = v;
+    else if (a == "--size") std::sscanf(v.c_str(), "%dx%d", &width, &height);
+    else if (a == "--level") level_index = std::atoi(v.c_str());
+    else if (a == "--frames") frames = std::max(2, std::atoi(v.c_str()));
+    else if (a == "--csv") csv_path = v;
+    else {
+      std::fprintf(stderr, "unknown option %s\n", a.c_str());
+      return 2;
+    }
+  }
+  const auto dir = find_data_dir("examples");
+  SceneLoadOptions opts;
+  opts.assets_dir = dir;
+  const Scene scene = load_scene_file(dir / (name + ".json"), opts);
+  Camera cam0 = scene.cameras.at(0);
+  cam0.width = width;
+  cam0.height = height;
+  const std::vector<AccuracyLevel> ladder = preview_ladder(scene);
+  level_index = std::clamp(level_index, 0, static_cast<int>(ladder.size()) - 1);
+  const AccuracyLevel& level = ladder[level_index];
+  Scene reduced = scene;
+  apply_accuracy_level(level, &reduced);
+  FrameOptions fo;
+  fo.resolution_scale = level.scale;
+
+  Renderer renderer;
+  std::fprintf(stderr, "renderer: %s; %s %dx%d, level %d (%s), %d frames\n",
+               renderer.description().c_str(), name.c_str(), width, height, level_index,
+               level.label.c_str(), frames);
+  std::vector<Image> full, moving;
+  for (const Camera& c : drag_path(cam0, frames)) {
+    full.push_back(to8(renderer.render(scene, {c})[0].image));
+    moving.push_back(to8(renderer.render(reduced, {c}, fo)[0].image));
+  }
+  Result raw{"uncompressed", 0};
+  for (int i = 0; i < frames; ++i) {
+    raw.psnr.push_back(compare_levels(moving[i], full[i]).psnr_db);
+    raw.ssim.push_back(ssim(moving[i], full[i]));
+  }
+
+  std::vector<Result> results;
+  for (int q : {50, 75, 85, 92}) {
+    Result r{"jpeg", static_cast<double>(q)};
+    for (int i = 0; i < frames; ++i) {
+      double t = thread_cpu_ms();
+      const auto bytes = encode_jpeg(moving[i], q);
+      r.encode_ms.push_back(thread_cpu_ms() - t);
+      t = thread_cpu_ms();
+      const Image shown = decode_jpeg(bytes);
+      r.decode_ms.push_back(thread_cpu_ms() - t);
+      r.bytes += bytes.size();
+      r.psnr.push_back(compare_levels(shown, full[i]).psnr_db);
+      r.ssim.push_back(ssim(shown, full[i]));
+    }
+    results.push_back(std::move(r));
+  }
+  for (VideoCodec codec : {VideoCodec::kVp8, VideoCodec::kVp9}) {
+    for (int kbps : {125, 250, 500, 1000, 2000, 4000}) {
+      Result r{std::string(video_codec_name(codec)), static_cast<double>(kbps)};
+      VideoEncoder enc({codec, width, height, kbps, 1});
+      VideoDecoder dec(codec);
+      for (int i = 0; i < frames; ++i) {
+        double t = thread_cpu_ms();
+        const EncodedVideoFrame f = enc.encode(moving[i], i * 1000.0 / 30.0);
+        r.encode_ms.push_back(thread_cpu_ms() - t);
+        t = thread_cpu_ms();
+        const Image shown = dec.decode(f.data);
+        r.decode_ms.push_back(thread_cpu_ms() - t);
+        r.bytes += f.data.size();
+        if (f.key) r.key_bytes += f.data.size();
+        r.psnr.push_back(compare_levels(shown, full[i]).psnr_db);
+        r.ssim.push_back(ssim(shown, full[i]));
+      }
+      results.push_back(std::move(r));
+    }
+  }
+
+  const double seconds = frames / 30.0;
+  std::printf("\n### %s, %dx%d, moving frames at level %d (%s), %d frames at 30 frames/s\n\n",
+              name.c_str(), width, height, level_index, level.label.c_str(), frames);
+  std::printf("Without compression the level's frames are %.2f dB PSNR, SSIM %.4f against full accuracy.\n\n",
+              mean(raw.psnr), mean(raw.ssim));
+  std::printf("| path | setting | KiB/s | Mbit/s | PSNR dB (mean) | PSNR min | SSIM (mean) | encode CPU ms (median) | decode CPU ms (median) | key frame bytes |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+  FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "a");
+  for (const Result& r : results) {
+    const double bps = r.bytes / seconds;
+    std::printf("| %s | %s%g | %.1f | %.3f | %.2f | %.2f | %.4f | %.2f | %.2f | %zu |\n", r.path.c_str(),
+                r.path == "jpeg" ? "q" : "", r.setting, bps / 1024, bps * 8 / 1e6, mean(r.psnr),
+                *std::min_element(r.psnr.begin(), r.psnr.end()), mean(r.ssim), median(r.encode_ms),
+                median(r.decode_ms), r.key_bytes);
+    if (csv) {
+      std::fprintf(csv, "%s,%dx%d,%s,%g,%.1f,%.3f,%.4f,%.3f,%.3f,%.3f,%.4f\n", name.c_str(), width,
+                   height, r.path.c_str(), r.setting, bps, mean(r.psnr), mean(r.ssim),
+                   median(r.encode_ms), median(r.decode_ms), mean(raw.psnr), mean(raw.ssim));
+    }
+  }
+  if (csv) std::fclose(csv);
+  return 0;
+}

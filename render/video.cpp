@@ -1,0 +1,267 @@
+#include "render/video.hpp"
+
+#include <vpx/vp8cx.h>
+#include <vpx/vp8dx.h>
+#include <vpx/vpx_decoder.h>
+#include <vpx/vpx_encoder.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "protocol/check.hpp"
+
+namespace beamcast {
+namespace {
+
+constexpr char kMagic[4] = {'B', 'C', 'V', '1'};
+
+[[noreturn]] void vpx_fail(vpx_codec_ctx_t* ctx, const char* call) {
+  std::string msg = std::string("libvpx: ") + call + ": ";
+  msg += ctx ? vpx_codec_error(ctx) : "failed";
+  if (ctx && vpx_codec_error_detail(ctx)) msg += std::string(" (") + vpx_codec_error_detail(ctx) + ")";
+  throw std::runtime_error(msg);
+}
+
+int clamp_byte(int v) { return std::clamp(v, 0, 255); }
+
+// BT.601 limited range (studio swing), the integer form of the matrix.
+void rgb_to_i420(const Image& src, vpx_image_t* dst) {
+  const int w = src.width, h = src.height;
+  const int shift = src.bit_depth == 16 ? 8 : 0;
+  auto px = [&](int x, int y, int c) {
+    return static_cast<int>(src.rgb[3 * (static_cast<std::size_t>(y) * w + x) + c] >> shift);
+  };
+  unsigned char* yp = dst->planes[VPX_PLANE_Y];
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int r = px(x, y, 0), g = px(x, y, 1), b = px(x, y, 2);
+      yp[static_cast<std::size_t>(y) * dst->stride[VPX_PLANE_Y] + x] =
+          static_cast<unsigned char>(((66 * r + 129 * g + 25 * b + 128) >> 8) + 16);
+    }
+  }
+  // Chroma of each 2x2 block from its mean colour (an odd last row or column
+  // averages what there is).
+  unsigned char* up = dst->planes[VPX_PLANE_U];
+  unsigned char* vp = dst->planes[VPX_PLANE_V];
+  for (int cy = 0; cy < (h + 1) / 2; ++cy) {
+    for (int cx = 0; cx < (w + 1) / 2; ++cx) {
+      int r = 0, g = 0, b = 0, n = 0;
+      for (int y = 2 * cy; y < std::min(h, 2 * cy + 2); ++y) {
+        for (int x = 2 * cx; x < std::min(w, 2 * cx + 2); ++x) {
+          r += px(x, y, 0);
+          g += px(x, y, 1);
+          b += px(x, y, 2);
+          ++n;
+        }
+      }
+      r = (r + n / 2) / n;
+      g = (g + n / 2) / n;
+      b = (b + n / 2) / n;
+      up[static_cast<std::size_t>(cy) * dst->stride[VPX_PLANE_U] + cx] =
+          static_cast<unsigned char>(((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128);
+      vp[static_cast<std::size_t>(cy) * dst->stride[VPX_PLANE_V] + cx] =
+          static_cast<unsigned char>(((112 * r - 94 * g - 18 * b + 128) >> 8) + 128);
+    }
+  }
+}
+
+// The inverse, chroma upsampled bilinearly between sample centres (what a
+// browser's video path does; nearest would add blockiness the stream lacks).
+Image i420_to_rgb(const vpx_image_t& src) {
+  const int w = static_cast<int>(src.d_w), h = static_cast<int>(src.d_h);
+  const int cw = (w + 1) / 2, ch = (h + 1) / 2;
+  Image out;
+  out.width = w;
+  out.height = h;
+  out.bit_depth = 8;
+  out.rgb.resize(3 * static_cast<std::size_t>(w) * h);
+  auto chroma = [&](int plane, double fx, double fy) {
+    const int x0 = std::clamp(static_cast<int>(std::floor(fx)), 0, cw - 1);
+    const int y0 = std::clamp(static_cast<int>(std::floor(fy)), 0, ch - 1);
+    const int x1 = std::min(x0 + 1, cw - 1), y1 = std::min(y0 + 1, ch - 1);
+    const double ax = std::clamp(fx - x0, 0.0, 1.0), ay = std::clamp(fy - y0, 0.0, 1.0);
+    const unsigned char* p = src.planes[plane];
+    const int s = src.stride[plane];
+    auto at = [&](int x, int y) { return static_cast<double>(p[static_cast<std::size_t>(y) * s + x]); };
+    return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x1, y0)) +
+           ay * ((1 - ax) * at(x0, y1) + ax * at(x1, y1));
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int c = src.planes[VPX_PLANE_Y][static_cast<std::size_t>(y) * src.stride[VPX_PLANE_Y] + x] - 16;
+      const double fx = (x - 0.5) / 2.0, fy = (y - 0.5) / 2.0;
+      const int d = static_cast<int>(std::lround(chroma(VPX_PLANE_U, fx, fy))) - 128;
+      const int e = static_cast<int>(std::lround(chroma(VPX_PLANE_V, fx, fy))) - 128;
+      std::uint16_t* o = &out.rgb[3 * (static_cast<std::size_t>(y) * w + x)];
+      o[0] = static_cast<std::uint16_t>(clamp_byte((298 * c + 409 * e + 128) >> 8));
+      o[1] = static_cast<std::uint16_t>(clamp_byte((298 * c - 100 * d - 208 * e + 128) >> 8));
+      o[2] = static_cast<std::uint16_t>(clamp_byte((298 * c + 516 * d + 128) >> 8));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string_view video_codec_name(VideoCodec c) { return c == VideoCodec::kVp8 ? "vp8" : "vp9"; }
+
+std::optional<VideoCodec> parse_video_codec(std::string_view name) {
+  if (name == "vp8") return VideoCodec::kVp8;
+  if (name == "vp9") return VideoCodec::kVp9;
+  return std::nullopt;
+}
+
+struct VideoEncoder::Impl {
+  vpx_codec_ctx_t ctx{};
+  vpx_codec_enc_cfg_t cfg{};
+  vpx_image_t* img = nullptr;
+  bool open = false;
+  ~Impl() {
+    if (img) vpx_img_free(img);
+    if (open) vpx_codec_destroy(&ctx);
+  }
+};
+
+VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
+    : impl_(std::make_unique<Impl>()), settings_(settings) {
+  BEAMCAST_CHECK(settings.width > 0 && settings.height > 0, "VideoEncoder: empty frame size");
+  const bool vp9 = settings.codec == VideoCodec::kVp9;
+  vpx_codec_iface_t* iface = vp9 ? vpx_codec_vp9_cx() : vpx_codec_vp8_cx();
+  vpx_codec_enc_cfg_t& cfg = impl_->cfg;
+  if (vpx_codec_enc_config_default(iface, &cfg, 0) != VPX_CODEC_OK) vpx_fail(nullptr, "config_default");
+  cfg.g_w = static_cast<unsigned>(settings.width);
+  cfg.g_h = static_cast<unsigned>(settings.height);
+  cfg.g_timebase = {1, 1000};  // pts in milliseconds of the caller's clock
+  cfg.g_threads = static_cast<unsigned>(std::max(1, settings.threads));
+  cfg.g_pass = VPX_RC_ONE_PASS;
+  cfg.g_lag_in_frames = 0;      // every frame out as soon as it is in
+  cfg.g_error_resilient = 0;    // a reliable transport (TCP/WebSocket)
+  cfg.rc_end_usage = VPX_CBR;
+  cfg.rc_target_bitrate = static_cast<unsigned>(settings.bitrate_kbps);
+  cfg.rc_dropframe_thresh = 0;  // never drop a frame: each request gets its picture
+  cfg.rc_min_quantizer = 2;
+  cfg.rc_max_quantizer = 56;
+  cfg.rc_undershoot_pct = 50;
+  cfg.rc_overshoot_pct = 50;
+  cfg.rc_buf_initial_sz = 500;
+  cfg.rc_buf_optimal_sz = 600;
+  cfg.rc_buf_sz = 1000;
+  cfg.kf_mode = VPX_KF_DISABLED;  // key frames at the start and on request only
+  if (vpx_codec_enc_init(&impl_->ctx, iface, &cfg, 0) != VPX_CODEC_OK) vpx_fail(&impl_->ctx, "enc_init");
+  impl_->open = true;
+  vpx_codec_ctx_t* c = &impl_->ctx;
+  // Realtime speed settings (libvpx's own realtime examples use these
+  // ranges): VP8 -cpu-used 8 (of 16), VP9 speed 8 (of 9), no alt-ref frames,
+  // key frames capped at 3x a frame's share of the bitrate.
+  if (vp9) {
+    vpx_codec_control(c, VP8E_SET_CPUUSED, 8);
+    vpx_codec_control(c, VP9E_SET_ROW_MT, 1);
+    vpx_codec_control(c, VP9E_SET_AQ_MODE, 3);
+    vpx_codec_control(c, VP9E_SET_TILE_COLUMNS, 1);
+  } else {
+    vpx_codec_control(c, VP8E_SET_CPUUSED, 8);
+    vpx_codec_control(c, VP8E_SET_NOISE_SENSITIVITY, 0);
+    vpx_codec_control(c, VP8E_SET_STATIC_THRESHOLD, 1);
+  }
+  vpx_codec_control(c, VP8E_SET_ENABLEAUTOALTREF, 0);
+  vpx_codec_control(c, VP8E_SET_MAX_INTRA_BITRATE_PCT, 300);
+  impl_->img = vpx_img_alloc(nullptr, VPX_IMG_FMT_I420, cfg.g_w, cfg.g_h, 16);
+  if (!impl_->img) throw std::runtime_error("libvpx: vpx_img_alloc failed");
+}
+
+VideoEncoder::~VideoEncoder() = default;
+
+void VideoEncoder::set_bitrate(int kbps) {
+  if (kbps == settings_.bitrate_kbps) return;
+  impl_->cfg.rc_target_bitrate = static_cast<unsigned>(kbps);
+  if (vpx_codec_enc_config_set(&impl_->ctx, &impl_->cfg) != VPX_CODEC_OK) {
+    vpx_fail(&impl_->ctx, "enc_config_set");
+  }
+  settings_.bitrate_kbps = kbps;
+}
+
+EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool force_key) {
+  BEAMCAST_CHECK(img.width == settings_.width && img.height == settings_.height,
+                 "VideoEncoder::encode: frame size differs from the encoder's");
+  rgb_to_i420(img, impl_->img);
+  // The frame lasts until the next one; the first gets a 30 frames/s share.
+  const double gap = frames_ == 0 ? 33.0 : time_ms - last_ms_;
+  const auto duration = static_cast<unsigned long>(std::clamp(std::lround(gap), 1L, 1000L));
+  last_ms_ = time_ms;
+  const vpx_enc_frame_flags_t flags = force_key || frames_ == 0 ? VPX_EFLAG_FORCE_KF : 0;
+  if (vpx_codec_encode(&impl_->ctx, impl_->img, pts_ms_, duration, flags, VPX_DL_REALTIME) !=
+      VPX_CODEC_OK) {
+    vpx_fail(&impl_->ctx, "encode");
+  }
+  pts_ms_ += static_cast<std::int64_t>(duration);
+  EncodedVideoFrame out;
+  out.pts = frames_++;
+  vpx_codec_iter_t iter = nullptr;
+  while (const vpx_codec_cx_pkt_t* pkt = vpx_codec_get_cx_data(&impl_->ctx, &iter)) {
+    if (pkt->kind != VPX_CODEC_CX_FRAME_PKT) continue;
+    const auto* p = static_cast<const std::uint8_t*>(pkt->data.frame.buf);
+    out.data.insert(out.data.end(), p, p + pkt->data.frame.sz);
+    out.key = out.key || (pkt->data.frame.flags & VPX_FRAME_IS_KEY) != 0;
+  }
+  BEAMCAST_CHECK(!out.data.empty(), "libvpx gave no packet for a frame (lag 0, no frame dropping)");
+  return out;
+}
+
+struct VideoDecoder::Impl {
+  vpx_codec_ctx_t ctx{};
+  bool open = false;
+  ~Impl() {
+    if (open) vpx_codec_destroy(&ctx);
+  }
+};
+
+VideoDecoder::VideoDecoder(VideoCodec codec) : impl_(std::make_unique<Impl>()) {
+  vpx_codec_iface_t* iface = codec == VideoCodec::kVp9 ? vpx_codec_vp9_dx() : vpx_codec_vp8_dx();
+  vpx_codec_dec_cfg_t cfg{};
+  cfg.threads = 1;
+  if (vpx_codec_dec_init(&impl_->ctx, iface, &cfg, 0) != VPX_CODEC_OK) vpx_fail(&impl_->ctx, "dec_init");
+  impl_->open = true;
+}
+
+VideoDecoder::~VideoDecoder() = default;
+
+Image VideoDecoder::decode(std::span<const std::uint8_t> frame) {
+  if (vpx_codec_decode(&impl_->ctx, frame.data(), static_cast<unsigned>(frame.size()), nullptr, 0) !=
+      VPX_CODEC_OK) {
+    vpx_fail(&impl_->ctx, "decode");
+  }
+  vpx_codec_iter_t iter = nullptr;
+  const vpx_image_t* img = vpx_codec_get_frame(&impl_->ctx, &iter);
+  if (!img) throw std::runtime_error("libvpx: decode: no picture");
+  if (img->fmt != VPX_IMG_FMT_I420) throw std::runtime_error("libvpx: decode: not I420");
+  return i420_to_rgb(*img);
+}
+
+std::vector<std::uint8_t> pack_video_frame(const EncodedVideoFrame& f, VideoCodec codec) {
+  std::vector<std::uint8_t> out(kVideoHeaderBytes + f.data.size());
+  std::memcpy(out.data(), kMagic, 4);
+  out[4] = f.key ? 1 : 0;
+  out[5] = codec == VideoCodec::kVp8 ? 0 : 1;
+  const auto pts = static_cast<std::uint32_t>(f.pts);
+  for (int i = 0; i < 4; ++i) out[8 + i] = static_cast<std::uint8_t>(pts >> (8 * i));
+  std::copy(f.data.begin(), f.data.end(), out.begin() + kVideoHeaderBytes);
+  return out;
+}
+
+VideoFrameView unpack_video_frame(std::span<const std::uint8_t> bytes) {
+  if (bytes.size() < kVideoHeaderBytes || std::memcmp(bytes.data(), kMagic, 4) != 0 ||
+      bytes[4] > 1 || bytes[5] > 1) {
+    throw std::runtime_error("not a video frame: no BCV1 header");
+  }
+  VideoFrameView v;
+  v.key = bytes[4] == 1;
+  v.codec = bytes[5] == 0 ? VideoCodec::kVp8 : VideoCodec::kVp9;
+  for (int i = 0; i < 4; ++i) v.pts |= static_cast<std::uint32_t>(bytes[8 + i]) << (8 * i);
+  v.data = bytes.subspan(kVideoHeaderBytes);
+  return v;
+}
+
+}  // namespace beamcast

@@ -1,0 +1,99 @@
+// Video encoding of the preview's moving frames (issue 42): VP8 or VP9 from
+// libvpx with low-latency settings (realtime deadline, no lag, no alt-ref,
+// constant bitrate, a key frame at the start and on request), and a decoder
+// for the tests and the bench. Pure CPU: no GL, no sockets.
+//
+// Frames are converted from RGB to I420 with BT.601 limited-range
+// coefficients, what a browser assumes for VP8/VP9 without colour metadata.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "render/image.hpp"
+
+namespace beamcast {
+
+enum class VideoCodec { kVp8, kVp9 };
+
+// "vp8", "vp9": the wire names.
+std::string_view video_codec_name(VideoCodec c);
+std::optional<VideoCodec> parse_video_codec(std::string_view name);
+
+struct VideoEncoderSettings {
+  VideoCodec codec = VideoCodec::kVp8;
+  int width = 0, height = 0;
+  int bitrate_kbps = 1000;  // the rate control's target
+  int threads = 1;          // libvpx's worker threads
+};
+
+struct EncodedVideoFrame {
+  std::vector<std::uint8_t> data;  // one compressed frame (the codec's bitstream)
+  bool key = false;
+  std::int64_t pts = 0;
+};
+
+class VideoEncoder {
+ public:
+  // Throws std::runtime_error if libvpx refuses the settings.
+  explicit VideoEncoder(const VideoEncoderSettings& settings);
+  ~VideoEncoder();
+  VideoEncoder(const VideoEncoder&) = delete;
+  VideoEncoder& operator=(const VideoEncoder&) = delete;
+
+  // Encodes `img` (the encoder's size; 8- or 16-bit, the high byte is kept)
+  // shown at `time_ms` (any monotonic clock; the rate control spends the
+  // bitrate over the time between frames). The first frame, and one with
+  // `force_key`, is a key frame. Every frame yields one packet (no lag).
+  EncodedVideoFrame encode(const Image& img, double time_ms, bool force_key = false);
+  void set_bitrate(int kbps);
+
+  const VideoEncoderSettings& settings() const { return settings_; }
+  std::int64_t frames() const { return frames_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  VideoEncoderSettings settings_;
+  std::int64_t frames_ = 0;
+  double last_ms_ = 0.0;
+  std::int64_t pts_ms_ = 0;
+};
+
+// Decodes a stream frame by frame into 8-bit RGB (tests and the bench).
+class VideoDecoder {
+ public:
+  explicit VideoDecoder(VideoCodec codec);
+  ~VideoDecoder();
+  VideoDecoder(const VideoDecoder&) = delete;
+  VideoDecoder& operator=(const VideoDecoder&) = delete;
+  // The picture of one compressed frame; throws std::runtime_error on a
+  // corrupt frame or one that yields no picture.
+  Image decode(std::span<const std::uint8_t> frame);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The frame header of the protocol's video frames (PROTOCOL.md, "Video
+// preview"): 12 bytes before the codec's frame: "BCV1", a flags byte (bit 0:
+// key frame), the codec (0 vp8, 1 vp9), two zero bytes, and the frame's
+// number on its stream (pts, uint32 little-endian; 0 at each key frame the
+// stream starts with).
+inline constexpr std::size_t kVideoHeaderBytes = 12;
+std::vector<std::uint8_t> pack_video_frame(const EncodedVideoFrame& f, VideoCodec codec);
+struct VideoFrameView {
+  bool key = false;
+  VideoCodec codec = VideoCodec::kVp8;
+  std::uint32_t pts = 0;
+  std::span<const std::uint8_t> data;
+};
+// Throws std::runtime_error if `bytes` do not start with a valid header.
+VideoFrameView unpack_video_frame(std::span<const std::uint8_t> bytes);
+
+}  // namespace beamcast

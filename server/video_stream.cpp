@@ -1,0 +1,55 @@
+#include "server/video_stream.hpp"
+
+#include <chrono>
+
+#include "protocol/check.hpp"
+#include "protocol/frame_format.hpp"
+
+namespace beamcast {
+
+void note_video_request(VideoStream& stream, const VideoParams& params) {
+  if (params.keyframe) stream.key_pending = true;
+}
+
+VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& params,
+                                    int default_kbps, int width, int height, int bit_depth,
+                                    double time_ms, RenderOutcome* out) {
+  BEAMCAST_CHECK(out->pngs.size() == 1 && out->is_jpeg.size() == 1 && !out->is_jpeg[0],
+                 "a video frame is one raw frame");
+  const auto t0 = std::chrono::steady_clock::now();
+  const VideoCodec codec = parse_video_codec(params.codec).value();
+  const int kbps = params.bitrate_kbps.value_or(default_kbps);
+  Image img;
+  img.width = width;
+  img.height = height;
+  img.bit_depth = bit_depth;
+  img.rgb = decode_raw_frame(out->pngs[0], width, height, bit_depth, FrameFormat::kRaw);
+  VideoEncoder* enc = stream.encoder.get();
+  if (!enc || enc->settings().codec != codec || enc->settings().width != width ||
+      enc->settings().height != height) {
+    stream.encoder = std::make_unique<VideoEncoder>(VideoEncoderSettings{codec, width, height, kbps, 1});
+    enc = stream.encoder.get();
+  }
+  enc->set_bitrate(kbps);
+  const EncodedVideoFrame f = enc->encode(img, time_ms, stream.key_pending);
+  stream.key_pending = false;
+  out->pngs[0] = pack_video_frame(f, codec);
+  VideoFrameReport r;
+  r.codec = params.codec;
+  r.bitrate_kbps = kbps;
+  r.key = f.key;
+  r.pts = static_cast<std::uint32_t>(f.pts);
+  r.encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  out->encode_ms[0] += r.encode_ms;
+  out->encode_wall_ms += r.encode_ms;
+  return r;
+}
+
+void set_video_report(const VideoFrameReport& f, QualityReport* q) {
+  q->format = f.codec;
+  q->jpeg_quality.reset();
+  q->bitrate_kbps = f.bitrate_kbps;
+  q->keyframe = f.key;
+}
+
+}  // namespace beamcast

@@ -1,0 +1,54 @@
+// A connection's video stream (issue 42; PROTOCOL.md, "Video preview"): the
+// moving frames of `quality: "auto"` renders that ask for "video" are encoded
+// by one VP8/VP9 encoder kept across the connection's requests, so each
+// frame is predicted from the previous one. Still frames stay PNG.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "protocol/render_response.hpp"
+#include "protocol/request.hpp"
+#include "render/video.hpp"
+#include "server/render_service.hpp"
+
+namespace beamcast {
+
+struct VideoStream {
+  // Held from a frame's encode to its send, so frames leave in the order the
+  // encoder made them (the order a decoder needs).
+  std::mutex mu;
+  std::unique_ptr<VideoEncoder> encoder;
+  bool key_pending = false;  // a key frame was asked for and not yet sent
+};
+
+struct VideoFrameReport {
+  std::string codec;
+  int bitrate_kbps = 0;
+  bool key = false;
+  std::uint32_t pts = 0;
+  double encode_ms = 0.0;
+};
+
+// Notes a key-frame request of `params` (which may come with a still frame:
+// the next moving frame is then the key frame).
+void note_video_request(VideoStream& stream, const VideoParams& params);
+
+// Encodes the one frame of `out`, raw samples (FrameFormat::kRaw) at
+// `bit_depth`, into `stream` and replaces its bytes with the packed video
+// frame (render/video.hpp: the BCV1 header and the codec's frame). A new
+// encoder, and so a key frame, for the first frame, a new codec and a new
+// frame size; the bitrate is params' or `default_kbps`. The encode time is
+// added to the outcome's encode times (the accuracy controller's frame cost).
+// Call with stream.mu held. Throws std::runtime_error if libvpx fails.
+VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& params,
+                                    int default_kbps, int width, int height, int bit_depth,
+                                    double time_ms, RenderOutcome* out);
+
+// The "quality" block of a video frame: the codec as its format, the
+// stream's bitrate and the key-frame flag in place of a JPEG quality.
+void set_video_report(const VideoFrameReport& f, QualityReport* q);
+
+}  // namespace beamcast
