@@ -340,7 +340,7 @@ def main():
                    "color": [0.35, 0.6, 1.0], "intensity": 1.5, "density": "quadratic"}],
         "occluders": [{"type": "slim", "material": {"type": "diffuse", "albedo": [0.8, 0.55, 0.3]},
                        "spheres": slim_torus(1.2, 0.45, 32, 12)}],
-        "cameras": [camera("view", [0.0, 2.6, 4.2], [0.0, 0.0, 0.0], 384, 384, fov_y=45)],
+        "cameras": [camera("view", [0.0, 2.6, 4.2], [0.0, 0.0, 0.0], 256, 256, fov_y=45)],
     }, ["occluders", 0, "spheres"])
 
 
