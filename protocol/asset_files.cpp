@@ -68,8 +68,13 @@ fs::path resolve_asset_path(const fs::path& assets_dir, const std::string& file,
   std::error_code ec;
   const fs::file_status st = fs::status(full, ec);  // follows links
   if (!fs::exists(st)) {
+    // Where the file must be is the caller's setting, not the client's: say so.
     fail("file_not_found", json_path,
-         kind + " file \"" + file + "\" was not found in the assets directory");
+         kind + " file \"" + file +
+             "\" was not found in the assets directory (beamcast-server reads mesh, SLIM and "
+             "volume files from its --assets directory, examples/ by default: copy the file "
+             "there or restart the server with --assets DIR; `beamcast render` reads them "
+             "beside the scene file, or from --assets DIR)");
   }
   // Symlinks inside the assets directory must not lead out of it (checked
   // before the type: a link out is refused as such, whatever it points to).

@@ -34,6 +34,7 @@ TEST_PACKAGES=(
   python3 python3-numpy python3-matplotlib            # plots and analysis scripts
   nodejs chromium                                     # the preview page's browser test (ctest -L preview)
   haproxy                                             # several servers behind it (deploy/, ctest -L scaleout)
+  curl                                                # POST /v1/render as the guide shows it (cli.first_hour)
 )
 PACKAGES=("${RUN_PACKAGES[@]}")
 if [ "$mode" = test ]; then PACKAGES+=("${TEST_PACKAGES[@]}"); fi

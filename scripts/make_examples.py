@@ -36,6 +36,69 @@ def camera(name, pos, target, w=512, h=512, **extra):
     return cam
 
 
+def quat_from_axes(x, y, z):
+    """[w, x, y, z] of the rotation whose matrix has columns x, y, z
+    (protocol/slim_model.cpp, same pivots)."""
+    m00, m11, m22 = x[0], y[1], z[2]
+    trace = m00 + m11 + m22
+    if trace > 0.0:
+        s = 2.0 * math.sqrt(1.0 + trace)
+        q = [0.25 * s, (y[2] - z[1]) / s, (z[0] - x[2]) / s, (x[1] - y[0]) / s]
+    elif m00 > m11 and m00 > m22:
+        s = 2.0 * math.sqrt(1.0 + m00 - m11 - m22)
+        q = [(y[2] - z[1]) / s, 0.25 * s, (y[0] + x[1]) / s, (z[0] + x[2]) / s]
+    elif m11 > m22:
+        s = 2.0 * math.sqrt(1.0 + m11 - m00 - m22)
+        q = [(z[0] - x[2]) / s, (y[0] + x[1]) / s, 0.25 * s, (z[1] + y[2]) / s]
+    else:
+        s = 2.0 * math.sqrt(1.0 + m22 - m00 - m11)
+        q = [(x[1] - y[0]) / s, (z[0] + x[2]) / s, (z[1] + y[2]) / s, 0.25 * s]
+    n = math.sqrt(sum(c * c for c in q))
+    return [c / n for c in q]
+
+
+def slim_torus(major, minor, nu, nv, support=1.5):
+    """A SLIM torus (axis y) of support spheres, each holding the torus's
+    second-order expansion at its centre (tests/common/slim_shapes.hpp's
+    slim_torus, the same surface): no mesh and no fit needed."""
+    spheres = []
+    spacing = max(2.0 * math.pi * (major + minor) / nu, 2.0 * math.pi * minor / nv)
+    for i in range(nu):
+        theta = 2.0 * math.pi * (i + 0.5) / nu
+        for j in range(nv):
+            phi = 2.0 * math.pi * (j + 0.5) / nv
+            radial = [math.cos(theta), 0.0, math.sin(theta)]
+            n = [math.cos(phi) * radial[0], math.sin(phi), math.cos(phi) * radial[2]]
+            ring_r = major + minor * math.cos(phi)
+            p = [ring_r * radial[0], minor * math.sin(phi), ring_r * radial[2]]
+            ring = [-math.sin(theta), 0.0, math.cos(theta)]
+            tube = cross(n, ring)
+            k_ring = math.cos(phi) / ring_r
+            spheres.append({
+                "center": [round(c, 5) for c in p],
+                "radius": round(support * spacing, 5),
+                "rotation": [round(c, 6) for c in quat_from_axes(ring, tube, n)],
+                "coefficients": [round(-0.5 * k_ring, 6), 0, round(-0.5 / minor, 6), 0, 0, 0]})
+    return spheres
+
+
+def write_compact_list(name, scene, key_path):
+    """As write(), with the list at key_path one element per line (a SLIM
+    model's spheres would take 30 lines each with indent=2)."""
+    marker = "@@LIST@@"
+    parent = scene
+    for k in key_path[:-1]:
+        parent = parent[k]
+    items = parent[key_path[-1]]
+    parent[key_path[-1]] = marker
+    text = json.dumps(scene, indent=2)
+    parent[key_path[-1]] = items
+    lines = ",\n".join("  " + json.dumps(it, separators=(",", ":")) for it in items)
+    with open(os.path.join(OUT, name), "w") as f:
+        f.write(text.replace(json.dumps(marker), "[\n" + lines + "\n]"))
+        f.write("\n")
+
+
 def write(name, scene):
     with open(os.path.join(OUT, name), "w") as f:
         json.dump(scene, f, indent=2)
@@ -268,6 +331,17 @@ def main():
     write("ground_fog.json", dict(stage, media=[
         {"type": "box", "min": [-5.0, 0.0, -5.0], "max": [5.0, 0.8, 5.0],
          "sigma_s": 0.6, "sigma_a": 0.05, "g": 0.3}]))
+    # A SLIM surface that needs no model file (issue 40, item 5): a torus of
+    # 384 support spheres written inline, a beam through its hole.
+    write_compact_list("slim_torus.json", {
+        "background": [0.02, 0.02, 0.03],
+        "light": {"direction": [-0.4, -1.0, -0.5], "intensity": 1.0, "ambient": 0.2},
+        "beams": [{"type": "capsule", "p0": [0.0, -1.8, 0.0], "p1": [0.0, 1.8, 0.0], "radius": 0.3,
+                   "color": [0.35, 0.6, 1.0], "intensity": 1.5, "density": "quadratic"}],
+        "occluders": [{"type": "slim", "material": {"type": "diffuse", "albedo": [0.8, 0.55, 0.3]},
+                       "spheres": slim_torus(1.2, 0.45, 32, 12)}],
+        "cameras": [camera("view", [0.0, 2.6, 4.2], [0.0, 0.0, 0.0], 256, 256, fov_y=45)],
+    }, ["occluders", 0, "spheres"])
 
 
 if __name__ == "__main__":

@@ -42,7 +42,7 @@ bool token_matches(std::string_view presented, std::string_view expected) {
 bool http_request_authorized(const ServerConfig& config, std::string_view path,
                              std::string_view authorization_header) {
   if (!token_required(config)) return true;
-  if (!path.starts_with("/api/") && path != "/metrics") return true;
+  if (!path.starts_with("/api/") && path != "/metrics" && path != "/v1/render") return true;
   constexpr std::string_view kBearer = "Bearer ";
   if (!authorization_header.starts_with(kBearer)) return false;
   return token_matches(authorization_header.substr(kBearer.size()), config.token);

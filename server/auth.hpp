@@ -27,10 +27,11 @@ inline bool token_required(const ServerConfig& config) { return !config.token.em
 // only on the length of the configured token, not on where they differ.
 bool token_matches(std::string_view presented, std::string_view expected);
 
-// The HTTP listener's gate: with a token configured, GET routes that return
-// data (/api/..., /metrics) need "Authorization: Bearer <token>"; the preview
-// page's static files, /health and the WebSocket upgrade (which then goes
-// through hello like TCP) do not. `path` excludes the query string.
+// The HTTP listener's gate: with a token configured, routes that return
+// data or render (/api/..., /metrics, POST /v1/render) need "Authorization:
+// Bearer <token>"; the preview page's static files, /health,
+// /v1/openapi.json and the WebSocket upgrade (which then goes through hello
+// like TCP) do not. `path` excludes the query string.
 bool http_request_authorized(const ServerConfig& config, std::string_view path,
                              std::string_view authorization_header);
 

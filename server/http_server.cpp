@@ -12,6 +12,7 @@
 #include <boost/beast/websocket.hpp>
 #include <boost/beast/websocket/ssl.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <deque>
@@ -42,9 +43,14 @@ namespace http = beast::http;
 namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
 
-// GET requests carry no body; headers beyond this are refused (431/400).
+// Headers beyond this are refused (413). A body may hold up to
+// max_message_bytes (POST /v1/render carries a scene), at least this much.
 constexpr std::size_t kMaxHttpHeaderBytes = 16 * 1024;
 constexpr std::size_t kMaxHttpBodyBytes = 16 * 1024;
+// After refusing a request whose body was not read, up to this much of it is
+// read and dropped before closing, so that the client gets the answer rather
+// than a reset (closing a socket with unread data sends RST).
+constexpr std::size_t kMaxDrainBytes = 64 * 1024 * 1024;
 constexpr auto kHttpIdle = std::chrono::seconds(30);
 // A TLS close_notify exchange on a connection we are closing anyway: short.
 constexpr auto kTlsShutdown = std::chrono::seconds(5);
@@ -63,6 +69,7 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
   std::mutex mu;  // routes and the socket list
   std::map<std::string, Handler, std::less<>> routes;
   std::vector<std::pair<std::string, PrefixHandler>> prefix_routes;
+  std::map<std::string, PostHandler, std::less<>> post_routes;
   std::vector<std::weak_ptr<Connection>> sockets;
   std::optional<asio::ssl::context> tls;  // set before start(); then read-only
 
@@ -96,6 +103,13 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
       return {500, "text/plain; charset=utf-8", std::string("internal error: ") + e.what() + "\n"};
     }
     return {404, "text/plain; charset=utf-8", "not found\n"};
+  }
+
+  PostHandler post_route(std::string_view target) {
+    const std::string_view path = target.substr(0, target.find('?'));
+    std::lock_guard lock(mu);
+    const auto it = post_routes.find(path);
+    return it == post_routes.end() ? PostHandler{} : it->second;
   }
 
   void do_accept();
@@ -326,7 +340,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   void do_read() {
     parser_.emplace();
     parser_->header_limit(kMaxHttpHeaderBytes);
-    parser_->body_limit(kMaxHttpBodyBytes);
+    parser_->body_limit(std::max<std::uint64_t>(kMaxHttpBodyBytes,
+                                                owner_->core.config.max_message_bytes));
     beast::get_lowest_layer(stream_).expires_after(kHttpIdle);
     http::async_read(stream_, buffer_, *parser_,
                      [self = shared_from_this()](beast::error_code ec, std::size_t) {
@@ -336,8 +351,19 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
 
   void on_read(beast::error_code ec) {
     if (ec == http::error::end_of_stream) return shutdown();
-    if (ec == http::error::header_limit || ec == http::error::body_limit) {
+    if (ec == http::error::header_limit) {
       return reply_error(http::status::payload_too_large, "request too large\n");
+    }
+    if (ec == http::error::body_limit) {
+      owner_->core.stats.count_error("message_too_large");
+      return reply_error(http::status::payload_too_large,
+                         error_body(std::string_view(parser_->get().target().data(),
+                                                     parser_->get().target().size()),
+                                    "message_too_large",
+                                    "the request body is over max_message_bytes (" +
+                                        std::to_string(owner_->core.config.max_message_bytes) +
+                                        " bytes)"),
+                         true);
     }
     if (ec && speaks_bcp1()) return reply_wrong_port();
     if (ec) return;  // timeout, reset, malformed: drop the connection
@@ -363,38 +389,99 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
       ws->accept(std::move(req));
       return;
     }
-    if (req.method() != http::verb::get && req.method() != http::verb::head) {
-      return reply_error(http::status::method_not_allowed, "only GET and HEAD\n");
+    const std::string_view target(req.target().data(), req.target().size());
+    const bool post = req.method() == http::verb::post;
+    HttpServer::PostHandler post_handler =
+        post ? owner_->post_route(target) : HttpServer::PostHandler{};
+    if (post && !post_handler) {
+      return reply_error(http::status::method_not_allowed,
+                         error_body(target, "method_not_allowed",
+                                    "POST is for /v1/render; other paths take GET and HEAD"));
+    }
+    if (!post && req.method() != http::verb::get && req.method() != http::verb::head) {
+      return reply_error(http::status::method_not_allowed,
+                         error_body(target, "method_not_allowed",
+                                    "only GET and HEAD (and POST to /v1/render)"));
     }
     {
-      const std::string_view target(req.target().data(), req.target().size());
       const auto auth = req[http::field::authorization];
       if (!http_request_authorized(owner_->core.config, target.substr(0, target.find('?')),
                                    std::string_view(auth.data(), auth.size()))) {
+        owner_->core.stats.count_error("unauthorized");
         return reply_error(http::status::unauthorized,
-                           "this server requires a token: Authorization: Bearer <token>\n");
+                           error_body(target, "unauthorized",
+                                      "this server requires a token: Authorization: Bearer "
+                                      "<token>"));
       }
     }
-    const HttpReply r = owner_->route(std::string_view(req.target().data(), req.target().size()));
+    if (post) {
+      HttpPost p{std::string(target), std::move(req.body()),
+                 std::string(req[http::field::authorization]), std::string(req[http::field::accept])};
+      const unsigned version = req.version();
+      const bool keep_alive = req.keep_alive();
+      post_handler(std::move(p), [self = shared_from_this(), version, keep_alive](HttpReply r) {
+        asio::post(self->stream_.get_executor(), [self, version, keep_alive, r = std::move(r)] {
+          self->write_reply(r, version, keep_alive, false);
+        });
+      });
+      return;
+    }
+    write_reply(owner_->route(target), req.version(), req.keep_alive(),
+                req.method() == http::verb::head);
+  }
+
+  void write_reply(const HttpReply& r, unsigned version, bool keep_alive, bool head) {
     auto res = std::make_shared<http::response<http::string_body>>(
-        static_cast<http::status>(r.status), req.version());
+        static_cast<http::status>(r.status), version);
     res->set(http::field::server, "beamcast-server");
     res->set(http::field::content_type, r.content_type);
     res->set(http::field::cache_control, "no-store");
-    res->keep_alive(req.keep_alive());
-    if (req.method() == http::verb::get) res->body() = r.body;
+    for (const auto& [name, value] : r.headers) res->set(name, value);
+    res->keep_alive(keep_alive);
+    if (!head) res->body() = r.body;
     res->prepare_payload();
-    if (req.method() == http::verb::head) res->content_length(r.body.size());
+    if (head) res->content_length(r.body.size());
     write(res);
   }
 
-  void reply_error(http::status status, std::string text) {
+  // The JSON error body of the /v1/ API (PROTOCOL.md, "HTTP render"); plain
+  // text on the other paths, as before.
+  static HttpReply error_body(std::string_view target, const std::string& code,
+                              const std::string& message) {
+    if (!target.starts_with("/v1/")) return {0, "text/plain; charset=utf-8", message + "\n"};
+    const nlohmann::json j = {{"error", {{"code", code}, {"message", message}, {"path", ""}}}};
+    return {0, "application/json", j.dump()};
+  }
+  void reply_error(http::status status, const HttpReply& body, bool drain = false) {
+    reply_error(status, body.body, drain, body.content_type);
+  }
+
+  // Closes after the reply; `drain`: the request's body was not read, so read
+  // and drop it first (bounded) so that the client sees the reply.
+  void reply_error(http::status status, std::string text, bool drain = false,
+                   const std::string& content_type = "text/plain; charset=utf-8") {
     auto res = std::make_shared<http::response<http::string_body>>(status, 11);
-    res->set(http::field::content_type, "text/plain; charset=utf-8");
+    res->set(http::field::content_type, content_type);
     res->keep_alive(false);
     res->body() = std::move(text);
     res->prepare_payload();
-    write(res);
+    if (!drain || kIsTls<Stream>) return write(res);
+    http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
+      if (ec) return;
+      beast::error_code ignored;
+      beast::get_lowest_layer(self->stream_).socket().shutdown(tcp::socket::shutdown_send, ignored);
+      self->drain(0);
+    });
+  }
+
+  void drain(std::size_t drained) {
+    if (drained > kMaxDrainBytes) return;
+    if (!scratch_) scratch_ = std::make_shared<std::vector<char>>(64 * 1024);
+    beast::get_lowest_layer(stream_).expires_after(kTlsShutdown);
+    beast::get_lowest_layer(stream_).async_read_some(
+        asio::buffer(*scratch_), [self = shared_from_this(), drained](beast::error_code ec, std::size_t n) {
+          if (!ec) self->drain(drained + n);
+        });
   }
 
   // A BCP1 client (`beamcast ping` given this port) sent its frame here: the
@@ -409,7 +496,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   void reply_wrong_port() {
     owner_->core.stats.count_error("wrong_port");
     const ErrorInfo e{"wrong_port",
-                      "this is beamcast-server's HTTP port (the preview page, /metrics, /health); "
+                      "this is beamcast-server's HTTP port (the preview page, POST /v1/render, "
+                      "/metrics, /health); "
                       "the BCP1 protocol is on TCP port " +
                           std::to_string(owner_->core.config.port),
                       ""};
@@ -445,6 +533,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   std::shared_ptr<HttpServer::Impl> owner_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
+  std::shared_ptr<std::vector<char>> scratch_;  // drain()'s buffer
 };
 
 }  // namespace
@@ -473,6 +562,11 @@ HttpServer::~HttpServer() = default;
 void HttpServer::add_get(std::string path, Handler handler) {
   std::lock_guard lock(impl_->mu);
   impl_->routes[std::move(path)] = std::move(handler);
+}
+
+void HttpServer::add_post(std::string path, PostHandler handler) {
+  std::lock_guard lock(impl_->mu);
+  impl_->post_routes[std::move(path)] = std::move(handler);
 }
 
 void HttpServer::add_get_prefix(std::string prefix, PrefixHandler handler) {

@@ -1,6 +1,6 @@
 // The HTTP listener of beamcast-server: GET routes registered by name (the
 // preview page, its scene lists, and whatever else a component adds, e.g.
-// /metrics), and WebSocket connections on /ws that speak the same JSON
+// /metrics), POST routes answered asynchronously (/v1/render), and WebSocket connections on /ws that speak the same JSON
 // requests as the BCP1 TCP protocol (protocol/PROTOCOL.md, "WebSocket").
 // Optionally TLS (HTTPS/WSS) with enable_tls(); the BCP1 port stays plain.
 //
@@ -12,6 +12,8 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include <boost/asio/io_context.hpp>
 
@@ -20,9 +22,22 @@ namespace beamcast {
 struct ServerCore;
 
 struct HttpReply {
+  HttpReply() = default;
+  HttpReply(int s, std::string type, std::string text,
+            std::vector<std::pair<std::string, std::string>> extra = {})
+      : status(s), content_type(std::move(type)), body(std::move(text)), headers(std::move(extra)) {}
   int status = 200;
   std::string content_type = "text/plain; charset=utf-8";
   std::string body;
+  std::vector<std::pair<std::string, std::string>> headers;  // extra response headers
+};
+
+// What a POST handler sees of its request.
+struct HttpPost {
+  std::string target;  // path and query string
+  std::string body;    // at most max_message_bytes
+  std::string authorization;
+  std::string accept;
 };
 
 class HttpServer {
@@ -30,6 +45,9 @@ class HttpServer {
   using Handler = std::function<HttpReply()>;
   // Gets the rest of the path after the prefix (already checked to be non-empty).
   using PrefixHandler = std::function<HttpReply(std::string_view rest)>;
+  // Answers by calling `reply` once, from any thread; the connection reads
+  // its next request only after that reply has been written.
+  using PostHandler = std::function<void(HttpPost request, std::function<void(HttpReply)> reply)>;
 
   HttpServer(boost::asio::io_context& io, ServerCore& core);
   ~HttpServer();
@@ -41,6 +59,9 @@ class HttpServer {
   void add_get(std::string path, Handler handler);
   // Every path that starts with `prefix` (e.g. "/api/examples/") and has more after it.
   void add_get_prefix(std::string prefix, PrefixHandler handler);
+  // Exact path for POST (the query string is ignored when matching). A POST
+  // body may hold up to max_message_bytes; GET routes answer only POST's 405.
+  void add_post(std::string path, PostHandler handler);
 
   // Serves HTTPS and WSS instead of HTTP and WS (call before start()). Loads
   // a PEM certificate chain and its PEM private key; throws std::runtime_error

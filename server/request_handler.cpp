@@ -487,9 +487,13 @@ void run_method(ServerCore& core, const std::shared_ptr<Connection>& session, Re
 
 }  // namespace
 
-bool handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
-                    std::string_view json_text, Clock::time_point arrived,
-                    std::function<void()> resume) {
+namespace {
+
+// handle_message and handle_request: `read` gives the request (parsing it,
+// which may throw) and sets the id to echo.
+bool handle_read(ServerCore& core, const std::shared_ptr<Connection>& session,
+                 const std::function<Request(json*)>& read, Clock::time_point arrived,
+                 std::function<void()> resume) {
   // Time spent here is not the client's (MessageClock).
   struct HandlingTime {
     ServerCore& core;
@@ -503,7 +507,7 @@ bool handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
   std::string method = "(invalid)";  // metrics key: a known method or a fixed placeholder
   std::optional<Request> load;       // handled on core.loaders
   answering_errors(core, *session, id, method, [&] {
-    Request req = parse_request(json_text, &id, core.config.json_limits);
+    Request req = read(&id);
     // Count unknown methods under one key: client-chosen strings must not grow the map.
     const bool known = is_request_method(req.method);
     method = known ? req.method : "(unknown)";
@@ -534,6 +538,28 @@ bool handle_message(ServerCore& core, const std::shared_ptr<Connection>& session
     resume();
   });
   return false;
+}
+
+}  // namespace
+
+bool handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
+                    std::string_view json_text, Clock::time_point arrived,
+                    std::function<void()> resume) {
+  return handle_read(
+      core, session,
+      [&](json* id) { return parse_request(json_text, id, core.config.json_limits); }, arrived,
+      std::move(resume));
+}
+
+bool handle_request(ServerCore& core, const std::shared_ptr<Connection>& session, Request request,
+                    Clock::time_point arrived, std::function<void()> resume) {
+  return handle_read(
+      core, session,
+      [&](json* id) {
+        *id = request.id;
+        return std::move(request);
+      },
+      arrived, std::move(resume));
 }
 
 }  // namespace beamcast

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string_view>
 
+#include "protocol/request.hpp"
 #include "server/server_core.hpp"
 
 namespace beamcast {
@@ -21,6 +22,12 @@ class Connection;
 // order while the network thread serves other connections.
 bool handle_message(ServerCore& core, const std::shared_ptr<Connection>& session,
                     std::string_view json_text, std::chrono::steady_clock::time_point arrived,
+                    std::function<void()> resume = {});
+
+// As handle_message, for a request already parsed (POST /v1/render: the
+// HTTP body is the params).
+bool handle_request(ServerCore& core, const std::shared_ptr<Connection>& session, Request request,
+                    std::chrono::steady_clock::time_point arrived,
                     std::function<void()> resume = {});
 
 // Reserves a message's estimated memory against max_request_memory_bytes

@@ -17,6 +17,7 @@
 #include "protocol/request.hpp"
 #include "server/threads.hpp"
 #include "server/auth.hpp"
+#include "server/http_render.hpp"
 #include "server/memory.hpp"
 #include "server/session.hpp"
 
@@ -39,6 +40,7 @@ Server::Server(const ServerConfig& config, RendererFactory renderers)
   }
   register_preview_routes(*http_, core_);
   register_metrics_routes(*http_, core_);
+  register_http_render_routes(*http_, core_);
 }
 
 Server::~Server() {

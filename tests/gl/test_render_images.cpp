@@ -24,6 +24,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "protocol/scene_json.hpp"
@@ -65,6 +66,14 @@ constexpr Tolerance kDefault{1e-3, 1e-3};
 // channels over 2 levels; at 16 samples a voxel without jitter the relative
 // L1 is 3.8e-5: the error is the step's).
 constexpr Tolerance kVolumes{0.02, 0.02};
+// Scenes with SLIM occluders (examples/slim_torus.json): the GPU's patch
+// evaluation decides a silhouette pixel by its footprint, the reference by
+// its centre ray (tests/gl/test_slim.cpp measures coverage, depth and
+// normals apart from the outline), and the supports' seams shade a few
+// levels apart (docs/slim.md: normals within 1 degree for 99% of pixels).
+// Measured on slim_torus at 256x256, llvmpipe: relative L1 0.049, 6.9% of
+// channels over 2 levels (most of those over 20 are outline pixels).
+constexpr Tolerance kSlim{0.08, 0.10};
 
 // Every scene in examples/ (a new example gets this test without a line here).
 std::vector<std::string> example_names() {
@@ -84,7 +93,11 @@ class ExampleImage : public ::testing::TestWithParam<std::string> {};
 TEST_P(ExampleImage, GpuMatchesCpuReference) {
   const std::string& example = GetParam();
   Scene scene = load_example(example);
-  const Tolerance tol = scene.volumes.empty() ? kDefault : kVolumes;
+  const bool slim =
+      std::any_of(scene.occluders.begin(), scene.occluders.end(), [](const Occluder& o) {
+        return std::holds_alternative<SlimOccluder>(o.shape);
+      });
+  const Tolerance tol = !scene.volumes.empty() ? kVolumes : slim ? kSlim : kDefault;
   // This compares the directional-light path (pass "surfaces") with the
   // beam reference; lit examples are compared with the path tracer in
   // test_gi.cpp and by `beamcast bench gi`, so their lights are removed here.

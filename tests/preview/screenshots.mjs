@@ -1,6 +1,6 @@
 // The preview's screenshots in docs/img/preview/ (not a test; run by hand
 // after a change to the page):
-//   tests/preview/run.sh screenshots.mjs --server build/server/beamcast-server [--out docs/img/preview]
+//   tests/preview/run.sh screenshots.mjs --server build/bin/beamcast-server [--out docs/img/preview] [--only slim]
 // For each scene: the first (full-accuracy) frame, the view after a drag
 // across half the canvas, and after the reset key; and the page's error for
 // an unknown scene. The view (canvas and overlay) only, at 256x256.
@@ -17,8 +17,11 @@ const opt = (name, def) => {
 const serverBin = opt('server');
 const out = opt('out', 'docs/img/preview');
 const size = 256;
+// --only NAME[,NAME]: these scenes only (and no unknown-scene shot).
+const only = opt('only', '');
 const scenes = [['demo', 'demo'], ['cornell_box', 'cornell_box'], ['fog', 'fog_stage'],
-                ['volume', 'volume_ml256']];
+                ['volume', 'volume_ml256'], ['slim', 'slim_torus']]
+                   .filter(([name]) => !only || only.split(',').includes(name));
 requireChromium();
 fs.mkdirSync(out, {recursive: true});
 const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'beamcast-shots-'));
@@ -46,10 +49,12 @@ try {
     await stillAfter(page, t2, 120000);
     await shot(`${name}_reset`);
   }
-  await page.setViewportSize({width: 720, height: 420});
-  await page.goto(`${server.url}?scene=nope&size=${size}`);
-  await page.locator('#error').waitFor({state: 'visible'});
-  await page.screenshot({path: path.join(out, 'unknown_scene.png')});
+  if (!only) {
+    await page.setViewportSize({width: 720, height: 420});
+    await page.goto(`${server.url}?scene=nope&size=${size}`);
+    await page.locator('#error').waitFor({state: 'visible'});
+    await page.screenshot({path: path.join(out, 'unknown_scene.png')});
+  }
 } finally {
   await context.close();
   server.proc.removeAllListeners('exit');

@@ -12,8 +12,11 @@ Checks, each on something the issue found wrong:
   --camera; frames named after the scene without --out; CPU reference
   progress; curl on the TCP port gets an HTTP answer naming the HTTP port, and
   ping on the HTTP port an error naming the TCP port; help texts; the run
-  and test package sets of scripts/install-deps.sh.
-Frames are 32x32 or smaller: about 6 s in all on 2 cores.
+  and test package sets of scripts/install-deps.sh; curl POSTs
+  examples/cornell_box.json to /v1/render (with the token; 401 without it; a
+  bad scene 400 with its path).
+Frames are 32x32 or smaller but the Cornell box (512x512, about 2 s): about
+8 s in all on 2 cores.
 """
 import os
 import socket
@@ -168,6 +171,31 @@ def main():
         rc, out, err = run("ping", "--server", f"127.0.0.1:{http_port}", "-c", "1", environ=no_token)
         check("ping on the HTTP port: an error naming the TCP port",
               rc != 0 and "HTTP port" in err and f"TCP port {port}" in err, err)
+
+        # POST /v1/render with curl, the guide's command (issue 40's must-show),
+        # with the server's token; without it 401; a bad scene 400 with its path.
+        url = f"http://127.0.0.1:{http_port}/v1/render"
+        cornell = os.path.join(ROOT, "examples", "cornell_box.json")
+        with tempfile.TemporaryDirectory() as d:
+            x_png = os.path.join(d, "x.png")
+            p = subprocess.run(["curl", "-sf", "-H", f"Authorization: Bearer {TOKEN}", "--data-binary",
+                                f"@{cornell}", url, "-o", x_png], capture_output=True, timeout=120)
+            check("curl -sf --data-binary @examples/cornell_box.json .../v1/render -o x.png",
+                  p.returncode == 0 and png_size(x_png) == (512, 512), (p.returncode, png_size(x_png)))
+        p = subprocess.run(["curl", "-s", "-w", "\n%{http_code}", "--data-binary", f"@{cornell}", url],
+                           capture_output=True, text=True, timeout=60)
+        check("curl without the token: 401 and the JSON error",
+              p.stdout.endswith("\n401") and '"code":"unauthorized"' in p.stdout, p.stdout)
+        p = subprocess.run(["curl", "-s", "-w", "\n%{http_code}", "-H", f"Authorization: Bearer {TOKEN}",
+                            "--data-binary", '{"beams": [{"type": "sphere", "radius": -1}]}', url],
+                           capture_output=True, text=True, timeout=60)
+        check("curl with a bad scene: 400, the code and the path into the body",
+              p.stdout.endswith("\n400") and '"path":"/beams/0/radius"' in p.stdout, p.stdout)
+        p = subprocess.run(["curl", "-s", "-w", "\n%{http_code}", "-H", f"Authorization: Bearer {TOKEN}",
+                            "--data-binary", '{"scene_id": "nope"}', url],
+                           capture_output=True, text=True, timeout=60)
+        check("curl with an unknown scene id: 404 unknown_scene",
+              p.stdout.endswith("\n404") and "unknown_scene" in p.stdout, p.stdout)
     finally:
         proc.terminate()
         proc.wait(timeout=30)

@@ -18,6 +18,7 @@
 #include "render/jpeg.hpp"
 #include "render/video.hpp"
 #include "server/server.hpp"
+#include "tests/server/http_test_server.hpp"
 
 namespace beamcast {
 namespace {
@@ -29,43 +30,8 @@ namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
 using nlohmann::json;
 
-class HttpTestServer {
- public:
-  explicit HttpTestServer(ServerConfig c = {}) {
-    c.port = 0;
-    c.http_port = 0;
-    c.assets_dir = std::filesystem::path(BEAMCAST_SOURCE_DIR) / "examples";
-    server_ = std::make_unique<Server>(c, gl_renderer_factory({}));
-    server_->http().add_get("/extra", [] { return HttpReply{200, "text/plain", "extra route\n"}; });
-    server_->start();
-    thread_ = std::thread([this] { server_->run(false); });
-  }
-  ~HttpTestServer() {
-    server_->shutdown();
-    thread_.join();
-  }
-  unsigned short http_port() const { return server_->http_port(); }
-  ServerCore& core() { return server_->core(); }
-
- private:
-  std::unique_ptr<Server> server_;
-  std::thread thread_;
-};
-
-http::response<http::string_body> get(unsigned short port, const std::string& target,
-                                      http::verb verb = http::verb::get) {
-  asio::io_context io;
-  beast::tcp_stream stream(io);
-  stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-  http::request<http::string_body> req{verb, target, 11};
-  req.set(http::field::host, "127.0.0.1");
-  http::write(stream, req);
-  beast::flat_buffer buf;
-  http::response_parser<http::string_body> parser;
-  parser.skip(verb == http::verb::head);  // a HEAD response has a length but no body
-  http::read(stream, buf, parser);
-  return parser.release();
-}
+using test::get;
+using test::HttpTestServer;
 
 // A WebSocket client speaking the protocol: one text message per request; a
 // response with attachments is followed by one binary message.
