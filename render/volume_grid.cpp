@@ -132,10 +132,14 @@ VolumeGridResources::VolumeGridResources(const VolumeGridBins& bins)
     side >>= 1;
     ++levels_;
   }
+  // Storage for the whole chain (a mipmap filter samples a complete
+  // texture), of which only the first levels_ are exact averages and read.
+  int chain = 1;
+  for (int n = std::max({d[0], d[1], d[2]}); n > 1; n >>= 1) ++chain;
   GLuint id = 0;
   glCreateTextures(GL_TEXTURE_3D, 1, &id);
   texture_ = GlTexture(id);
-  glTextureStorage3D(id, levels_, GL_RGBA32F, d[0], d[1], d[2]);
+  glTextureStorage3D(id, chain, GL_RGBA32F, d[0], d[1], d[2]);
   glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   // Outside the grid nothing: the border cells' light fades over the half
@@ -145,7 +149,6 @@ VolumeGridResources::VolumeGridResources(const VolumeGridBins& bins)
   }
   const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   glTextureParameterfv(id, GL_TEXTURE_BORDER_COLOR, zero);
-  glTextureParameteri(id, GL_TEXTURE_MAX_LEVEL, levels_ - 1);
   gl_check("volume grid upload");
 }
 
