@@ -376,13 +376,13 @@ TEST(Medium, MeshRegionsAttenuateSurfacesExactly) {
 }
 
 // examples/beam_fog.json: glowing beams that emit light into the fog (their
-// photons scatter in it like a lamp's): the volume photon pass runs, and the
+// photons scatter in it like a lamp's): the volume photon pass (the grid) runs, and the
 // frame's mean matches the path tracer's (its beams added on top, as the
 // GPU's) within 5%, the bound of the stage above.
 TEST(Medium, EmittingBeamsLightTheFogAroundThem) {
   const Scene scene = example_at("beam_fog.json", 48);
   const std::vector<std::string> passes = plan_passes(scene);
-  EXPECT_NE(std::find(passes.begin(), passes.end(), "volume_photons"), passes.end());
+  EXPECT_NE(std::find(passes.begin(), passes.end(), "volume_grid"), passes.end());
   const double want = image_mean(path_traced(scene));
   const double got =
       image_mean(renderer().render(scene, FrameOptions{.read_hdr = true})[0].hdr);
