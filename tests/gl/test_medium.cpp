@@ -186,9 +186,12 @@ TEST(Medium, TheFogStageMatchesThePathTracer) {
 // dropped) keeps the image's mean within 2% (at 128^2: 0.952 of the
 // reference against 0.958 without LOD; what is lost is the coarse cells'
 // light spread behind the walls, where the march stops) while the frame
-// changes.
+// changes (here: mean 1.011, rel L1 0.40 to the frame without LOD). Without
+// the stage's surfaces (the spot in open fog), so that
+// the frame is the grid's alone (gi.lod thins the surface photons too).
 TEST(Medium, GridLodKeepsTheLight) {
-  Scene scene = example_at("fog_stage.json", 64);
+  Scene scene = example_at("fog_stage.json", 48);
+  scene.occluders.clear();
   ASSERT_EQ(scene.medium->estimator, VolumeEstimator::kGrid);
   const auto render = [&] {
     return renderer().render(scene, FrameOptions{.read_hdr = true})[0].hdr;
