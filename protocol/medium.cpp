@@ -464,7 +464,9 @@ Medium parse_medium(const Node& n) {
   if (auto v = o.optional("beam_step")) m.beam_step = check_closed(*v, read_number(*v), 0.05, 8.0);
   if (auto v = o.optional("estimator")) {
     m.estimator = read_enum<VolumeEstimator>(
-        *v, {{"beam", VolumeEstimator::kBeam}, {"seed", VolumeEstimator::kSeed}});
+        *v, {{"grid", VolumeEstimator::kGrid},
+             {"beam", VolumeEstimator::kBeam},
+             {"seed", VolumeEstimator::kSeed}});
   }
   if (auto v = o.optional("radius")) m.radius = check_closed(*v, read_number(*v), 0.0, 1e6);
   // At most 256: far past where the error stops falling (docs/media.md).

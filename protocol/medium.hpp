@@ -48,6 +48,13 @@ enum class VolumeEstimator : unsigned char {
   // ray nearest to it, attenuated from there to the eye, over the disk of
   // radius r about the photon facing the camera.
   kSeed,
+  // No splats (issue 39, item 5): the photons binned into a world-space
+  // grid each frame (their phase towards the eye summed per cell, a
+  // compute pass), and each pixel's view ray marched through it
+  // (trilinear), attenuated exactly per step (pass "volume_grid",
+  // render/volume_grid.hpp). Costs photons + pixels x steps, not photons x
+  // covered pixels.
+  kGrid,
 };
 
 struct Medium {
@@ -62,7 +69,7 @@ struct Medium {
   // are split into ceil(depth / beam_step) sub-pieces, at most
   // kMaxBeamSubPieces); the error falls as beam_step^4 (docs/media.md).
   double beam_step = 1.0;
-  VolumeEstimator estimator = VolumeEstimator::kBeam;
+  VolumeEstimator estimator = VolumeEstimator::kGrid;
   // The volume photons' kernel radius; 0: about 50 photons per kernel sphere
   // for the stored photons spread evenly through the scene's bounding box
   // (default_volume_radius, gi/photon_map.hpp).

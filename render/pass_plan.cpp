@@ -28,6 +28,11 @@ bool shadow_mapped_direct(const Scene& scene) {
          scene.gi.direct == DirectLightMethod::kShadowMaps;
 }
 
+// The volume photons' light by the grid (medium.estimator "grid"), not splats.
+bool grid_estimate(const Scene& scene) {
+  return scene.medium.value_or(Medium{}).estimator == VolumeEstimator::kGrid;
+}
+
 }  // namespace
 
 bool interleaves_direct(const Scene& scene) {
@@ -185,9 +190,17 @@ const std::vector<PassDecl>& pass_catalog() {
       // (render/medium_pass.hpp; medium.estimator picks the estimate).
       {PassId::kVolumePhotons, "volume_photons",
        [](const PlanInput& in) {
-         return in.scene.has_gi() && in.scene.medium_scatters();
+         return in.scene.has_gi() && in.scene.medium_scatters() && !grid_estimate(in.scene);
        },
        {"hdr"}, {"view_depth"}, {"hdr"}, {"volume_photons"}},
+      // The same light without splats (medium.estimator "grid", the
+      // default; render/volume_grid.hpp): the volume photons binned into a
+      // world grid each frame (compute), each pixel's ray marched through it.
+      {PassId::kVolumeGrid, "volume_grid",
+       [](const PlanInput& in) {
+         return in.scene.has_gi() && in.scene.medium_scatters() && grid_estimate(in.scene);
+       },
+       {"hdr"}, {"view_depth"}, {"hdr"}, {"volume_grid"}},
       // Scalar volumes (seed 004; render/volume_pass.hpp): each ray cast up
       // to the nearest surface and composited over hdr, farther volumes
       // first; with beams in the scene, the same pass also writes the

@@ -42,6 +42,7 @@ enum class PassId {
   kSpecular,
   kMedium,
   kVolumePhotons,
+  kVolumeGrid,
   kVolumes,
   kVolumesForBeams,
   kBeams,

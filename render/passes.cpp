@@ -11,6 +11,7 @@
 
 #include "gi/photon_map.hpp"
 #include "render/medium_pass.hpp"
+#include "render/volume_grid.hpp"
 #include "render/slim_pass.hpp"
 #include "render/specular_pass.hpp"
 #include "render/volume_pass.hpp"
@@ -809,6 +810,8 @@ std::unique_ptr<Pass> make_pass(PassId id) {
       return make_medium_pass();
     case PassId::kVolumePhotons:
       return make_volume_photon_pass();
+    case PassId::kVolumeGrid:
+      return make_volume_grid_pass();
     case PassId::kVolumes:
     case PassId::kVolumesForBeams:
       return make_volume_pass();

@@ -1,5 +1,7 @@
 #include "render/scene_resources.hpp"
 
+#include "protocol/scene_bounds.hpp"
+
 #include <chrono>
 
 #include <algorithm>
@@ -156,6 +158,10 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
     if (!photons)
       throw GlError("the plan splats volume photons but the renderer has no photon cache");
     upload_volume_photons(*photons);
+  }
+  if (plan.uploads_group("volume_grid")) {
+    if (!photons) throw GlError("the plan bins volume photons but the renderer has no photon cache");
+    upload_volume_grid(*photons);
   }
   if (plan.uploads_group("shadows")) upload_direct();
   if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene);
@@ -329,16 +335,37 @@ void SceneResources::upload_volume_photons(PhotonCache& cache) {
     glNamedBufferStorage(id, static_cast<GLsizeiptr>(data.size() * sizeof(VolumeData)),
                          data.data(), 0);
   }
-  // The drawn share (gi.display_fraction) sets the default radius, as for the surface maps.
-  const double share = display_share(scene_.gi.display_fraction);
-  const auto drawn = std::max<std::int64_t>(
-      1, std::llround(share * static_cast<double>(maps_->volume.size())));
-  volume_radius_ = scene_.medium && scene_.medium->radius > 0.0
-                       ? scene_.medium->radius
-                       : default_volume_radius(scene_, drawn);
+  volume_radius_ = volume_kernel_radius(maps_->volume.size());
   photon_upload_ms_ +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   gl_check("upload volume photons");
+}
+
+double SceneResources::volume_kernel_radius(std::size_t stored) const {
+  // The drawn share (gi.display_fraction) sets the default radius, as for the surface maps.
+  const double share = display_share(scene_.gi.display_fraction);
+  const auto drawn =
+      std::max<std::int64_t>(1, std::llround(share * static_cast<double>(stored)));
+  return scene_.medium && scene_.medium->radius > 0.0 ? scene_.medium->radius
+                                                      : default_volume_radius(scene_, drawn);
+}
+
+void SceneResources::upload_volume_grid(PhotonCache& cache) {
+  const auto t0 = std::chrono::steady_clock::now();
+  double traced_ms = 0.0;
+  if (!maps_) {
+    bool traced = false;
+    maps_ = cache.get(scene_, &traced);
+    traced_ms = traced ? maps_->trace_ms : 0.0;
+    photon_trace_ms_ += traced_ms;
+  }
+  volume_radius_ = volume_kernel_radius(maps_->volume.size());
+  volume_count_ = static_cast<GLsizei>(maps_->volume.size());  // reported; no splat buffer
+  volume_grid_ = std::make_unique<VolumeGridResources>(
+      bin_volume_photons(maps_->volume, scene_.medium_field(), volume_radius_, scene_box(scene_)));
+  photon_upload_ms_ +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() -
+      traced_ms;
 }
 
 void SceneResources::upload_direct() {

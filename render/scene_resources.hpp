@@ -19,6 +19,7 @@
 #include "render/lut.hpp"
 #include "render/pass_plan.hpp"
 #include "render/slim_pass.hpp"
+#include "render/volume_grid.hpp"
 #include "render/volume_pass.hpp"
 
 namespace beamcast {
@@ -105,6 +106,9 @@ class SceneResources {
   GLsizei volume_count() const { return volume_count_; }
   const Vec3& volume_anchor() const { return volume_anchor_; }
   double volume_radius() const { return volume_radius_; }
+  // The same photons binned into a world grid (group "volume_grid",
+  // render/volume_grid.hpp); null without that group.
+  const VolumeGridResources* volume_grid() const { return volume_grid_.get(); }
   // Direct light (group "shadows"): the lights' DirectPoints, each with its
   // light's flux folded in, positions relative to direct_anchor(); the key
   // names the geometry and points the shadow maps are rendered for.
@@ -155,6 +159,10 @@ class SceneResources {
   void upload_occluders();
   void upload_photons(PhotonCache& cache, bool skip_direct);
   void upload_volume_photons(PhotonCache& cache);
+  void upload_volume_grid(PhotonCache& cache);
+  // The volume photons' kernel radius: medium.radius or the default for
+  // the drawn share of `stored` photons.
+  double volume_kernel_radius(std::size_t stored) const;
   void upload_direct();
   GlBuffer direct_ssbo_;
   GlBuffer medium_tri_ssbo_;
@@ -176,6 +184,7 @@ class SceneResources {
   GLsizei volume_count_ = 0;
   Vec3 volume_anchor_{};
   double volume_radius_ = 1.0;
+  std::unique_ptr<VolumeGridResources> volume_grid_;
   std::unique_ptr<SlimResources> slim_;
   std::unique_ptr<VolumeResources> volumes_;
   std::unique_ptr<GiScene> gi_scene_;

@@ -41,7 +41,8 @@ def main():
         gpu, render = float(r["gpu_ms"] or 0), float(r["render_ms"] or 0)
         # render_ms holds the GPU passes; 0.05 ms covers the two roundings to 0.01 ms.
         check(f"{n}: 0 < GPU ms <= render ms", 0 < gpu <= render + 0.05, f"gpu {gpu}, render {render}")
-    photon = {"photons", "gi_resolve", "direct", "gbuffer", "volume_photons"}
+    photon = {"photons", "gi_resolve", "direct", "gbuffer", "volume_photons",
+              "volume_grid"}
     check("beams: only beam passes", "beams" in passes.get("beams", set()) and
           not passes.get("beams", set()) & (photon | {"volumes"}), str(passes.get("beams")))
     check("gi: photon passes, no beam pass", {"photons", "gi_resolve"} <= passes.get("gi", set()) and

@@ -67,11 +67,23 @@ TEST(Medium, TheMediumPassIsPlannedOnlyWhenSomethingAttenuates) {
   // Volume photons: only a lit scene whose medium scatters.
   json lit = fogged({{"sigma_s", 0.1}});
   lit["lights"] = {{{"type", "point"}, {"position", {0, 3, 0}}, {"power", 10}}};
-  const auto has_volume_pass = [](const json& j) {
+  const auto has_pass = [](const json& j, const char* name) {
     const std::vector<std::string> p = plan_passes(parse_scene(j, {}));
-    return std::find(p.begin(), p.end(), "volume_photons") != p.end();
+    return std::find(p.begin(), p.end(), name) != p.end();
+  };
+  const auto has_volume_pass = [&](const json& j) {
+    return has_pass(j, "volume_photons") || has_pass(j, "volume_grid");
   };
   EXPECT_TRUE(has_volume_pass(lit));
+  // The grid (the default) or the splats (medium.estimator "beam", "seed"), never both.
+  EXPECT_TRUE(has_pass(lit, "volume_grid"));
+  EXPECT_FALSE(has_pass(lit, "volume_photons"));
+  for (const char* splats : {"beam", "seed"}) {
+    json s = lit;
+    s["medium"]["estimator"] = splats;
+    EXPECT_TRUE(has_pass(s, "volume_photons")) << splats;
+    EXPECT_FALSE(has_pass(s, "volume_grid")) << splats;
+  }
   lit["medium"] = {{"sigma_a", 0.1}};
   EXPECT_FALSE(has_volume_pass(lit));
   EXPECT_FALSE(has_volume_pass(fogged({{"sigma_s", 0.1}})));
@@ -177,7 +189,7 @@ TEST(Medium, BadFieldsAreRefusedWithTheirPath) {
       {{{"sigma_s", "thick"}}, "wrong_type", "/medium/sigma_s"},
       {{{"beam_rule", "simpson"}}, "invalid_value", "/medium/beam_rule"},
       {{{"beam_step", 0.0}}, "out_of_range", "/medium/beam_step"},
-      {{{"estimator", "grid"}}, "invalid_value", "/medium/estimator"},
+      {{{"estimator", "froxel"}}, "invalid_value", "/medium/estimator"},
       {{{"radius", -1.0}}, "out_of_range", "/medium/radius"},
       {{{"segments", 257}}, "out_of_range", "/medium/segments"},
       {{{"segments", -1}}, "out_of_range", "/medium/segments"},
