@@ -325,9 +325,11 @@ void RenderService::charge_locked(const Task& task, double ms) {
 }
 
 // The next slice: the first class with queued work that is not held
-// (interactive before batch); in it, the connection that has used the least
-// render time (ClassQueue::used; ties in turn order); of that connection's
-// tasks, the oldest. The connection then goes to the back of the turns.
+// (interactive before batch); in it, the connection whose next slice would
+// finish first in render time: its start (the render time it has used,
+// ClassQueue::used, or the clock) plus the slice's estimated cost (ties in
+// turn order), so a cheap render passes a costly one queued at the same
+// start; of that connection's tasks, the oldest. The connection then goes to the back of the turns.
 // A task's first slice is preceded by a check for photon tracing
 // (Pick::check), which holds its connection until the worker answers.
 RenderService::Pick RenderService::pick_locked(std::unique_lock<std::mutex>& lock) {
@@ -344,20 +346,25 @@ RenderService::Pick RenderService::pick_locked(std::unique_lock<std::mutex>& loc
     // the first in turn order goes (equal costs take plain turns whatever
     // the timing noise).
     std::vector<double> starts(q->turns.size(), std::numeric_limits<double>::infinity());
+    std::vector<double> finishes(q->turns.size(), std::numeric_limits<double>::infinity());
     double least = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < q->turns.size(); ++i) {
       const auto queued = q->by_client.find(q->turns[i]);
       BEAMCAST_CHECK(queued != q->by_client.end() && !queued->second.empty(),
                      "a connection in the turns has queued work");
-      if (queued->second.front()->held) continue;
+      const Task& next = *queued->second.front();
+      if (next.held) continue;
       const auto used = q->used.find(q->turns[i]);
       starts[i] = std::max(q->vtime, used == q->used.end() ? 0.0 : used->second);
-      least = std::min(least, starts[i]);
+      const std::size_t cameras =
+          next.next_slice < next.slices.size() ? next.slices[next.next_slice].size() : 1;
+      finishes[i] = starts[i] + next.cost_per_camera * static_cast<double>(cameras);
+      least = std::min(least, finishes[i]);
     }
-    const auto at = std::find_if(starts.begin(), starts.end(),
+    const auto at = std::find_if(finishes.begin(), finishes.end(),
                                  [&](double v) { return v <= least + kTurnQuantumMs; });
-    const auto best = static_cast<std::size_t>(at - starts.begin());
-    const double best_start = *at;
+    const auto best = static_cast<std::size_t>(at - finishes.begin());
+    const double best_start = starts[best];
     const std::uint64_t client = q->turns[best];
     auto it = q->by_client.find(client);
     TaskPtr task = it->second.front();
@@ -426,6 +433,7 @@ void RenderService::after_check(const TaskPtr& task, bool trace) {
     std::lock_guard lock(mu_);
     if (trace && !stopping_) {
       trace_queue_.push_back(task);
+      ++traces_in_flight_;
     } else {
       task->held = false;
     }
@@ -482,6 +490,7 @@ void RenderService::trace_for(Task& task) {
   task.options.photon_maps = std::move(maps);
   task.prep_error = error;
   task.held = false;
+  --traces_in_flight_;
   charge_locked(task, ms);
 }
 
@@ -523,6 +532,9 @@ void RenderService::worker_main(int index) {
       const auto woken = [&] { return stopping_ || has_work_locked(); };
       if (!released &&
           !cv_.wait_for(lock, std::chrono::milliseconds(idle_release_ms_.load()), woken)) {
+        // Not idle while photons are traced for a queued render: its
+        // slices come next and use what this renderer holds.
+        if (traces_in_flight_ > 0) continue;
         // Idle: the caches go (server/memory.hpp, kIdleReleaseMs), then
         // the heap pages they held.
         lock.unlock();
@@ -833,6 +845,13 @@ void RenderService::slices_finished(const TaskPtr& t, std::size_t slice, std::si
 // Every slice is finished: each member job gets its outcome.
 void RenderService::complete(Task& task) {
   const auto now = Clock::now();
+  // Every slice has rendered: the maps traced for it (trace_for) are the
+  // renderer's cache's now, or dropped, but not held by a finished task that
+  // an encode or a connection may keep alive a while.
+  {
+    std::lock_guard lock(mu_);
+    task.options.photon_maps.reset();
+  }
   for (std::size_t m = 0; m < task.members.size(); ++m) {
     RenderJob& job = task.members[m];
     RenderOutcome out;

@@ -290,6 +290,7 @@ class RenderService {
   std::atomic<std::int64_t> idle_release_ms_;
   std::atomic<std::uint64_t> idle_releases_{0};
   std::atomic<std::uint64_t> idle_rebuilds_{0};
+  std::size_t traces_in_flight_ = 0;  // queued or tracing on the pool; guarded by mu_
   std::atomic<std::uint64_t> photon_traces_{0};
   std::atomic<std::uint64_t> photon_traces_cancelled_{0};
   // The lowest RSS after an idle release; set by wait_ready to the size at

@@ -107,6 +107,12 @@ TEST(PassPlan, EveryCatalogPassIsReachable) {
   Scene quad = scene_with(false, true, true);
   quad.lights[0].shape = QuadLight{};
   for (const auto& n : make_plan(PlanInput{quad}).names()) seen.push_back(n);
+  // The fog's photon splats: the volume estimates other than the default grid.
+  for (VolumeEstimator est : {VolumeEstimator::kBeam, VolumeEstimator::kSeed}) {
+    Scene fog = scene_with(false, true, true, false, false, true);
+    fog.medium->estimator = est;
+    for (const auto& n : make_plan(PlanInput{fog}).names()) seen.push_back(n);
+  }
   for (const PassDecl& p : pass_catalog()) {
     EXPECT_NE(std::find(seen.begin(), seen.end(), p.name), seen.end()) << p.name;
     EXPECT_FALSE(p.writes.empty()) << p.name;
