@@ -106,7 +106,8 @@ struct GiSettings {
   // over the occluders, a BVH of their triangles and the photons in hashed
   // grids; render/specular_gpu.hpp) or the CPU (Embree and kd-trees,
   // gi/photon_gather.hpp, the reference the GPU's is tested against).
-  // Scenes the GPU tracer does not cover (SLIM occluders, a medium) are
+  // Scenes the GPU tracer does not cover (SLIM occluders, a medium and,
+  // for now, direct light from shadow maps: gpu_traces_specular) are
   // traced on the CPU whatever this says.
   SpecularTracer specular_tracer = SpecularTracer::kGpu;
   // Photons are splatted at 1/splat_scale of the render size per side, then
