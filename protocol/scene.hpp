@@ -72,6 +72,7 @@ enum class SplatKernel { kBox, kCone, kEpanechnikov };
 // Who carries direct light (light -> diffuse surface): the raster pass
 // "direct" (shadow-mapped point emitters, no splat noise) or the photons.
 enum class DirectLightMethod { kShadowMaps, kPhotons };
+enum class SpecularTracer { kGpu, kCpu };
 struct GiSettings {
   std::int64_t photons = 100000;          // emitted for the global map
   std::int64_t caustic_photons = 100000;  // emitted for the caustic map (with specular surfaces)
@@ -101,6 +102,14 @@ struct GiSettings {
   // pixel, their radiance averaged (the reflections' and refractions' edges
   // and the light seen in them, as the reference's pixel average does).
   int specular_samples = 2;
+  // Who follows those rays (gi.specular_tracer): the GPU (a compute pass
+  // over the occluders, a BVH of their triangles and the photons in hashed
+  // grids; render/specular_gpu.hpp) or the CPU (Embree and kd-trees,
+  // gi/photon_gather.hpp, the reference the GPU's is tested against).
+  // Scenes the GPU tracer does not cover (SLIM occluders, a medium and,
+  // for now, direct light from shadow maps: gpu_traces_specular) are
+  // traced on the CPU whatever this says.
+  SpecularTracer specular_tracer = SpecularTracer::kGpu;
   // Photons are splatted at 1/splat_scale of the render size per side, then
   // brought back by a surface-aware upsampling (pass gi_resolve) of values
   // each corrected at its own splat pixel (the edge correction); on the

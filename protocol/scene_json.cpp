@@ -335,7 +335,8 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   o.allow_only({"photons", "caustic_photons", "radius", "kernel", "seed", "max_depth", "direct",
                 "direct_samples", "direct_interleave", "shadow_size", "edge_correction",
                 "splat_scale", "cluster",
-                "light_antialias", "caustic_radius", "specular_samples", "lod"});
+                "light_antialias", "caustic_radius", "specular_samples", "specular_tracer",
+                "lod"});
   GiSettings g;
   std::int64_t total = 0;
   auto count = [&](const Node& v) {
@@ -410,6 +411,10 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   if (auto v = o.optional("splat_scale")) g.splat_scale = read_int_in(*v, 0, 8);
   if (auto v = o.optional("cluster")) g.cluster = check_closed(*v, read_number(*v), 0.0, 1.0);
   if (auto v = o.optional("specular_samples")) g.specular_samples = read_int_in(*v, 1, 8);
+  if (auto v = o.optional("specular_tracer")) {
+    g.specular_tracer = read_enum<SpecularTracer>(
+        *v, {{"gpu", SpecularTracer::kGpu}, {"cpu", SpecularTracer::kCpu}});
+  }
   if (auto v = o.optional("lod")) {
     ObjectReader lod(*v, "photon level of detail");
     lod.allow_only({"near", "far", "groups"});

@@ -171,8 +171,12 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
     if (!photons)
       throw GlError("the plan traces specular rays but the renderer has no photon cache");
     if (!maps_) maps_ = photons->get(scene);
-    gi_scene_ = std::make_unique<GiScene>(scene);
-    photon_gather_ = photons->gather(maps_, plan.uploads_group("shadows"));
+    if (scene.gi.specular_tracer == SpecularTracer::kGpu && gpu_traces_specular(scene)) {
+      specular_gpu_ = std::make_unique<SpecularGpu>(scene, *maps_, plan.uploads_group("shadows"));
+    } else {
+      gi_scene_ = std::make_unique<GiScene>(scene);
+      photon_gather_ = photons->gather(maps_, plan.uploads_group("shadows"));
+    }
   }
   GLuint id = 0;
   glCreateBuffers(1, &id);

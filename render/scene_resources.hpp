@@ -19,6 +19,7 @@
 #include "render/lut.hpp"
 #include "render/pass_plan.hpp"
 #include "render/slim_pass.hpp"
+#include "render/specular_gpu.hpp"
 #include "render/volume_grid.hpp"
 #include "render/volume_pass.hpp"
 
@@ -127,6 +128,9 @@ class SceneResources {
   // photon maps' search structures; null without the group.
   const GiScene* gi_scene() const { return gi_scene_.get(); }
   const PhotonGather* photon_gather() const { return photon_gather_.get(); }
+  // The same on the GPU (render/specular_gpu.hpp), instead of the two
+  // above, with gi.specular_tracer "gpu" where gpu_traces_specular.
+  const SpecularGpu* specular_gpu() const { return specular_gpu_.get(); }
   // The mesh regions' triangles (Scene::media), world space, three vec4 per
   // triangle in the regions' order, for shaders/medium_regions.glsl; 0
   // without mesh regions.
@@ -189,6 +193,7 @@ class SceneResources {
   std::unique_ptr<VolumeResources> volumes_;
   std::unique_ptr<GiScene> gi_scene_;
   std::shared_ptr<const PhotonGather> photon_gather_;
+  std::unique_ptr<SpecularGpu> specular_gpu_;
   // The per-camera data of bind_camera, written to `out` (for bind_views).
   void fill_camera(const Camera& cam, const CameraBasis& basis, void* block) const;
   void fill_beams(const Camera& cam, const CameraBasis& basis, void* beams) const;

@@ -7,6 +7,7 @@
 #include "protocol/camera.hpp"
 #include "render/passes.hpp"
 #include "render/gl_validate.hpp"
+#include "render/specular_gpu.hpp"
 
 namespace beamcast {
 
@@ -16,6 +17,52 @@ class SpecularPass final : public Pass {
  public:
   SpecularPass() : program_("specular_add") {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
+    if (const SpecularGpu* gpu = ctx.resources.specular_gpu()) {
+      trace_on_gpu(ctx, *gpu);
+    } else {
+      trace_on_cpu(ctx);
+    }
+    glUseProgram(program_.get(ctx.views > 0));
+    glBindTextureUnit(0, ctx.targets.texture("specular"));
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_DEPTH_TEST);
+    glBindVertexArray(ctx.empty_vao);
+    for_each_view(ctx, self, program_, [] { draw_arrays(GL_TRIANGLES, 0, 3); });
+    glDisable(GL_BLEND);
+    gl_check("specular pass");
+  }
+
+ private:
+  // shaders/specular_trace.comp into the "specular" target, each view its
+  // layer (render/specular_gpu.hpp).
+  void trace_on_gpu(FrameContext& ctx, const SpecularGpu& gpu) {
+    const bool multi = ctx.views > 0;
+    ProgramPair& trace = lazy_.get("specular_trace");
+    const GLuint program = trace.get(multi);
+    glUseProgram(program);
+    gpu.bind(program);
+    glUniform1i(trace.uniform(multi, "u_samples"), ctx.scene.gi.specular_samples);
+    glBindTextureUnit(0, ctx.targets.texture("gb_albedo"));
+    glBindImageTexture(0, ctx.targets.texture("specular"), 0, multi ? GL_TRUE : GL_FALSE, 0,
+                       GL_WRITE_ONLY, GL_RGBA32F);
+    const GLint eye = trace.uniform(multi, "u_eye");
+    const int views = multi ? ctx.views : 1;
+    for (int v = 0; v < views; ++v) {
+      const Camera& cam = multi ? (*ctx.view_cameras)[static_cast<std::size_t>(v)] : ctx.camera;
+      const Vec3 e = view_eye(ctx, multi ? v : -1) - gpu.anchor();
+      glUniform3f(eye, static_cast<float>(e[0]), static_cast<float>(e[1]), static_cast<float>(e[2]));
+      if (multi) glUniform1i(trace.uniform(true, "u_view"), v);
+      dispatch_compute(static_cast<GLuint>((cam.width + 7) / 8),
+                       static_cast<GLuint>((cam.height + 7) / 8), 1);
+    }
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    gl_check("specular pass: tracing on the GPU");
+  }
+
+  void trace_on_cpu(FrameContext& ctx) {
     const GiScene* surfaces = ctx.resources.gi_scene();
     const PhotonGather* gather = ctx.resources.photon_gather();
     if (!surfaces || !gather)
@@ -64,20 +111,10 @@ class SpecularPass final : public Pass {
         glTextureSubImage2D(out_tex, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, out.data());
       }
     }
-    glUseProgram(program_.get(multi));
-    glBindTextureUnit(0, out_tex);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    glBlendEquation(GL_FUNC_ADD);
-    glDisable(GL_DEPTH_TEST);
-    glBindVertexArray(ctx.empty_vao);
-    for_each_view(ctx, self, program_, [] { draw_arrays(GL_TRIANGLES, 0, 3); });
-    glDisable(GL_BLEND);
-    gl_check("specular pass");
   }
 
- private:
   ProgramPair program_;
+  LazyPrograms lazy_;  // specular_trace, built when a scene is traced on the GPU
 };
 
 }  // namespace
