@@ -413,7 +413,9 @@ GiSettings parse_gi(const Node& n, const SceneLimits& limits) {
   if (auto v = o.optional("specular_samples")) g.specular_samples = read_int_in(*v, 1, 8);
   if (auto v = o.optional("specular_tracer")) {
     g.specular_tracer = read_enum<SpecularTracer>(
-        *v, {{"gpu", SpecularTracer::kGpu}, {"cpu", SpecularTracer::kCpu}});
+        *v, {{"auto", SpecularTracer::kAuto},
+             {"gpu", SpecularTracer::kGpu},
+             {"cpu", SpecularTracer::kCpu}});
   }
   if (auto v = o.optional("lod")) {
     ObjectReader lod(*v, "photon level of detail");

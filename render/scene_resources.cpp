@@ -143,6 +143,19 @@ class VertexSink final : public TriangleSink {
 
 }  // namespace
 
+namespace {
+
+// Whether the current context's GL is a software rasterizer (Mesa's
+// llvmpipe or softpipe): gi.specular_tracer "auto" keeps the CPU tracer
+// there (docs/performance.md, "Caustics on the GPU").
+bool software_gl() {
+  const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const std::string s = name != nullptr ? name : "";
+  return s.find("llvmpipe") != std::string::npos || s.find("softpipe") != std::string::npos;
+}
+
+}  // namespace
+
 SceneResources::SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan,
                                PhotonCache* photons, VolumeTextureCache* volumes)
     : scene_(scene) {
@@ -171,7 +184,10 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
     if (!photons)
       throw GlError("the plan traces specular rays but the renderer has no photon cache");
     if (!maps_) maps_ = photons->get(scene);
-    if (scene.gi.specular_tracer == SpecularTracer::kGpu && gpu_traces_specular(scene)) {
+    const SpecularTracer tracer = scene.gi.specular_tracer;
+    const bool gpu = tracer == SpecularTracer::kGpu ||
+                     (tracer == SpecularTracer::kAuto && !software_gl());
+    if (gpu && gpu_traces_specular(scene)) {
       specular_gpu_ = std::make_unique<SpecularGpu>(scene, *maps_, plan.uploads_group("shadows"));
     } else {
       gi_scene_ = std::make_unique<GiScene>(scene);

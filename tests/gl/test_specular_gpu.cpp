@@ -131,7 +131,8 @@ json mirror_room(int size) {
          {"height", size}}}}};
 }
 
-// The GPU tracer is what a frame uses by default, "cpu" selects Embree, and
+// By default ("auto") a frame uses the GPU tracer on a hardware GL and Embree
+// on llvmpipe; "gpu" selects the GPU tracer, "cpu" Embree, and
 // a scene it does not cover (a medium; for now direct light from shadow
 // maps) falls back to the CPU.
 TEST(SpecularGpu, TheSettingPicksTheTracer) {
@@ -146,6 +147,13 @@ TEST(SpecularGpu, TheSettingPicksTheTracer) {
     auto r = std::make_unique<SceneResources>(scene, tables, plan, &cache);
     return std::pair<bool, bool>{r->specular_gpu() != nullptr, r->gi_scene() != nullptr};
   };
+  // "auto" (the default): the CPU on a software rasterizer, the GPU on a
+  // hardware one.
+  const std::string& gl_name = context->gl_renderer();
+  const bool software = gl_name.find("llvmpipe") != std::string::npos ||
+                        gl_name.find("softpipe") != std::string::npos;
+  EXPECT_EQ(resources(j), std::make_pair(!software, software)) << gl_name;
+  j["gi"]["specular_tracer"] = "gpu";
   EXPECT_EQ(resources(j), std::make_pair(true, false));
   j["gi"]["specular_tracer"] = "cpu";
   EXPECT_EQ(resources(j), std::make_pair(false, true));
