@@ -217,7 +217,7 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
     upload_volume_photons(*photons);
   }
   if (plan.uploads_group("shadows")) upload_direct();
-  if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene);
+  if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene, content);
   if (plan.uploads_group("volumes")) volumes_ = std::make_unique<VolumeResources>(scene, volumes);
   upload_medium_meshes();
   if (plan.uploads_group("specular")) {

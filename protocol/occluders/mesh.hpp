@@ -32,8 +32,8 @@ struct MeshOccluder {
                                        double t_max) const;
 };
 
-// Two 64-bit hashes (std::hash over the bytes, seeded apart) of the
-// vertices' and triangles' bytes, and their counts.
+// The counts of vertices and triangles and a 64-bit hash (std::hash over
+// the bytes) of each.
 std::string mesh_content_key(const MeshOccluder& mesh);
 
 }  // namespace beamcast
