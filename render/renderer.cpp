@@ -606,13 +606,6 @@ bool Renderer::needs_photon_trace(const Scene& scene, const FrameOptions& opts) 
 std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<Camera>& cameras,
                                           const FrameOptions& opts) {
   const EglContext::Current current(*impl_->context);
-  // Maps traced before the render are taken by the photon cache in place of
-  // tracing; offered for this call only.
-  struct Offer {
-    PhotonCache& cache;
-    ~Offer() { cache.offer({}, nullptr); }
-  } offer{impl_->photons};
-  if (opts.photon_maps) impl_->photons.offer(photon_key(scene), opts.photon_maps);
   const int k = scene.output.supersample;
   // Supersampled: every camera at k times the size, its HDR box-filtered
   // back and tone-mapped here (render/image.hpp's tone_map, the same curve
@@ -648,6 +641,14 @@ std::uint64_t Renderer::submit(const Scene& scene, const std::vector<Camera>& ca
                                const FrameOptions& opts, bool supersample) {
   const EglContext::Current current(*impl_->context);
   Impl& m = *impl_;
+  // Maps traced before the render (FrameOptions::photon_maps) are taken by
+  // the photon cache in place of tracing; offered for this call only. Every
+  // render, render() included, uploads its photons here.
+  struct Offer {
+    PhotonCache& cache;
+    ~Offer() { cache.offer({}, nullptr); }
+  } offer{m.photons};
+  if (opts.photon_maps) m.photons.offer(photon_key(scene), opts.photon_maps);
   const std::uint64_t ticket = m.next_ticket++;
   auto sub = std::make_unique<SubmittedRender>();
   SubmittedRender& r = *sub;
