@@ -64,6 +64,7 @@ class GlFrameRenderer final : public FrameRenderer {
   std::vector<FrameResult> finish(std::uint64_t ticket) override {
     return renderer_.finish(ticket);
   }
+  bool overlaps() const override { return true; }
   void fail_next_render_for_test() override { renderer_.fail_next_render_for_test(); }
   bool needs_photon_trace(const Scene& scene, const FrameOptions& options) override {
     return renderer_.needs_photon_trace(scene, options);
@@ -439,6 +440,7 @@ void RenderService::after_check(const TaskPtr& task, bool trace) {
     std::lock_guard lock(mu_);
     if (trace && !stopping_) {
       trace_queue_.push_back(task);
+      ++traces_in_flight_;
     } else {
       task->held = false;
     }
@@ -495,6 +497,7 @@ void RenderService::trace_for(Task& task) {
   task.options.photon_maps = std::move(maps);
   task.prep_error = error;
   task.held = false;
+  --traces_in_flight_;
   charge_locked(task, ms);
 }
 
@@ -531,8 +534,8 @@ void RenderService::worker_main(int index) {
   bool released = true;  // nothing rendered since the last idle release
   // The slice submitted last, its frames not yet taken (FrameRenderer::finish):
   // it is finished after the next slice is submitted when more work is
-  // queued, so its GPU work and read-back overlap that submission; at once
-  // otherwise.
+  // queued and the renderer overlaps (FrameRenderer::overlaps), so its GPU
+  // work and read-back overlap that submission; at once otherwise.
   std::optional<SubmittedSlice> pending;
   // After the failed job is answered: the old context goes before the new
   // one is made current on this thread. A worker whose rebuild fails tries
@@ -564,6 +567,9 @@ void RenderService::worker_main(int index) {
       const auto woken = [&] { return stopping_ || has_work_locked(); };
       if (!released &&
           !cv_.wait_for(lock, std::chrono::milliseconds(idle_release_ms_.load()), woken)) {
+        // Not idle while a job's photons are traced for it (Task::held):
+        // its render follows, with what the release would drop.
+        if (traces_in_flight_ > 0) continue;
         // Idle: the caches go (server/memory.hpp, kIdleReleaseMs), then
         // the heap pages they held.
         lock.unlock();
@@ -627,8 +633,9 @@ void RenderService::worker_main(int index) {
       end_slice(*pending, renderer.get(), index, &gl_failed);
       pending.reset();
     }
-    if (next && gl_failed) {
-      // The context goes: what was submitted on it is finished first.
+    if (next && (gl_failed || !renderer->overlaps())) {
+      // The context goes: what was submitted on it is finished first. Or
+      // the renderer rendered in submit(): nothing to overlap.
       end_slice(*next, renderer.get(), index, &gl_failed);
       next.reset();
     }
@@ -1117,6 +1124,7 @@ void RenderService::stop() {
   {
     std::lock_guard lock(mu_);
     tracers_stopping_ = true;
+    traces_in_flight_ -= static_cast<int>(trace_queue_.size());
     trace_queue_.clear();
   }
   trace_cv_.notify_all();

@@ -64,6 +64,11 @@ class FrameRenderer {
     done_[ticket] = render(scene, cameras, options);
     return ticket;
   }
+  // Whether submit() returns with the frames still in flight (a GPU's work
+  // and read-back), so that finishing the slice after the next submission
+  // overlaps them; false (the default): submit() renders, and each slice is
+  // finished at once (a later submission would only hold its frames back).
+  virtual bool overlaps() const { return false; }
   virtual std::vector<FrameResult> finish(std::uint64_t ticket) {
     const auto it = done_.find(ticket);
     if (it == done_.end()) throw std::logic_error("finish: unknown ticket");
@@ -378,6 +383,7 @@ class RenderService {
   // tracers (kPhotonTracers, each tracing with the cores less one).
   std::deque<TaskPtr> trace_queue_;  // guarded by mu_
   bool tracers_stopping_ = false;    // guarded by mu_
+  int traces_in_flight_ = 0;         // queued or tracing; guarded by mu_
   std::condition_variable trace_cv_;
   std::vector<SizedThread> tracers_;
   std::mutex encode_mu_;
