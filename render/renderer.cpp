@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "protocol/camera.hpp"
+#include "protocol/cancel.hpp"
 #include "render/gl_util.hpp"
 #include "render/gl_validate.hpp"
 #include "render/passes.hpp"
@@ -38,23 +39,42 @@ void split_views(const T* src, int w, int h, std::size_t first, std::size_t view
   }
 }
 
-// A multi-view batch whose read-back was issued into a pixel buffer object
-// and fenced, but not yet mapped: it is finished (fence waited, PBO mapped,
-// views split into frames) after the next batch's passes are submitted, so
-// on a GPU that renders asynchronously the transfer of batch k overlaps the
-// draws of batch k+1. Lives only inside one Renderer::render call.
+// How long finishing a read-back waits for the GPU before it gives up (a
+// device that has not finished a frame in this time has hung or been
+// lost): the wait is made in steps of kFenceStepNs, between which a
+// cancelled render (deadline, shutdown) stops waiting.
+constexpr double kFenceLimitMs = 120'000.0;
+constexpr GLuint64 kFenceStepNs = 50'000'000;  // 50 ms
+
+// A render submitted by Renderer::submit: its plan and frames, filled in as
+// its read-backs complete.
+struct SubmittedRender {
+  FramePlan plan;
+  std::vector<FrameResult> frames;
+  std::vector<int> batch_of;  // each frame's batch, in render order
+};
+
+// A read-back queued into a pixel buffer object with a fence after a frame's
+// or multi-view batch's passes, not yet mapped. It is completed (fence
+// waited, buffer mapped, views split into their frames) only when its slot
+// is needed again or its render is finished, so the wait overlaps whatever
+// was submitted since: the next camera or batch of the same render, or the
+// next render.
 struct PendingReadback {
+  SubmittedRender* render = nullptr;
   std::vector<std::size_t> idx;  // frames of the batch
   int w = 0, h = 0;
   bool wide = false;  // 16-bit channels
-  int slot = 0;       // PBO and timestamp-query set
   GLsync fence = nullptr;
   double submit_ms = 0.0;  // CPU time issuing the passes and the read-back
   PendingReadback() = default;
   PendingReadback(const PendingReadback&) = delete;
   PendingReadback& operator=(const PendingReadback&) = delete;
-  ~PendingReadback() {
+  ~PendingReadback() { clear(); }
+  void clear() {
     if (fence) glDeleteSync(fence);
+    fence = nullptr;
+    render = nullptr;
   }
 };
 
@@ -64,22 +84,29 @@ struct Renderer::Impl {
   TableCache tables;
   PhotonCache photons;  // photon maps by what they depend on (gi/photon_cache.hpp)
   VolumeTextureCache volumes;  // volume textures across frames (render/volume_pass.hpp)
+  SceneGpuCache scene_cache;   // uploads of scene content across renders
   FrameTargets targets;
   FrameTargets layered;  // multi-view batches
   GlVertexArray empty_vao;
   // Timestamps (frame start, then one after each pass), one set per read-back
-  // slot: a batch's set is read after the next batch has written the other.
+  // slot: a slot's set is read when its read-back completes, before the slot
+  // is used again.
   std::array<std::vector<GlQuery>, 2> query_sets;
-  // Double-buffered pixel pack buffers of multi-view batches, by slot.
+  // Double-buffered pixel pack buffers and their read-backs in flight, by slot.
   std::array<GlBuffer, 2> pbos;
   std::array<std::size_t, 2> pbo_bytes{};
+  std::array<PendingReadback, 2> in_flight;
   int next_slot = 0;
-  bool software_rasterizer = false;  // Readback::kAuto reads synchronously there
+  // Submitted renders not yet finished, by ticket.
+  std::map<std::uint64_t, std::unique_ptr<SubmittedRender>> submitted;
+  std::uint64_t next_ticket = 1;
   int max_layers = 0;
   bool fail_next = false;  // fail_next_render_for_test()
 
   explicit Impl(const RendererOptions& opts)
-      : context(EglContext::create(opts.egl)), tables(opts.table_cache_entries) {
+      : context(EglContext::create(opts.egl)),
+        tables(opts.table_cache_entries),
+        scene_cache(opts.scene_cache_bytes) {
     const EglContext::Current current(*context);
     // One executor per catalog pass: a declaration the renderer cannot run is
     // an error here, not a pass silently missing from frames.
@@ -96,10 +123,6 @@ struct Renderer::Impl {
     // near to far.
     glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
-    const auto* gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    const std::string name = gl_renderer ? gl_renderer : "";
-    software_rasterizer = name.find("llvmpipe") != std::string::npos ||
-                          name.find("softpipe") != std::string::npos;
     gl_check("renderer setup");
   }
 
@@ -138,10 +161,26 @@ struct Renderer::Impl {
     return t;
   }
 
-  FrameResult render_camera(const Scene& scene, const Camera& full_cam, SceneResources& res,
-                            const FramePlan& plan, const FrameOptions& opts) {
+  // The next read-back slot, its earlier read-back completed first (its
+  // timestamp queries and pixel buffer are about to be reused).
+  int take_slot() {
+    const int slot = next_slot;
+    next_slot ^= 1;
+    complete_slot(slot);
+    return slot;
+  }
+
+  // Whether `queue` asks for the synchronous read (completed as soon as issued).
+  static bool synchronous(const FrameOptions& opts) {
+    return opts.readback == Readback::kSynchronous;
+  }
+
+  void render_camera(const Scene& scene, const Camera& full_cam, SceneResources& res,
+                     SubmittedRender& sub, std::size_t index, const FrameOptions& opts) {
     const auto wall0 = std::chrono::steady_clock::now();
-    FrameResult result;
+    const FramePlan& plan = sub.plan;
+    const int slot = take_slot();
+    FrameResult& result = sub.frames[index];
     // A scaled frame renders a smaller copy of the camera (same view, fewer pixels).
     Camera small = full_cam;
     if (PlanInput{scene, opts.resolution_scale}.scaled()) {
@@ -158,37 +197,24 @@ struct Renderer::Impl {
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, res.camera_buffer());
     FrameContext ctx{scene,           plan, cam, basis, res, targets, empty_vao.get(), 0,
                      full_cam.width, full_cam.height, {}};
-    run_passes(scene, ctx, query_sets[0]);
+    run_passes(scene, ctx, query_sets[static_cast<std::size_t>(slot)]);
     if (res.slim() && !res.slim()->slots().empty()) result.slim_points = res.slim()->slots()[0];
-    const double submit_ms = ms_since(wall0);
 
-    // Read-back (synchronous: it waits for the GPU to finish the frame).
-    const auto rb0 = std::chrono::steady_clock::now();
-    const int w = full_cam.width, h = full_cam.height;
-    result.image.width = w;
-    result.image.height = h;
-    result.image.bit_depth = scene.output.bit_depth;
-    result.image.rgb.resize(3 * static_cast<std::size_t>(w) * h);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
     // The last pass's framebuffer holds the final target at attachment 0.
+    const bool wide = scene.output.bit_depth == 16;
+    const int w = full_cam.width, h = full_cam.height;
+    const std::size_t bytes = 3 * static_cast<std::size_t>(w) * h * (wide ? 2 : 1);
+    bind_pack_buffer(slot, bytes);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, targets.fbo(*plan.passes.back(), -1));
-    if (scene.output.bit_depth == 16) {
-      glReadnPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_SHORT,
-                    static_cast<GLsizei>(result.image.rgb.size() * 2), result.image.rgb.data());
-    } else {
-      std::vector<std::uint8_t> bytes(result.image.rgb.size());
-      glReadnPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, static_cast<GLsizei>(bytes.size()),
-                    bytes.data());
-      std::copy(bytes.begin(), bytes.end(), result.image.rgb.begin());
-    }
-    gl_check("glReadnPixels(output)");
-    result.readback_ms = ms_since(rb0);
-    // GL rows run bottom-up; images run top-down.
-    const std::size_t row = 3 * static_cast<std::size_t>(w);
-    for (int y = 0; y < h / 2; ++y) {
-      std::swap_ranges(result.image.rgb.begin() + y * row, result.image.rgb.begin() + (y + 1) * row,
-                       result.image.rgb.begin() + (h - 1 - y) * row);
-    }
+    // With a pack buffer bound, the pointer argument is an offset into it.
+    glReadnPixels(0, 0, w, h, GL_RGB, wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE,
+                  static_cast<GLsizei>(bytes), nullptr);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    gl_check("glReadnPixels(output into PBO)");
+    fence_slot(slot, sub, {index}, w, h, wide, wall0);
+    if (!synchronous(opts) && !opts.read_hdr && opts.read_targets.empty()) return;
+    complete_slot(slot);
+
     if (opts.read_hdr) {
       // The HDR buffer stays at the render size.
       const int hw = cam.width, hh = cam.height;
@@ -221,27 +247,18 @@ struct Renderer::Impl {
         std::memcpy(&out[y * trow], &buf[(th - 1 - y) * trow], trow * sizeof(float));
       }
     }
-    result.batch = read_timings(plan, query_sets[0]);
-    result.batch.submit_ms = submit_ms;
-    result.passes = result.batch.passes;
-    result.gpu_ms = result.batch.gpu_ms;
-    result.wall_ms = ms_since(wall0);
-    result.batch.readback_ms = result.readback_ms;
-    result.batch.readback_wait_ms = result.readback_ms;  // not split on this path
-    result.batch.wall_ms = result.wall_ms;
-    return result;
   }
 
   // Renders cameras[idx[0..]] (all one size) in one multi-view pass set and
-  // reads every view back: pipelined, issues the read-back into
-  // a pixel pack buffer with a fence (`out`), completed by finish_batch();
-  // otherwise reads synchronously. With read_hdr the batch is finished at once
-  // (the HDR read-back stays synchronous).
+  // queues every view's read-back into a pixel pack buffer with a fence
+  // (completed later by complete_slot); Readback::kSynchronous reads into
+  // client memory at once instead. With read_hdr the batch is completed at
+  // once (the HDR read-back is synchronous).
   void render_batch(const Scene& scene, const std::vector<Camera>& cameras,
                     const std::vector<std::size_t>& idx, SceneResources& res,
-                    const FramePlan& plan, const FrameOptions& opts,
-                    std::vector<FrameResult>& frames, PendingReadback& out) {
+                    SubmittedRender& sub, const FrameOptions& opts) {
     const auto wall0 = std::chrono::steady_clock::now();
+    const FramePlan& plan = sub.plan;
     const std::size_t k = idx.size();
     std::vector<Camera> cams;
     std::vector<CameraBasis> bases;
@@ -250,8 +267,7 @@ struct Renderer::Impl {
       bases.push_back(camera_basis(cameras[i]));
     }
     const int w = cams[0].width, h = cams[0].height;
-    const int slot = next_slot;
-    next_slot ^= 1;
+    const int slot = take_slot();
     res.bind_views(cams, bases, kMaxBatchViews);
     layered.ensure(plan, w, h, w, h, scene.output.bit_depth, static_cast<int>(k));
     glViewport(0, 0, w, h);
@@ -264,27 +280,33 @@ struct Renderer::Impl {
     run_passes(scene, ctx, query_sets[static_cast<std::size_t>(slot)]);
 
     const bool wide = scene.output.bit_depth == 16;
-    const bool pipelined = opts.readback == Readback::kPipelined ||
-                           (opts.readback == Readback::kAuto && !software_rasterizer);
-    if (pipelined) {
-      issue_batch(plan, idx, w, h, wide, slot, wall0, out);
+    if (synchronous(opts)) {
+      read_batch_now(plan, sub.frames, idx, w, h, wide, slot, ms_since(wall0));
     } else {
-      read_batch_now(plan, frames, idx, w, h, wide, slot, ms_since(wall0));
+      const std::size_t bytes = 3 * static_cast<std::size_t>(w) * h * k * (wide ? 2 : 1);
+      bind_pack_buffer(slot, bytes);
+      // With a pack buffer bound, the pointer argument is an offset into it.
+      glGetTextureImage(layered.texture(plan.final_target), 0, GL_RGB,
+                        wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE, static_cast<GLsizei>(bytes),
+                        nullptr);
+      glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+      gl_check("glGetTextureImage(output layers into PBO)");
+      fence_slot(slot, sub, idx, w, h, wide, wall0);
     }
     if (opts.read_hdr) {
-      finish_batch(plan, frames, out);
+      complete_slot(slot);
       std::vector<float> all(3 * static_cast<std::size_t>(w) * h * k);
       glGetTextureImage(layered.texture("hdr"), 0, GL_RGB, GL_FLOAT,
                         static_cast<GLsizei>(all.size() * sizeof(float)), all.data());
       gl_check("glGetTextureImage(hdr layers)");
       for (std::size_t v = 0; v < k; ++v) {
-        HdrImage& hdr = frames[idx[v]].hdr;
+        HdrImage& hdr = sub.frames[idx[v]].hdr;
         hdr.width = w;
         hdr.height = h;
         hdr.rgb.resize(3 * static_cast<std::size_t>(w) * h);
       }
       split_views(all.data(), w, h, 0, k,
-                  [&](std::size_t v) { return frames[idx[v]].hdr.rgb.data(); });
+                  [&](std::size_t v) { return sub.frames[idx[v]].hdr.rgb.data(); });
     }
   }
 
@@ -300,8 +322,9 @@ struct Renderer::Impl {
     }
   }
 
-  // The synchronous read-back (Readback::kSynchronous): glGetTextureImage into
-  // client memory waits for the passes, then transfers every layer.
+  // The synchronous read-back of a batch (Readback::kSynchronous):
+  // glGetTextureImage into client memory waits for the passes, then
+  // transfers every layer.
   void read_batch_now(const FramePlan& plan, std::vector<FrameResult>& frames,
                       const std::vector<std::size_t>& idx, int w, int h, bool wide, int slot,
                       double submit_ms) {
@@ -330,59 +353,74 @@ struct Renderer::Impl {
     set_batch_timing(plan, frames, idx, slot, submit_ms, wait_ms, readback_ms - wait_ms);
   }
 
-  // The pipelined read-back: every layer into this slot's PBO (queued after
-  // the passes, so no wait here; the next batch's draws into the same layered
-  // targets are ordered after it by GL's command order), then a fence.
-  void issue_batch(const FramePlan& plan, const std::vector<std::size_t>& idx, int w, int h,
-                   bool wide, int slot, std::chrono::steady_clock::time_point wall0,
-                   PendingReadback& out) {
-    const std::size_t k = idx.size();
-    const std::size_t bytes = 3 * static_cast<std::size_t>(w) * h * k * (wide ? 2 : 1);
-    GlBuffer& pbo = pbos[static_cast<std::size_t>(slot)];
-    if (!pbo.get() || pbo_bytes[static_cast<std::size_t>(slot)] < bytes) {
+  // Binds the slot's pixel pack buffer for a transfer of `bytes`. The buffer's
+  // old contents are dead (its read-back was completed by take_slot): a
+  // larger transfer re-specifies its storage, a smaller one invalidates it,
+  // so the driver never keeps old contents or waits for them.
+  void bind_pack_buffer(int slot, std::size_t bytes) {
+    const auto s = static_cast<std::size_t>(slot);
+    if (!pbos[s].get()) {
       GLuint id = 0;
       glCreateBuffers(1, &id);
-      pbo = GlBuffer(id);
-      glNamedBufferData(id, static_cast<GLsizeiptr>(bytes), nullptr, GL_STREAM_READ);
-      pbo_bytes[static_cast<std::size_t>(slot)] = bytes;
+      pbos[s] = GlBuffer(id);
+      pbo_bytes[s] = 0;
+    }
+    if (pbo_bytes[s] < bytes) {
+      glNamedBufferData(pbos[s].get(), static_cast<GLsizeiptr>(bytes), nullptr, GL_STREAM_READ);
+      pbo_bytes[s] = bytes;
+    } else {
+      glInvalidateBufferData(pbos[s].get());
     }
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glBindBuffer(GL_PIXEL_PACK_BUFFER, pbo.get());
-    // With a pack buffer bound, the pointer argument is an offset into it.
-    glGetTextureImage(layered.texture(plan.final_target), 0, GL_RGB,
-                      wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE, static_cast<GLsizei>(bytes),
-                      nullptr);
-    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-    gl_check("glGetTextureImage(output layers into PBO)");
-    out.fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
-    // Starts the queued work now (a fence waited on with
-    // GL_SYNC_FLUSH_COMMANDS_BIT would flush only at the wait).
-    glFlush();
-    gl_check("glFenceSync(output layers)");
-    out.idx = idx;
-    out.w = w;
-    out.h = h;
-    out.wide = wide;
-    out.slot = slot;
-    out.submit_ms = ms_since(wall0);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, pbos[s].get());
   }
 
-  // Completes a batch issued by issue_batch: waits for its fence (the passes
-  // and the transfer), maps its PBO, splits the views into their frames and
-  // reads the batch's timestamps. A no-op for an empty (already finished) one.
-  void finish_batch(const FramePlan& plan, std::vector<FrameResult>& frames,
-                    PendingReadback& p) {
+  // After a transfer into the slot's buffer: a fence behind it, and the
+  // queued work started now (a fence waited on with
+  // GL_SYNC_FLUSH_COMMANDS_BIT would flush only at the wait).
+  void fence_slot(int slot, SubmittedRender& sub, std::vector<std::size_t> idx, int w, int h,
+                  bool wide, std::chrono::steady_clock::time_point wall0) {
+    PendingReadback& p = in_flight[static_cast<std::size_t>(slot)];
+    p.fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glFlush();
+    gl_check("glFenceSync(read-back)");
+    p.render = &sub;
+    p.idx = std::move(idx);
+    p.w = w;
+    p.h = h;
+    p.wide = wide;
+    p.submit_ms = ms_since(wall0);
+  }
+
+  // Waits for a fence in bounded steps (kFenceStepNs), up to kFenceLimitMs;
+  // a cancelled render stops waiting between steps.
+  static void wait_fence(GLsync fence) {
+    const auto t0 = std::chrono::steady_clock::now();
+    GLbitfield flags = GL_SYNC_FLUSH_COMMANDS_BIT;
+    for (;;) {
+      const GLenum r = glClientWaitSync(fence, flags, kFenceStepNs);
+      if (r == GL_ALREADY_SIGNALED || r == GL_CONDITION_SATISFIED) return;
+      if (r == GL_WAIT_FAILED) {
+        gl_check("glClientWaitSync(read-back)");
+        throw GlError("glClientWaitSync(read-back) failed");
+      }
+      flags = 0;  // flushed by the first call
+      check_cancel();
+      if (ms_since(t0) > kFenceLimitMs) {
+        throw GlError("the GPU did not finish a frame in " +
+                      std::to_string(std::lround(kFenceLimitMs / 1000.0)) + " s");
+      }
+    }
+  }
+
+  // Completes the slot's read-back, if one is in flight: waits for its fence
+  // (the passes and the transfer), maps its buffer, splits the views into
+  // their frames and reads its timestamps.
+  void complete_slot(int slot) {
+    PendingReadback& p = in_flight[static_cast<std::size_t>(slot)];
     if (!p.fence) return;
     const auto wait0 = std::chrono::steady_clock::now();
-    for (;;) {
-      const GLenum r = glClientWaitSync(p.fence, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000ull);
-      if (r == GL_ALREADY_SIGNALED || r == GL_CONDITION_SATISFIED) break;
-      if (r == GL_WAIT_FAILED) {
-        gl_check("glClientWaitSync(output layers)");
-        throw GlError("glClientWaitSync(output layers) failed");
-      }
-      // GL_TIMEOUT_EXPIRED: keep waiting (a large batch on a slow device).
-    }
+    wait_fence(p.fence);
     glDeleteSync(p.fence);
     p.fence = nullptr;
     const double wait_ms = ms_since(wait0);
@@ -390,13 +428,14 @@ struct Renderer::Impl {
     const auto copy0 = std::chrono::steady_clock::now();
     const std::size_t k = p.idx.size();
     const std::size_t bytes = 3 * static_cast<std::size_t>(p.w) * p.h * k * (p.wide ? 2 : 1);
-    const GLuint pbo = pbos[static_cast<std::size_t>(p.slot)].get();
+    const GLuint pbo = pbos[static_cast<std::size_t>(slot)].get();
     const void* mapped =
         glMapNamedBufferRange(pbo, 0, static_cast<GLsizeiptr>(bytes), GL_MAP_READ_BIT);
     if (!mapped) {
-      gl_check("glMapNamedBufferRange(output layers)");
-      throw GlError("glMapNamedBufferRange(output layers) returned null");
+      gl_check("glMapNamedBufferRange(read-back)");
+      throw GlError("glMapNamedBufferRange(read-back) returned null");
     }
+    std::vector<FrameResult>& frames = p.render->frames;
     size_frames(frames, p.idx, p.w, p.h, p.wide);
     auto image_of = [&](std::size_t v) { return frames[p.idx[v]].image.rgb.data(); };
     if (p.wide) {
@@ -405,8 +444,26 @@ struct Renderer::Impl {
       split_views(static_cast<const std::uint8_t*>(mapped), p.w, p.h, 0, k, image_of);
     }
     glUnmapNamedBuffer(pbo);
-    gl_check("glUnmapNamedBuffer(output layers)");
-    set_batch_timing(plan, frames, p.idx, p.slot, p.submit_ms, wait_ms, ms_since(copy0));
+    gl_check("glUnmapNamedBuffer(read-back)");
+    set_batch_timing(p.render->plan, frames, p.idx, slot, p.submit_ms, wait_ms, ms_since(copy0));
+    p.clear();
+  }
+
+  // Completes the read-backs in flight of one submitted render (all: null).
+  void complete_render(const SubmittedRender* sub) {
+    for (int s = 0; s < 2; ++s) {
+      if (in_flight[static_cast<std::size_t>(s)].fence &&
+          (!sub || in_flight[static_cast<std::size_t>(s)].render == sub)) {
+        complete_slot(s);
+      }
+    }
+  }
+
+  // Forgets a submitted render's read-backs in flight (after an error).
+  void abandon(const SubmittedRender* sub) {
+    for (PendingReadback& p : in_flight) {
+      if (p.render == sub) p.clear();
+    }
   }
 
   // The batch's timing (GPU timestamps from its query set, the CPU split),
@@ -421,9 +478,8 @@ struct Renderer::Impl {
     batch.readback_wait_ms = wait_ms;
     batch.readback_copy_ms = copy_ms;
     batch.readback_ms = wait_ms + copy_ms;
-    // The batch's own CPU time: its submission and its completion (with
-    // pipelining, not the next batch's submission in between, which that
-    // batch accounts for).
+    // The batch's own CPU time: its submission and its completion (not
+    // what was submitted in between, which accounts for itself).
     batch.wall_ms = submit_ms + batch.readback_ms;
     const double share = 1.0 / static_cast<double>(k);
     for (std::size_t v = 0; v < k; ++v) {
@@ -452,10 +508,14 @@ const std::string& Renderer::description() const { return impl_->context->descri
 
 void Renderer::fail_next_render_for_test() { impl_->fail_next = true; }
 
+SceneGpuCache::Stats Renderer::scene_cache_stats() const { return impl_->scene_cache.stats(); }
+
 void Renderer::release_idle_memory(std::size_t keep_photon_bytes) {
   Impl& m = *impl_;
   const EglContext::Current current(*m.context);
+  m.complete_render(nullptr);  // the pixel buffers are about to go
   m.photons.shrink_to(keep_photon_bytes);
+  m.scene_cache.shrink_to(keep_photon_bytes);
   m.volumes.drop_unused();
   m.targets = FrameTargets();
   m.layered = FrameTargets();
@@ -546,20 +606,13 @@ bool Renderer::needs_photon_trace(const Scene& scene, const FrameOptions& opts) 
 std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<Camera>& cameras,
                                           const FrameOptions& opts) {
   const EglContext::Current current(*impl_->context);
-  // Maps traced before the render are taken by the photon cache in place of
-  // tracing; offered for this call only.
-  struct Offer {
-    PhotonCache& cache;
-    ~Offer() { cache.offer({}, nullptr); }
-  } offer{impl_->photons};
-  if (opts.photon_maps) impl_->photons.offer(photon_key(scene), opts.photon_maps);
   const int k = scene.output.supersample;
   // Supersampled: every camera at k times the size, its HDR box-filtered
   // back and tone-mapped here (render/image.hpp's tone_map, the same curve
   // as the tonemap pass). Frames of a preview's lower resolution scale skip
   // it: they are a moving camera's quick frames.
   if (k <= 1 || PlanInput{scene, opts.resolution_scale}.scaled()) {
-    return render_cameras(scene, cameras, opts);
+    return finish(submit(scene, cameras, opts));
   }
   std::vector<Camera> big = cameras;
   for (Camera& c : big) {
@@ -568,7 +621,7 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
   }
   FrameOptions o = opts;
   o.read_hdr = true;
-  std::vector<FrameResult> frames = render_cameras(scene, big, o);
+  std::vector<FrameResult> frames = finish(submit(scene, big, o, false));
   for (FrameResult& f : frames) {
     const auto t0 = std::chrono::steady_clock::now();
     f.hdr = box_downsample(f.hdr, k);
@@ -579,11 +632,67 @@ std::vector<FrameResult> Renderer::render(const Scene& scene, const std::vector<
   return frames;
 }
 
-std::vector<FrameResult> Renderer::render_cameras(const Scene& scene,
-                                                  const std::vector<Camera>& cameras,
-                                                  const FrameOptions& opts) {
-  const FramePlan plan = make_plan(PlanInput{scene, opts.resolution_scale});
-  SceneResources res(scene, impl_->tables, plan, &impl_->photons, &impl_->volumes);
+std::uint64_t Renderer::submit(const Scene& scene, const std::vector<Camera>& cameras,
+                               const FrameOptions& opts) {
+  return submit(scene, cameras, opts, true);
+}
+
+std::uint64_t Renderer::submit(const Scene& scene, const std::vector<Camera>& cameras,
+                               const FrameOptions& opts, bool supersample) {
+  const EglContext::Current current(*impl_->context);
+  Impl& m = *impl_;
+  // Maps traced before the render (FrameOptions::photon_maps) are taken by
+  // the photon cache in place of tracing; offered for this call only. Every
+  // render, render() included, uploads its photons here.
+  struct Offer {
+    PhotonCache& cache;
+    ~Offer() { cache.offer({}, nullptr); }
+  } offer{m.photons};
+  if (opts.photon_maps) m.photons.offer(photon_key(scene), opts.photon_maps);
+  const std::uint64_t ticket = m.next_ticket++;
+  auto sub = std::make_unique<SubmittedRender>();
+  SubmittedRender& r = *sub;
+  m.submitted.emplace(ticket, std::move(sub));
+  try {
+    if (supersample && scene.output.supersample > 1 && !PlanInput{scene, opts.resolution_scale}.scaled()) {
+      // Supersampled frames are finished here (their HDR read-back is synchronous).
+      r.frames = render(scene, cameras, opts);
+    } else {
+      submit_cameras(scene, cameras, opts, r);
+    }
+  } catch (...) {
+    m.abandon(&r);
+    m.submitted.erase(ticket);
+    throw;
+  }
+  return ticket;
+}
+
+std::vector<FrameResult> Renderer::finish(std::uint64_t ticket) {
+  const EglContext::Current current(*impl_->context);
+  Impl& m = *impl_;
+  const auto it = m.submitted.find(ticket);
+  if (it == m.submitted.end()) throw GlError("finish: no submitted render " + std::to_string(ticket));
+  const std::unique_ptr<SubmittedRender> sub = std::move(it->second);
+  m.submitted.erase(it);
+  try {
+    m.complete_render(sub.get());
+  } catch (...) {
+    m.abandon(sub.get());
+    throw;
+  }
+  for (std::size_t i = 0; i < sub->batch_of.size(); ++i) {
+    sub->frames[i].batch.index = sub->batch_of[i];
+  }
+  return std::move(sub->frames);
+}
+
+void Renderer::submit_cameras(const Scene& scene, const std::vector<Camera>& cameras,
+                              const FrameOptions& opts, SubmittedRender& sub) {
+  sub.plan = make_plan(PlanInput{scene, opts.resolution_scale});
+  const FramePlan& plan = sub.plan;
+  SceneResources res(scene, impl_->tables, plan, &impl_->photons, &impl_->volumes,
+                     &impl_->scene_cache);
   if (std::exchange(impl_->fail_next, false)) {
     // Out of KHR_debug's sight: the tests fail on any driver-reported error
     // they did not plant themselves; this one is planted, and glGetError
@@ -594,27 +703,24 @@ std::vector<FrameResult> Renderer::render_cameras(const Scene& scene,
     if (debug_output) glEnable(GL_DEBUG_OUTPUT);
     gl_check("glEnable(0) (injected test failure)");
   }
-  std::vector<FrameResult> frames(cameras.size());
+  std::vector<FrameResult>& frames = sub.frames;
+  frames.assign(cameras.size(), FrameResult{});
   const std::vector<std::vector<std::size_t>> batches =
       camera_batches(cameras, opts, std::min(kMaxBatchViews, impl_->max_layers));
-  // Multi-view batches are pipelined: batch b's read-back is finished after
-  // batch b+1's passes are submitted (render_batch, finish_batch).
-  std::array<PendingReadback, 2> pending;
-  std::size_t cur = 0;
-  for (std::size_t b = 0; b < batches.size(); ++b) {
-    const auto& idx = batches[b];
+  // Every camera or batch's read-back is queued into a pixel buffer with a
+  // fence and completed when its slot comes round again (two batches
+  // later) or in finish(): the CPU never waits for the frame it has just
+  // submitted.
+  for (const auto& idx : batches) {
     if (idx.size() == 1) {
-      impl_->finish_batch(plan, frames, pending[cur ^ 1]);
-      frames[idx[0]] = impl_->render_camera(scene, cameras[idx[0]], res, plan, opts);
+      impl_->render_camera(scene, cameras[idx[0]], res, sub, idx[0], opts);
     } else {
-      impl_->render_batch(scene, cameras, idx, res, plan, opts, frames, pending[cur]);
-      impl_->finish_batch(plan, frames, pending[cur ^ 1]);
-      cur ^= 1;
+      impl_->render_batch(scene, cameras, idx, res, sub, opts);
     }
   }
-  impl_->finish_batch(plan, frames, pending[cur ^ 1]);
+  sub.batch_of.assign(cameras.size(), 0);
   for (std::size_t b = 0; b < batches.size(); ++b) {
-    for (std::size_t i : batches[b]) frames[i].batch.index = static_cast<int>(b);
+    for (std::size_t i : batches[b]) sub.batch_of[i] = static_cast<int>(b);
   }
   for (FrameResult& f : frames) {
     f.photons = res.photons_kept();
@@ -623,7 +729,6 @@ std::vector<FrameResult> Renderer::render_cameras(const Scene& scene,
     f.photon_trace_ms = res.photon_trace_ms();
     f.photon_upload_ms = res.photon_upload_ms();
   }
-  return frames;
 }
 
 }  // namespace beamcast

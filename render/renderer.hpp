@@ -12,6 +12,7 @@
 #include "render/egl_context.hpp"
 #include "render/image.hpp"
 #include "render/pass_plan.hpp"
+#include "render/scene_resources.hpp"
 
 namespace beamcast {
 
@@ -20,6 +21,9 @@ struct PhotonMaps;
 struct RendererOptions {
   EglOptions egl;
   std::size_t table_cache_entries = 64;  // CPU-side line-integral tables kept
+  // Uploads that depend only on a scene's content (occluder triangles, SLIM
+  // sphere records), kept across renders within this budget (SceneGpuCache).
+  std::size_t scene_cache_bytes = 256u << 20;
 };
 
 struct PassTiming {
@@ -27,19 +31,20 @@ struct PassTiming {
   double gpu_ms = 0.0;  // GL timestamp queries around the pass
 };
 
-// How multi-view batches are read back.
+// How frames are read back.
 enum class Readback {
-  // Pipelined, except on a software rasterizer (llvmpipe, softpipe), where
-  // the passes run during submission and there is nothing asynchronous to
-  // overlap: measured neutral to 4% slower there (docs/performance.md,
-  // "Mixed load (issue 13)"), so the synchronous read is kept.
+  // kPipelined, on every device (issue 39).
   kAuto,
-  // Each batch into one of two pixel buffer objects with a fence, mapped only
-  // after the next batch's passes are submitted: on a GPU that renders
-  // asynchronously, batch k's transfer overlaps batch k+1's draws.
+  // Each camera's frame or multi-view batch into one of two pixel buffer
+  // objects with a fence, mapped only when its buffer is needed again (two
+  // cameras or batches later) or when the render is finished
+  // (Renderer::finish): on a GPU that renders asynchronously the transfer
+  // and the wait overlap the next frames' submission, the next render's
+  // included when the caller submits it before finishing this one.
   kPipelined,
-  // glGetTextureImage into client memory right after the batch's passes
-  // (waits for them).
+  // Read at once after the passes (waits for them): multi-view batches with
+  // glGetTextureImage into client memory, single cameras through the pixel
+  // buffer, completed at once.
   kSynchronous,
 };
 
@@ -104,7 +109,7 @@ struct FrameResult {
   HdrImage hdr;           // only with FrameOptions::read_hdr
   std::vector<PassTiming> passes;
   double gpu_ms = 0.0;       // whole frame on the GPU
-  double readback_ms = 0.0;  // glReadPixels, wall clock
+  double readback_ms = 0.0;  // completing the read-back (batch share): wait + copy, wall clock
   double wall_ms = 0.0;      // the whole call for this camera, wall clock (batch share)
   BatchTiming batch;
   // Lit scenes: photons splatted, and the CPU time of this render call's
@@ -130,6 +135,8 @@ std::vector<std::vector<std::size_t>> camera_batches(const std::vector<Camera>& 
                                                     const FrameOptions& opts,
                                                     int device_max_views = 64);  // kMaxBatchViews
 
+struct SubmittedRender;  // renderer.cpp
+
 class Renderer {
  public:
   // Creates the EGL context (throws std::runtime_error if none can be had).
@@ -144,8 +151,20 @@ class Renderer {
   // geometry) are uploaded once and shared by the cameras.
   std::vector<FrameResult> render(const Scene& scene, const FrameOptions& opts = {});
   // Renders the given cameras (which need not be the scene's own).
+  // finish(submit(...)).
   std::vector<FrameResult> render(const Scene& scene, const std::vector<Camera>& cameras,
                                   const FrameOptions& opts = {});
+  // Submits the cameras' passes and queues their read-back (pixel buffers
+  // and fences); the frames come from finish(ticket). Submitting the next
+  // render before finishing this one overlaps this one's GPU work and
+  // transfer with the next one's submission. `scene` need only outlive
+  // this call. Every ticket is finished (or the renderer destroyed); a
+  // submit or finish that throws leaves no read-back of its render behind.
+  std::uint64_t submit(const Scene& scene, const std::vector<Camera>& cameras,
+                       const FrameOptions& opts = {});
+  // The frames of a submitted render, its read-backs completed (waiting for
+  // the GPU only as long as it has not finished them).
+  std::vector<FrameResult> finish(std::uint64_t ticket);
 
   // Test hook (the server's context-rebuild test): the next render issues an
   // invalid GL call after uploading its scene and throws the GlError that
@@ -161,12 +180,17 @@ class Renderer {
   // other photon maps, textures of volumes whose scene is gone, the frame
   // targets and read-back buffers. The next render re-creates what it needs.
   // For a server whose renderer has gone idle (RenderService).
+  // The scene-content cache is kept down to the same bytes.
   void release_idle_memory(std::size_t keep_photon_bytes);
+  // The scene-content cache's use (render/scene_resources.hpp).
+  SceneGpuCache::Stats scene_cache_stats() const;
 
  private:
-  // render() without output.supersample.
-  std::vector<FrameResult> render_cameras(const Scene& scene, const std::vector<Camera>& cameras,
-                                          const FrameOptions& opts);
+  // submit() with supersampling (false: the cameras as given).
+  std::uint64_t submit(const Scene& scene, const std::vector<Camera>& cameras,
+                       const FrameOptions& opts, bool supersample);
+  void submit_cameras(const Scene& scene, const std::vector<Camera>& cameras,
+                      const FrameOptions& opts, SubmittedRender& sub);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

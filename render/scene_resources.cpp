@@ -3,6 +3,7 @@
 #include "protocol/scene_bounds.hpp"
 
 #include <chrono>
+#include <type_traits>
 
 #include <algorithm>
 #include <cmath>
@@ -29,6 +30,44 @@ std::shared_ptr<const LineIntegralTable> TableCache::get(const Density& density,
   entries_.emplace_front(key, table);
   while (entries_.size() > max_entries_) entries_.pop_back();
   return table;
+}
+
+std::shared_ptr<const void> SceneGpuCache::find_entry(const std::string& key) {
+  const auto it = index_.find(key);
+  if (it == index_.end()) {
+    ++misses_;
+    return nullptr;
+  }
+  ++hits_;
+  lru_.splice(lru_.begin(), lru_, it->second);
+  return it->second->value;
+}
+
+void SceneGpuCache::put(const std::string& key, std::shared_ptr<const void> value,
+                        std::size_t bytes) {
+  if (const auto it = index_.find(key); it != index_.end()) {
+    bytes_ -= it->second->bytes;
+    lru_.erase(it->second);
+    index_.erase(it);
+  }
+  if (bytes > budget_) return;
+  lru_.push_front(Entry{key, std::move(value), bytes});
+  index_[key] = lru_.begin();
+  bytes_ += bytes;
+  shrink_to(budget_);
+}
+
+void SceneGpuCache::shrink_to(std::size_t bytes) {
+  while (bytes_ > bytes && !lru_.empty()) {
+    bytes_ -= lru_.back().bytes;
+    index_.erase(lru_.back().key);
+    lru_.pop_back();
+    ++evictions_;
+  }
+}
+
+SceneGpuCache::Stats SceneGpuCache::stats() const {
+  return {bytes_, lru_.size(), budget_, hits_, misses_, evictions_};
 }
 
 namespace {
@@ -141,6 +180,25 @@ class VertexSink final : public TriangleSink {
   std::vector<Vertex>* out_;
 };
 
+// Appends the triangles' exact values to a key.
+class KeySink final : public TriangleSink {
+ public:
+  explicit KeySink(std::string* key) : key_(key) {}
+  void add(const Vec3& a, const Vec3& b, const Vec3& c, bool one_sided) override {
+    for (const Vec3* p : {&a, &b, &c}) {
+      key_->append(reinterpret_cast<const char*>(p->data()), sizeof(Vec3));
+    }
+    key_->push_back(one_sided ? '1' : '0');
+  }
+
+ private:
+  std::string* key_;
+};
+
+void append_raw(std::string* key, const Vec3& v) {
+  key->append(reinterpret_cast<const char*>(v.data()), sizeof(Vec3));
+}
+
 }  // namespace
 
 namespace {
@@ -157,10 +215,11 @@ bool software_gl() {
 }  // namespace
 
 SceneResources::SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan,
-                               PhotonCache* photons, VolumeTextureCache* volumes)
+                               PhotonCache* photons, VolumeTextureCache* volumes,
+                               SceneGpuCache* content)
     : scene_(scene) {
   if (plan.uploads_group("beams")) upload_beams(tables);
-  if (plan.uploads_group("occluders")) upload_occluders();
+  if (plan.uploads_group("occluders")) upload_occluders(content);
   if (plan.uploads_group("photons")) {
     if (!photons) throw GlError("the plan splats photons but the renderer has no photon cache");
     // Photons straight from a light are left out when the direct pass
@@ -177,7 +236,7 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
     upload_volume_grid(*photons);
   }
   if (plan.uploads_group("shadows")) upload_direct();
-  if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene);
+  if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene, content);
   if (plan.uploads_group("volumes")) volumes_ = std::make_unique<VolumeResources>(scene, volumes);
   upload_medium_meshes();
   if (plan.uploads_group("specular")) {
@@ -443,7 +502,50 @@ void SceneResources::upload_direct() {
   gl_check("upload direct points");
 }
 
-void SceneResources::upload_occluders() {
+// Lit scenes: quad lights are drawn as what a camera sees of them, their
+// radiance from the front (G-buffer material code kEmitterMaterial).
+static std::vector<std::pair<const QuadLight*, Color>> emitters_of(const Scene& scene) {
+  std::vector<std::pair<const QuadLight*, Color>> out;
+  if (!scene.has_gi()) return out;
+  for (const Light& l : scene.lights) {
+    if (const auto* q = std::get_if<QuadLight>(&l.shape)) {
+      out.emplace_back(q, q->radiance_scale() * l.flux);
+    }
+  }
+  return out;
+}
+
+std::string SceneResources::occluder_key(const Scene& scene) {
+  // Exact values, except a mesh's vertices and triangles, named by their
+  // hashes (mesh_content_key).
+  std::string key = "occluders";
+  for (const Occluder& occ : scene.occluders) {
+    std::visit(
+        [&](const auto& shape) {
+          using Kind = std::decay_t<decltype(shape)>;
+          if constexpr (Kind::kGpu == GpuForm::kTriangles) {
+            key.push_back('|');
+            key.append(Kind::kType);
+            append_raw(&key, occ.albedo);
+            key.push_back(static_cast<char>('0' + static_cast<int>(occ.material.type)));
+            if constexpr (std::is_same_v<Kind, MeshOccluder>) {
+              key += shape.content_key.empty() ? mesh_content_key(shape) : shape.content_key;
+            } else {
+              KeySink sink(&key);
+              shape.gpu_triangles(sink);
+            }
+          }
+        },
+        occ.shape);
+  }
+  for (const auto& [q, radiance] : emitters_of(scene)) {
+    key += "|emitter";
+    for (const Vec3* v : {&q->corner, &q->edge_u, &q->edge_v, &radiance}) append_raw(&key, *v);
+  }
+  return key;
+}
+
+void SceneResources::upload_occluders(SceneGpuCache* content) {
   const Scene& scene = scene_;
   // Triangle kinds go into one vertex buffer, stored relative to an anchor
   // (the centre of their bounds) so float precision follows the geometry;
@@ -461,62 +563,20 @@ void SceneResources::upload_occluders() {
         },
         occ.shape);
   }
-  // Lit scenes: quad lights are drawn as what a camera sees of them, their
-  // radiance from the front (G-buffer material code kEmitterMaterial).
-  std::vector<const QuadLight*> emitters;
-  std::vector<Color> radiance;
-  if (scene.has_gi()) {
-    for (const Light& l : scene.lights) {
-      if (const auto* q = std::get_if<QuadLight>(&l.shape)) {
-        emitters.push_back(q);
-        radiance.push_back(q->radiance_scale() * l.flux);
-        bounds.grow(q->bounds());
-      }
-    }
-  }
-  std::vector<Vertex> verts;
+  for (const auto& e : emitters_of(scene)) bounds.grow(e.first->bounds());
   mesh_bounds_ = bounds;
   if (!bounds.empty()) {
     mesh_anchor_ = bounds.centre();
-    VertexSink sink(mesh_anchor_, &verts);
-    for (const Occluder& occ : scene.occluders) {
-      sink.albedo = occ.albedo;
-      sink.material = static_cast<float>(occ.material.type);
-      std::visit(
-          [&](const auto& shape) {
-            if constexpr (std::decay_t<decltype(shape)>::kGpu == GpuForm::kTriangles) {
-              shape.gpu_triangles(sink);
-            }
-          },
-          occ.shape);
+    // The triangles depend only on the scene's content: kept across renders.
+    const std::string key = content ? occluder_key(scene) : std::string();
+    if (content) geometry_ = content->find<OccluderGeometry>(key);
+    if (!geometry_) {
+      geometry_ = make_geometry();
+      if (content && geometry_) {
+        content->put(key, geometry_,
+                     static_cast<std::size_t>(geometry_->vertices) * sizeof(Vertex) + key.size());
+      }
     }
-    sink.material = kEmitterMaterial;
-    for (std::size_t i = 0; i < emitters.size(); ++i) {
-      const QuadLight& q = *emitters[i];
-      sink.albedo = radiance[i];  // the surface shader writes it as emitted radiance
-      const Vec3 far = q.corner + q.edge_u + q.edge_v;
-      sink.add(q.corner, q.corner + q.edge_u, far, true);
-      sink.add(q.corner, far, q.corner + q.edge_v, true);
-    }
-  }
-  if (!verts.empty()) {
-    GLuint id = 0;
-    glCreateBuffers(1, &id);
-    tri_vbo_ = GlBuffer(id);
-    glNamedBufferStorage(id, static_cast<GLsizeiptr>(verts.size() * sizeof(Vertex)),
-                         verts.data(), 0);
-    glCreateVertexArrays(1, &id);
-    tri_vao_ = GlVertexArray(id);
-    glVertexArrayVertexBuffer(id, 0, tri_vbo_.get(), 0, sizeof(Vertex));
-    // position, normal, albedo (3 floats each), one_sided, material (1 float each).
-    for (GLuint a = 0; a < 5; ++a) {
-      glEnableVertexArrayAttrib(id, a);
-      glVertexArrayAttribFormat(id, a, a < 3 ? 3 : 1, GL_FLOAT, GL_FALSE,
-                                static_cast<GLuint>((a < 4 ? a * 3 : 10) * sizeof(float)));
-      glVertexArrayAttribBinding(id, a, 0);
-    }
-    tri_vertices_ = static_cast<GLsizei>(verts.size());
-    gl_check("upload occluder triangles");
   }
   if (!analytic_.empty()) {
     GLuint id = 0;
@@ -525,6 +585,53 @@ void SceneResources::upload_occluders() {
     glNamedBufferStorage(id, static_cast<GLsizeiptr>(sizeof(AnalyticData) * analytic_.size()),
                          nullptr, GL_DYNAMIC_STORAGE_BIT);
   }
+}
+
+// The vertex buffer of the triangle occluders and emitters, relative to
+// mesh_anchor_; null without a triangle.
+std::shared_ptr<const OccluderGeometry> SceneResources::make_geometry() const {
+  std::vector<Vertex> verts;
+  VertexSink sink(mesh_anchor_, &verts);
+  for (const Occluder& occ : scene_.occluders) {
+    sink.albedo = occ.albedo;
+    sink.material = static_cast<float>(occ.material.type);
+    std::visit(
+        [&](const auto& shape) {
+          if constexpr (std::decay_t<decltype(shape)>::kGpu == GpuForm::kTriangles) {
+            shape.gpu_triangles(sink);
+          }
+        },
+        occ.shape);
+  }
+  sink.material = kEmitterMaterial;
+  for (const auto& [q, radiance] : emitters_of(scene_)) {
+    sink.albedo = radiance;  // the surface shader writes it as emitted radiance
+    const Vec3 far = q->corner + q->edge_u + q->edge_v;
+    sink.add(q->corner, q->corner + q->edge_u, far, true);
+    sink.add(q->corner, far, q->corner + q->edge_v, true);
+  }
+  if (verts.empty()) return nullptr;
+  auto g = std::make_shared<OccluderGeometry>();
+  GLuint id = 0;
+  glCreateBuffers(1, &id);
+  g->vbo = GlBuffer(id);
+  glNamedBufferStorage(id, static_cast<GLsizeiptr>(verts.size() * sizeof(Vertex)), verts.data(),
+                       0);
+  glCreateVertexArrays(1, &id);
+  g->vao = GlVertexArray(id);
+  glVertexArrayVertexBuffer(id, 0, g->vbo.get(), 0, sizeof(Vertex));
+  // position, normal, albedo (3 floats each), one_sided, material (1 float each).
+  for (GLuint a = 0; a < 5; ++a) {
+    glEnableVertexArrayAttrib(id, a);
+    glVertexArrayAttribFormat(id, a, a < 3 ? 3 : 1, GL_FLOAT, GL_FALSE,
+                              static_cast<GLuint>((a < 4 ? a * 3 : 10) * sizeof(float)));
+    glVertexArrayAttribBinding(id, a, 0);
+  }
+  g->vertices = static_cast<GLsizei>(verts.size());
+  g->anchor = mesh_anchor_;
+  g->bounds = mesh_bounds_;
+  gl_check("upload occluder triangles");
+  return g;
 }
 
 void SceneResources::fill_camera(const Camera& cam, const CameraBasis& basis, void* block) const {

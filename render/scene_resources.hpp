@@ -16,6 +16,7 @@
 #include "protocol/camera.hpp"
 #include "protocol/scene.hpp"
 #include "render/gl_util.hpp"
+#include "render/scene_gpu_cache.hpp"
 #include "render/lut.hpp"
 #include "render/pass_plan.hpp"
 #include "render/slim_pass.hpp"
@@ -48,13 +49,26 @@ class TableCache {
   std::list<std::pair<std::string, std::shared_ptr<const LineIntegralTable>>> entries_;
 };
 
+// Triangle occluders (and lit scenes' quad-light emitters) as one vertex
+// buffer, positions relative to `anchor`: a SceneGpuCache entry.
+struct OccluderGeometry {
+  GlBuffer vbo;
+  GlVertexArray vao;
+  GLsizei vertices = 0;
+  Vec3 anchor{};
+  Aabb bounds;
+};
+
 class SceneResources {
  public:
   // Uploads the resource groups the plan's passes declare: "beams" (tables,
   // beam instances), "occluders" (triangles, analytic occluders), "photons"
   // (the scene's photon maps from `photons`, traced there unless cached).
+  // `content`: where uploads that depend only on the scene's content are
+  // kept across renders (null: made for this render alone).
   SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan,
-                 PhotonCache* photons = nullptr, VolumeTextureCache* volumes = nullptr);
+                 PhotonCache* photons = nullptr, VolumeTextureCache* volumes = nullptr,
+                 SceneGpuCache* content = nullptr);
   // Uploads the camera block and camera-relative beam and occluder data.
   void bind_camera(const Camera& cam, const CameraBasis& basis);
   // Multi-view: uploads one camera block per view (the CameraBlocks uniform
@@ -77,8 +91,8 @@ class SceneResources {
   GLuint beam_buffer() const { return views_ ? views_beam_ssbo_.get() : beam_ssbo_.get(); }
   GLsizei beam_count() const { return static_cast<GLsizei>(beam_layers_.size()); }
   GLuint camera_buffer() const { return camera_ubo_.get(); }
-  GLuint triangle_vao() const { return tri_vao_.get(); }
-  GLsizei triangle_vertex_count() const { return tri_vertices_; }
+  GLuint triangle_vao() const { return geometry_ ? geometry_->vao.get() : 0; }
+  GLsizei triangle_vertex_count() const { return geometry_ ? geometry_->vertices : 0; }
   GLuint analytic_buffer() const {
     return views_ ? views_analytic_ssbo_.get() : analytic_ssbo_.get();
   }
@@ -124,6 +138,8 @@ class SceneResources {
   // The triangle vertices' anchor (positions in triangle_vao() are relative to it).
   const Vec3& mesh_anchor() const { return mesh_anchor_; }
   const Aabb& mesh_bounds() const { return mesh_bounds_; }
+  // The key of the scene's occluder triangles in SceneGpuCache (their content).
+  static std::string occluder_key(const Scene& scene);
   // Ray tracing on the CPU (group "specular"): the scene's surfaces and its
   // photon maps' search structures; null without the group.
   const GiScene* gi_scene() const { return gi_scene_.get(); }
@@ -149,9 +165,8 @@ class SceneResources {
   int nd_ = 0, ns_ = 0, nf_ = 0, nw_ = 2;
   std::vector<float> beam_layers_;  // table layer of each beam
   GlTexture g_tex_, f_tex_, warp_tex_, gm_tex_;
-  GlBuffer beam_ssbo_, camera_ubo_, analytic_ssbo_, tri_vbo_;
-  GlVertexArray tri_vao_;
-  GLsizei tri_vertices_ = 0;
+  GlBuffer beam_ssbo_, camera_ubo_, analytic_ssbo_;
+  std::shared_ptr<const OccluderGeometry> geometry_;  // null without triangles
   Vec3 mesh_anchor_{};
   Aabb mesh_bounds_;
   std::vector<const Occluder*> analytic_;  // planes and spheres
@@ -160,7 +175,8 @@ class SceneResources {
   std::size_t views_capacity_ = 0;  // views the multi-view buffers hold
 
   void upload_beams(TableCache& tables);
-  void upload_occluders();
+  void upload_occluders(SceneGpuCache* content);
+  std::shared_ptr<const OccluderGeometry> make_geometry() const;
   void upload_photons(PhotonCache& cache, bool skip_direct);
   void upload_volume_photons(PhotonCache& cache);
   void upload_volume_grid(PhotonCache& cache);

@@ -121,7 +121,31 @@ SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasi
   return g;
 }
 
-SlimResources::SlimResources(const Scene& scene) {
+std::string SlimResources::content_key(const Scene& scene) {
+  std::string key = "slim|";
+  key.push_back(scene.slim.evaluation == SlimEvaluation::kPatch ? 'p' : 's');
+  for (const Occluder& occ : scene.occluders) {
+    if (const auto* slim = std::get_if<SlimOccluder>(&occ.shape)) {
+      key += "|" + slim->surface->content_key();
+      key.append(reinterpret_cast<const char*>(occ.albedo.data()), sizeof(occ.albedo));
+      key.push_back(static_cast<char>('0' + static_cast<int>(occ.material.type)));
+    }
+  }
+  return key;
+}
+
+SlimResources::SlimResources(const Scene& scene, SceneGpuCache* content) {
+  // The records depend only on the scene's content: kept across renders.
+  const std::string key = content ? content_key(scene) : std::string();
+  if (content) st_ = content->find<SlimStatic>(key);
+  if (st_) return;
+  st_ = make_static(scene);
+  if (content) content->put(key, st_, st_->bytes + key.size());
+}
+
+std::shared_ptr<const SlimStatic> SlimResources::make_static(const Scene& scene) {
+  auto st = std::make_shared<SlimStatic>();
+  std::vector<const SlimSphere*>& spheres = st->spheres;
   Aabb box;
   std::vector<const Occluder*> occluder_of;  // each sphere's occluder (its albedo)
   // Each sphere's height range, which only the patch evaluation reads
@@ -130,13 +154,14 @@ SlimResources::SlimResources(const Scene& scene) {
   std::vector<const std::array<double, 2>*> range_of;
   // Spheres without a crease first, then those with one (crease_begin()).
   for (const bool creases : {false, true}) {
-    if (creases) crease_begin_ = spheres_.size();
+    if (creases) st->crease_begin = spheres.size();
     for (const Occluder& occ : scene.occluders) {
       if (const auto* slim = std::get_if<SlimOccluder>(&occ.shape)) {
+        if (!creases) st->surfaces.push_back(slim->surface);
         const auto* ranges = patch ? slim->surface->height_ranges().data() : nullptr;
         for (std::size_t k = 0; k < slim->spheres().size(); ++k) {
           if ((slim->spheres()[k].crease != SlimCrease::kNone) != creases) continue;
-          spheres_.push_back(&slim->spheres()[k]);
+          spheres.push_back(&slim->spheres()[k]);
           occluder_of.push_back(&occ);
           range_of.push_back(ranges ? ranges + k : nullptr);
         }
@@ -144,19 +169,20 @@ SlimResources::SlimResources(const Scene& scene) {
       }
     }
   }
-  box_ = box;
-  if (!box.empty()) anchor_ = 0.5 * (box.lo + box.hi);
-  std::vector<SlimGpu> data(spheres_.size());
-  std::vector<std::uint32_t> index(spheres_.size());
-  for (std::size_t i = 0; i < spheres_.size(); ++i) {
-    const SlimSphere& s = *spheres_[i];
+  st->box = box;
+  if (!box.empty()) st->anchor = 0.5 * (box.lo + box.hi);
+  const Vec3& anchor = st->anchor;
+  std::vector<SlimGpu> data(spheres.size());
+  std::vector<std::uint32_t> index(spheres.size());
+  for (std::size_t i = 0; i < spheres.size(); ++i) {
+    const SlimSphere& s = *spheres[i];
     const Occluder& occ = *occluder_of[i];
     SlimGpu& d = data[i];
     auto put = [](float* out, const Vec3& v, double w) {
       for (int k = 0; k < 3; ++k) out[k] = static_cast<float>(v[k]);
       out[3] = static_cast<float>(w);
     };
-    put(d.center, s.center - anchor_, s.radius);
+    put(d.center, s.center - anchor, s.radius);
     put(d.axis_u, s.to_world({1.0, 0.0, 0.0}) - s.center, 0.0);
     put(d.axis_v, s.to_world({0.0, 1.0, 0.0}) - s.center, 0.0);
     put(d.axis_w, s.to_world({0.0, 0.0, 1.0}) - s.center, 0.0);
@@ -179,37 +205,40 @@ SlimResources::SlimResources(const Scene& scene) {
     put(d.albedo, occ.albedo, static_cast<double>(occ.material.type));
     index[i] = static_cast<std::uint32_t>(i);
   }
-  if (spheres_.empty()) return;
-  sphere_ssbo_ = make_buffer(data);
-  index_vbo_ = make_buffer(index);
+  if (spheres.empty()) return st;
+  st->sphere_ssbo = make_buffer(data);
+  st->index_vbo = make_buffer(index);
+  st->bytes = data.size() * sizeof(SlimGpu) + index.size() * sizeof(std::uint32_t) +
+              spheres.size() * sizeof(const SlimSphere*);
   GLuint id = 0;
   glCreateVertexArrays(1, &id);
-  vao_ = GlVertexArray(id);
-  glVertexArrayVertexBuffer(id, 0, index_vbo_.get(), 0, sizeof(std::uint32_t));
+  st->vao = GlVertexArray(id);
+  glVertexArrayVertexBuffer(id, 0, st->index_vbo.get(), 0, sizeof(std::uint32_t));
   glEnableVertexArrayAttrib(id, 0);
   glVertexArrayAttribIFormat(id, 0, 1, GL_UNSIGNED_INT, 0);
   glVertexArrayAttribBinding(id, 0, 0);
   glVertexArrayBindingDivisor(id, 0, 1);  // one sphere per instance: the command's base instance
   gl_check("SlimResources");
+  return st;
 }
 
 void SlimResources::plan_patches(std::size_t views) {
-  slots_.assign(views, static_cast<std::int64_t>(spheres_.size()));
-  if (!corner_ssbo_ && !spheres_.empty()) {
-    corner_ssbo_ = make_buffer(spheres_.size() * 4 * 4 * sizeof(float), nullptr);
+  slots_.assign(views, static_cast<std::int64_t>(st_->spheres.size()));
+  if (!corner_ssbo_ && !st_->spheres.empty()) {
+    corner_ssbo_ = make_buffer(st_->spheres.size() * 4 * 4 * sizeof(float), nullptr);
   }
 }
 
 void SlimResources::plan_views(const std::vector<Camera>& cams, const std::vector<CameraBasis>& bases,
                                const SlimSettings& settings) {
-  const std::size_t n = spheres_.size();
+  const std::size_t n = st_->spheres.size();
   const std::size_t views = cams.size();
   std::vector<DrawCommand> commands(n * views);
   std::vector<std::uint32_t> grids(2 * n * views);
   slots_.assign(views, 0);
   for (std::size_t v = 0; v < views; ++v) {
     for (std::size_t i = 0; i < n; ++i) {
-      const SlimGrid g = slim_grid(*spheres_[i], cams[v], bases[v], settings);
+      const SlimGrid g = slim_grid(*st_->spheres[i], cams[v], bases[v], settings);
       const std::uint64_t count = std::uint64_t{g.m} * g.m * g.s * g.s;
       commands[v * n + i] = {static_cast<std::uint32_t>(count), g.m > 0 ? 1u : 0u, 0,
                              static_cast<std::uint32_t>(i)};

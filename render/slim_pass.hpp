@@ -33,6 +33,7 @@
 #include "protocol/scene.hpp"
 #include "render/gl_util.hpp"
 #include "render/pass_plan.hpp"
+#include "render/scene_gpu_cache.hpp"
 
 namespace beamcast {
 
@@ -64,22 +65,41 @@ double slim_cell_diagonal(const SlimSettings& settings);
 SlimGrid slim_grid(const SlimSphere& sphere, const Camera& cam, const CameraBasis& basis,
                    const SlimSettings& settings);
 
+// What SlimResources uploads from the scene's content alone (the sphere
+// records, their order, the instance array): a SceneGpuCache entry. Holds
+// the surfaces its sphere pointers point into.
+struct SlimStatic {
+  std::vector<std::shared_ptr<const SlimSurface>> surfaces;
+  std::vector<const SlimSphere*> spheres;
+  std::size_t crease_begin = 0;
+  Vec3 anchor{};
+  Aabb box;
+  GlBuffer sphere_ssbo, index_vbo;
+  GlVertexArray vao;
+  std::size_t bytes = 0;  // what the buffers hold
+};
+
 // GPU data of a scene's SLIM surfaces (upload group "slim").
 class SlimResources {
  public:
-  explicit SlimResources(const Scene& scene);
-  std::size_t sphere_count() const { return spheres_.size(); }
+  // `content`: where the sphere records are kept across renders, by the
+  // surfaces' content, their materials and the evaluation (null: made for
+  // this render alone).
+  explicit SlimResources(const Scene& scene, SceneGpuCache* content = nullptr);
+  std::size_t sphere_count() const { return st_->spheres.size(); }
   // The spheres are held with every crease sphere after every other one:
   // spheres [0, crease_begin()) have one polynomial, the rest a min/max of
   // two, so the patch evaluation draws each run with its own program (no
   // crease rule where none is needed: llvmpipe runs a fragment shader's
   // untaken branches too).
-  std::size_t crease_begin() const { return crease_begin_; }
-  GLuint sphere_buffer() const { return sphere_ssbo_.get(); }
-  GLuint instance_vao() const { return vao_.get(); }
-  const Vec3& anchor() const { return anchor_; }
+  std::size_t crease_begin() const { return st_->crease_begin; }
+  GLuint sphere_buffer() const { return st_->sphere_ssbo.get(); }
+  GLuint instance_vao() const { return st_->vao.get(); }
+  const Vec3& anchor() const { return st_->anchor; }
   // The union of the SLIM surfaces' bounds (world space).
-  const Aabb& bounds() const { return box_; }
+  const Aabb& bounds() const { return st_->box; }
+  // The key of the scene's SLIM records in SceneGpuCache.
+  static std::string content_key(const Scene& scene);
 
   // Plans the samples of `views` cameras (one command and one grid per
   // sphere and view, view-major) and uploads them; returns the sample slots
@@ -98,12 +118,9 @@ class SlimResources {
   const std::vector<std::int64_t>& slots() const { return slots_; }
 
  private:
-  std::vector<const SlimSphere*> spheres_;
-  std::size_t crease_begin_ = 0;
-  Vec3 anchor_{};
-  Aabb box_;
-  GlBuffer sphere_ssbo_, index_vbo_, command_buffer_, grid_ssbo_, corner_ssbo_;
-  GlVertexArray vao_;
+  static std::shared_ptr<const SlimStatic> make_static(const Scene& scene);
+  std::shared_ptr<const SlimStatic> st_;
+  GlBuffer command_buffer_, grid_ssbo_, corner_ssbo_;
   std::size_t capacity_views_ = 0;
   std::vector<std::int64_t> slots_;
 };

@@ -150,6 +150,21 @@ std::string Metrics::prometheus(const Gauges& g) const {
   header(o, "beamcast_renderer_rebuilds_total", "counter",
          "Render contexts discarded and recreated after a GL error.");
   o += "beamcast_renderer_rebuilds_total " + std::to_string(g.renderer_rebuilds) + "\n";
+  header(o, "beamcast_scene_cache_bytes", "gauge",
+         "Uploads of scene content (occluder triangles, SLIM spheres) kept across renders.");
+  o += "beamcast_scene_cache_bytes " + std::to_string(g.scene_cache_bytes) + "\n";
+  header(o, "beamcast_scene_cache_budget_bytes", "gauge",
+         "The scene-content caches' budget, summed over render workers.");
+  o += "beamcast_scene_cache_budget_bytes " + std::to_string(g.scene_cache_budget_bytes) + "\n";
+  header(o, "beamcast_scene_cache_entries", "gauge", "Entries in the scene-content caches.");
+  o += "beamcast_scene_cache_entries " + std::to_string(g.scene_cache_entries) + "\n";
+  header(o, "beamcast_scene_cache_hits_total", "counter", "Renders that found their upload cached.");
+  o += "beamcast_scene_cache_hits_total " + std::to_string(g.scene_cache_hits) + "\n";
+  header(o, "beamcast_scene_cache_misses_total", "counter", "Renders that made their upload.");
+  o += "beamcast_scene_cache_misses_total " + std::to_string(g.scene_cache_misses) + "\n";
+  header(o, "beamcast_scene_cache_evictions_total", "counter",
+         "Scene-content cache entries evicted (least recently used) for the budget.");
+  o += "beamcast_scene_cache_evictions_total " + std::to_string(g.scene_cache_evictions) + "\n";
   header(o, "beamcast_queue_depth", "gauge", "Render jobs waiting for a GL worker.");
   o += "beamcast_queue_depth " + std::to_string(g.queue_depth) + "\n";
   header(o, "beamcast_inflight", "gauge", "Render jobs admitted and not yet answered.");

@@ -27,6 +27,13 @@ Metrics::Gauges sample_gauges(const ServerCore& core) {
                            core.renders->queued(WorkClass::kBatch)};
     g.renders_cancelled = core.renders->cancelled();
     g.slices_dropped = core.renders->slices_dropped();
+    const SceneGpuCache::Stats c = core.renders->scene_cache();
+    g.scene_cache_bytes = c.bytes;
+    g.scene_cache_budget_bytes = c.budget;
+    g.scene_cache_entries = c.entries;
+    g.scene_cache_hits = c.hits;
+    g.scene_cache_misses = c.misses;
+    g.scene_cache_evictions = c.evictions;
   }
   return g;
 }

@@ -57,11 +57,20 @@ class GlFrameRenderer final : public FrameRenderer {
                                   const FrameOptions& options) override {
     return renderer_.render(scene, cameras, options);
   }
+  std::uint64_t submit(const Scene& scene, const std::vector<Camera>& cameras,
+                       const FrameOptions& options) override {
+    return renderer_.submit(scene, cameras, options);
+  }
+  std::vector<FrameResult> finish(std::uint64_t ticket) override {
+    return renderer_.finish(ticket);
+  }
+  bool overlaps() const override { return true; }
   void fail_next_render_for_test() override { renderer_.fail_next_render_for_test(); }
   bool needs_photon_trace(const Scene& scene, const FrameOptions& options) override {
     return renderer_.needs_photon_trace(scene, options);
   }
   void release_idle_memory() override { renderer_.release_idle_memory(kIdlePhotonCacheBytes); }
+  SceneGpuCache::Stats scene_cache_stats() const override { return renderer_.scene_cache_stats(); }
 
  private:
   Renderer renderer_;
@@ -77,6 +86,11 @@ std::vector<std::vector<std::size_t>> make_slices(const std::vector<Camera>& cam
 }
 
 }  // namespace
+
+nlohmann::json scene_cache_json(const SceneGpuCache::Stats& s) {
+  return {{"bytes", s.bytes},   {"budget_bytes", s.budget}, {"entries", s.entries},
+          {"hits", s.hits},     {"misses", s.misses},       {"evictions", s.evictions}};
+}
 
 const char* work_class_name(WorkClass c) {
   return c == WorkClass::kInteractive ? "interactive" : "batch";
@@ -525,20 +539,49 @@ void RenderService::worker_main(int index) {
   ready_cv_.notify_all();
 
   bool released = true;  // nothing rendered since the last idle release
+  // The slice submitted last, its frames not yet taken (FrameRenderer::finish):
+  // it is finished after the next slice is submitted when more work is
+  // queued and the renderer overlaps (FrameRenderer::overlaps), so its GPU
+  // work and read-back overlap that submission; at once otherwise.
+  std::optional<SubmittedSlice> pending;
+  // After the failed job is answered: the old context goes before the new
+  // one is made current on this thread. A worker whose rebuild fails tries
+  // again before its next slice (and answers `internal` meanwhile).
+  const auto rebuild_if = [&](bool gl_failed) {
+    rebuild_pending = rebuild_pending || gl_failed;
+    if (gl_failed || !renderer) {
+      renderer.reset();
+      renderer = make_renderer(index);
+      if (renderer && rebuild_pending) {
+        rebuilds_.fetch_add(1);
+        rebuild_pending = false;
+      }
+    }
+  };
   for (;;) {
     Pick pick;
     {
       std::unique_lock lock(mu_);
+      if (pending && (stopping_ || !has_work_locked())) {
+        lock.unlock();
+        bool gl_failed = false;
+        end_slice(*pending, renderer.get(), index, &gl_failed);
+        pending.reset();
+        note_cache(renderer.get(), index);
+        rebuild_if(gl_failed);
+        continue;
+      }
       const auto woken = [&] { return stopping_ || has_work_locked(); };
       if (!released &&
           !cv_.wait_for(lock, std::chrono::milliseconds(idle_release_ms_.load()), woken)) {
-        // Not idle while photons are traced for a queued render: its
-        // slices come next and use what this renderer holds.
+        // Not idle while a job's photons are traced for it (Task::held):
+        // its render follows, with what the release would drop.
         if (traces_in_flight_ > 0) continue;
         // Idle: the caches go (server/memory.hpp, kIdleReleaseMs), then
         // the heap pages they held.
         lock.unlock();
         release_when_idle(renderer, index);
+        note_cache(renderer.get(), index);
         released = true;
         continue;
       }
@@ -591,20 +634,49 @@ void RenderService::worker_main(int index) {
       continue;
     }
     bool gl_failed = false;
-    run_slice(task, slice, renderer.get(), index, &gl_failed);
-    // After the failed job is answered: the old context goes before the new
-    // one is made current on this thread. A worker whose rebuild fails tries
-    // again before its next slice (and answers `internal` meanwhile).
-    rebuild_pending = rebuild_pending || gl_failed;
-    if (gl_failed || !renderer) {
-      renderer.reset();
-      renderer = make_renderer(index);
-      if (renderer && rebuild_pending) {
-        rebuilds_.fetch_add(1);
-        rebuild_pending = false;
-      }
+    std::optional<SubmittedSlice> next = start_slice(task, slice, renderer.get(), index, &gl_failed);
+    if (pending) {
+      // The earlier slice's read-back, overlapped by this one's submission.
+      end_slice(*pending, renderer.get(), index, &gl_failed);
+      pending.reset();
     }
+    if (next && (gl_failed || !renderer->overlaps())) {
+      // The context goes: what was submitted on it is finished first. Or
+      // the renderer rendered in submit(): nothing to overlap.
+      end_slice(*next, renderer.get(), index, &gl_failed);
+      next.reset();
+    }
+    pending = std::move(next);
+    note_cache(renderer.get(), index);
+    rebuild_if(gl_failed);
   }
+}
+
+void RenderService::note_cache(const FrameRenderer* renderer, int index) {
+  const SceneGpuCache::Stats s = renderer ? renderer->scene_cache_stats() : SceneGpuCache::Stats{};
+  std::lock_guard lock(cache_mu_);
+  auto& [base, last] = cache_stats_[index];
+  if (s.hits + s.misses < last.hits + last.misses) {  // a new renderer
+    base.hits += last.hits;
+    base.misses += last.misses;
+    base.evictions += last.evictions;
+  }
+  last = s;
+}
+
+SceneGpuCache::Stats RenderService::scene_cache() const {
+  std::lock_guard lock(cache_mu_);
+  SceneGpuCache::Stats sum;
+  for (const auto& [index, w] : cache_stats_) {
+    const auto& [base, s] = w;
+    sum.bytes += s.bytes;
+    sum.entries += s.entries;
+    sum.budget += s.budget;
+    sum.hits += base.hits + s.hits;
+    sum.misses += base.misses + s.misses;
+    sum.evictions += base.evictions + s.evictions;
+  }
+  return sum;
 }
 
 void RenderService::release_when_idle(std::unique_ptr<FrameRenderer>& renderer, int index) {
@@ -654,103 +726,152 @@ void RenderService::release_when_idle(std::unique_ptr<FrameRenderer>& renderer, 
   idle_releases_.fetch_add(1);
 }
 
-void RenderService::run_slice(const TaskPtr& t, std::size_t slice, FrameRenderer* renderer,
-                              int index, bool* gl_failed) {
-  Task& task = *t;
-  const std::vector<std::size_t>& idx = task.slices[slice];
-  std::vector<Camera> cameras;
-  cameras.reserve(idx.size());
-  for (std::size_t i : idx) cameras.push_back(task.cameras[i]);
-  std::optional<ErrorInfo> error;
-  std::vector<FrameResult> frames;
-  const auto start = Clock::now();
+// Runs `render` (a renderer call for the slice) as a render of `task`:
+// its deadline and cancellation in scope, its failures as the job's error
+// (a GL error or a cancelled render also sets *gl_failed: the context is
+// rebuilt before the next slice).
+std::optional<ErrorInfo> RenderService::guarded_render(Task& task, std::size_t slice, int index,
+                                                       bool* gl_failed, bool starting,
+                                                       const std::function<void()>& render) {
   // Merged jobs share the render: the earliest deadline holds for it.
   Clock::time_point deadline = Clock::time_point::max();
   for (const RenderJob& j : task.members) deadline = std::min(deadline, j.deadline);
   const RenderJob& first = task.members.front();
   const CancelToken token(deadline, &cancel_all_,
                           task.members.size() == 1 ? first.client_alive.get() : nullptr);
-  bool rendering = false;  // past the photon maps traced for it (Task::prep_error)
-  if (token.stopped()) {
-    error = ErrorInfo{"shutting_down", "the server is stopping: the render was cancelled", ""};
-  } else if (token.expired()) {
-    error = deadline_error(first, "before its slice " + std::to_string(slice + 1) + " of " +
-                                      std::to_string(task.slices.size()) + " started");
-  } else if (!renderer) {
+  if (starting && token.stopped()) {
+    return ErrorInfo{"shutting_down", "the server is stopping: the render was cancelled", ""};
+  }
+  if (starting && token.expired()) {
+    return deadline_error(first, "before its slice " + std::to_string(slice + 1) + " of " +
+                                     std::to_string(task.slices.size()) + " started");
+  }
+  // Past the photon maps traced for it (Task::prep_error): a slice being
+  // finished always is.
+  bool rendering = !starting;
+  const CancelScope scope(&token);
+  try {
+    if (!rendering && task.prep_error) std::rethrow_exception(task.prep_error);
+    rendering = true;
+    const InteractiveRender hold(this, task.cls == WorkClass::kInteractive);
+    render();
+    return std::nullopt;
+  } catch (const Cancelled& e) {
+    // Stopped inside a CPU loop, perhaps mid-frame: the context is
+    // rebuilt before the next slice, as after a GL error, so no state of
+    // the abandoned frame reaches another (not when shutting down, nor when
+    // the photon trace before the render was what stopped).
+    *gl_failed = *gl_failed || (rendering && e.reason() != Cancelled::Reason::kShutdown);
+    if (e.reason() == Cancelled::Reason::kShutdown) {
+      return ErrorInfo{"shutting_down", "the server is stopping: the render was cancelled", ""};
+    }
+    if (e.reason() == Cancelled::Reason::kClientGone) {
+      // Never sent: the job completes as dropped (RenderService::complete).
+      cancelled_.fetch_add(1);
+      return ErrorInfo{"internal", "the client has gone", ""};
+    }
+    const std::string where =
+        rendering ? "while rendering slice " : "while tracing photons for slice ";
+    return deadline_error(first, where + std::to_string(slice + 1) + " of " +
+                                     std::to_string(task.slices.size()));
+  } catch (const PhotonEventLimit& e) {
+    return ErrorInfo{"limit_exceeded", e.what(),
+                     first.scene_path == "/params/scene" ? "/params/scene/gi/photons"
+                                                         : first.scene_path};
+  } catch (const ProtocolError& e) {
+    ErrorInfo info = e.info();
+    info.path =
+        first.scene_path == "/params/scene" ? first.scene_path + info.path : first.scene_path;
+    return info;
+  } catch (const GlError& e) {
+    std::fprintf(stderr, "beamcast-server: render worker %d: GL error, rebuilding its context: %s\n",
+                 index, e.what());
+    *gl_failed = true;
+    return ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "beamcast-server: render failed: %s\n", e.what());
+    return ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
+  }
+}
+
+std::optional<RenderService::SubmittedSlice> RenderService::start_slice(
+    const TaskPtr& t, std::size_t slice, FrameRenderer* renderer, int index, bool* gl_failed) {
+  Task& task = *t;
+  SubmittedSlice sub{t, slice, 0, 0.0};
+  const auto start = Clock::now();
+  std::optional<ErrorInfo> error;
+  if (!renderer) {
     error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
   } else {
-    const CancelScope scope(&token);
-    try {
+    error = guarded_render(task, slice, index, gl_failed, true, [&] {
       int inject = inject_failures_.load();
       while (inject > 0 && !inject_failures_.compare_exchange_weak(inject, inject - 1)) {
       }
       if (inject > 0) renderer->fail_next_render_for_test();
-      if (task.prep_error) std::rethrow_exception(task.prep_error);
-      rendering = true;
-      InteractiveRender hold(this, task.cls == WorkClass::kInteractive);
+      std::vector<Camera> cameras;
+      cameras.reserve(task.slices[slice].size());
+      for (std::size_t i : task.slices[slice]) cameras.push_back(task.cameras[i]);
       // Merged jobs share a render only with the same stored scene and default
       // options (RenderJob::batch_key), so the first job's options hold for all.
-      frames = renderer->render(*task.members.front().scene, cameras, task.options);
-      BEAMCAST_CHECK(frames.size() == cameras.size(), "one frame per camera of a slice");
-    } catch (const Cancelled& e) {
-      // Stopped inside a CPU loop, perhaps mid-frame: the context is
-      // rebuilt before the next slice, as after a GL error, so no state of
-      // the abandoned frame reaches another (not when shutting down).
-      if (e.reason() == Cancelled::Reason::kShutdown) {
-        error = ErrorInfo{"shutting_down", "the server is stopping: the render was cancelled", ""};
-      } else if (e.reason() == Cancelled::Reason::kClientGone) {
-        // Never sent: the job completes as dropped (RenderService::complete).
-        error = ErrorInfo{"internal", "the client has gone", ""};
-        cancelled_.fetch_add(1);
-      } else {
-        const std::string where =
-            rendering ? "while rendering slice " : "while tracing photons for slice ";
-        error = deadline_error(first, where + std::to_string(slice + 1) + " of " +
-                                          std::to_string(task.slices.size()));
-      }
-      *gl_failed = rendering && e.reason() != Cancelled::Reason::kShutdown;
-    } catch (const PhotonEventLimit& e) {
-      error = ErrorInfo{"limit_exceeded", e.what(),
-                        first.scene_path == "/params/scene" ? "/params/scene/gi/photons"
-                                                            : first.scene_path};
-    } catch (const ProtocolError& e) {
-      ErrorInfo info = e.info();
-      info.path = first.scene_path == "/params/scene" ? first.scene_path + info.path
-                                                      : first.scene_path;
-      error = std::move(info);
-    } catch (const GlError& e) {
-      std::fprintf(stderr, "beamcast-server: render worker %d: GL error, rebuilding its context: %s\n",
-                   index, e.what());
-      error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
-      *gl_failed = true;
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "beamcast-server: render failed: %s\n", e.what());
-      error = ErrorInfo{"internal", std::string("render failed: ") + e.what(), ""};
-    }
+      sub.ticket = renderer->submit(*task.members.front().scene, cameras, task.options);
+    });
   }
-  const double render_ms = ms_between(start, Clock::now());
-  {
-    // The estimate charged when the slice was taken, corrected to the time
-    // measured.
-    std::lock_guard lock(mu_);
-    charge_locked(task, render_ms - task.cost_per_camera * static_cast<double>(idx.size()));
+  sub.render_ms = ms_between(start, Clock::now());
+  if (!error) return sub;
+  charge_measured(task, slice, sub.render_ms);
+  fail_slice(task, sub.render_ms, std::move(*error));
+  slices_finished(t, std::numeric_limits<std::size_t>::max(), 1 + withdraw_slices(task));
+  return std::nullopt;
+}
+
+// The estimate charged when the slice was taken, corrected to the time
+// measured (its submission and its finish).
+void RenderService::charge_measured(const Task& task, std::size_t slice, double render_ms) {
+  std::lock_guard lock(mu_);
+  charge_locked(task, render_ms - task.cost_per_camera *
+                                      static_cast<double>(task.slices[slice].size()));
+}
+
+// The job is answered with the error: its other slices are not rendered.
+void RenderService::fail_slice(Task& task, double render_ms, ErrorInfo error) {
+  malloc_trim(0);
+  std::lock_guard lock(task.mu);
+  task.render_ms += render_ms;
+  if (!task.error) task.error = std::move(error);
+}
+
+std::size_t RenderService::withdraw_slices(Task& task) {
+  std::lock_guard lock(mu_);
+  return withdraw_locked(task);
+}
+
+void RenderService::end_slice(SubmittedSlice& sub, FrameRenderer* renderer, int index,
+                              bool* gl_failed) {
+  const TaskPtr& t = sub.task;
+  Task& task = *t;
+  const std::size_t slice = sub.slice;
+  const std::vector<std::size_t>& idx = task.slices[slice];
+  std::vector<FrameResult> frames;
+  const auto start = Clock::now();
+  std::optional<ErrorInfo> error;
+  if (!renderer) {
+    error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
+  } else {
+    error = guarded_render(task, slice, index, gl_failed, false, [&] {
+      frames = renderer->finish(sub.ticket);
+      BEAMCAST_CHECK(frames.size() == idx.size(), "one frame per camera of a slice");
+    });
   }
-  if (error || render_ms >= kTrimAfterRenderMs) malloc_trim(0);
+  // The slice's own time on this worker: its submission and its finish, not
+  // the next slice's submission between them.
+  const double render_ms = sub.render_ms + ms_between(start, Clock::now());
+  charge_measured(task, slice, render_ms);
   if (error) {
-    // The job is answered with the error: its other slices are not rendered.
-    std::size_t withdrawn = 0;
-    {
-      std::lock_guard lock(mu_);
-      withdrawn = withdraw_locked(task);
-    }
-    {
-      std::lock_guard lock(task.mu);
-      task.render_ms += render_ms;
-      if (!task.error) task.error = error;
-    }
-    slices_finished(t, std::numeric_limits<std::size_t>::max(), 1 + withdrawn);
+    fail_slice(task, render_ms, std::move(*error));
+    slices_finished(t, std::numeric_limits<std::size_t>::max(), 1 + withdraw_slices(task));
     return;
   }
+  if (render_ms >= kTrimAfterRenderMs) malloc_trim(0);
   std::vector<std::size_t> encode;  // frames that get their own image (not atlas tiles)
   {
     std::lock_guard lock(task.mu);
@@ -1017,6 +1138,7 @@ void RenderService::stop() {
   {
     std::lock_guard lock(mu_);
     tracers_stopping_ = true;
+    traces_in_flight_ -= static_cast<int>(trace_queue_.size());
     trace_queue_.clear();
   }
   trace_cv_.notify_all();

@@ -22,11 +22,13 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include <boost/asio/thread_pool.hpp>
+#include <nlohmann/json.hpp>
 
 #include "server/threads.hpp"
 
@@ -52,6 +54,28 @@ class FrameRenderer {
     (void)options;
     return render(scene, cameras);
   }
+  // Two steps (Renderer::submit and finish): the service submits a slice,
+  // then the next one when more work is queued, and only then finishes the
+  // first, so a GPU's work and read-back overlap the next submission. A
+  // renderer without them renders in submit().
+  virtual std::uint64_t submit(const Scene& scene, const std::vector<Camera>& cameras,
+                               const FrameOptions& options) {
+    const std::uint64_t ticket = next_ticket_++;
+    done_[ticket] = render(scene, cameras, options);
+    return ticket;
+  }
+  // Whether submit() returns with the frames still in flight (a GPU's work
+  // and read-back), so that finishing the slice after the next submission
+  // overlaps them; false (the default): submit() renders, and each slice is
+  // finished at once (a later submission would only hold its frames back).
+  virtual bool overlaps() const { return false; }
+  virtual std::vector<FrameResult> finish(std::uint64_t ticket) {
+    const auto it = done_.find(ticket);
+    if (it == done_.end()) throw std::logic_error("finish: unknown ticket");
+    std::vector<FrameResult> frames = std::move(it->second);
+    done_.erase(it);
+    return frames;
+  }
   // Test hook (RenderService::fail_next_render_for_test): the next render
   // throws GlError from inside the renderer.
   virtual void fail_next_render_for_test() = 0;
@@ -68,7 +92,16 @@ class FrameRenderer {
   // back what is kept for later renders (caches, targets), as far as
   // repeating the last render stays cheap.
   virtual void release_idle_memory() {}
+  // The scene-content cache's use (Renderer::scene_cache_stats); none by default.
+  virtual SceneGpuCache::Stats scene_cache_stats() const { return {}; }
+
+ private:
+  std::uint64_t next_ticket_ = 1;
+  std::map<std::uint64_t, std::vector<FrameResult>> done_;  // submitted, by ticket
 };
+
+// `stats`' "scene_cache" object (bytes, budget_bytes, entries, hits, misses, evictions).
+nlohmann::json scene_cache_json(const SceneGpuCache::Stats& s);
 
 // Called on each worker thread, so a GL context is created on the thread that uses it.
 using RendererFactory = std::function<std::unique_ptr<FrameRenderer>()>;
@@ -208,6 +241,8 @@ class RenderService {
   // failed jobs `internal` and builds a new renderer (a new EGL context)
   // before it takes the next job.
   std::uint64_t renderer_rebuilds() const { return rebuilds_.load(); }
+  // The workers' scene-content caches, summed (as of each one's last slice).
+  SceneGpuCache::Stats scene_cache() const;
   // Test hook, compiled in always and reached only from tests: the next render
   // (on whichever worker takes it) fails with a real GL error
   // (Renderer::fail_next_render_for_test).
@@ -258,9 +293,25 @@ class RenderService {
   // Merges the queued tasks that may join `first` (same batch key) once its
   // window has passed; called with `lock` held, may wait on it.
   void gather_batch(Task& first, std::unique_lock<std::mutex>& lock);
-  // One slice: render it and hand its frames to the encoders.
-  void run_slice(const TaskPtr& task, std::size_t slice, FrameRenderer* renderer, int index,
-                 bool* gl_failed);
+  // A slice submitted to the renderer (FrameRenderer::submit), its frames
+  // not yet taken.
+  struct SubmittedSlice {
+    TaskPtr task;
+    std::size_t slice = 0;
+    std::uint64_t ticket = 0;
+    double render_ms = 0.0;  // the submission's wall time
+  };
+  // One slice in two steps: submitted (null if it failed, the job answered),
+  // then finished and its frames handed to the encoders.
+  std::optional<SubmittedSlice> start_slice(const TaskPtr& task, std::size_t slice,
+                                            FrameRenderer* renderer, int index, bool* gl_failed);
+  void end_slice(SubmittedSlice& sub, FrameRenderer* renderer, int index, bool* gl_failed);
+  std::optional<ErrorInfo> guarded_render(Task& task, std::size_t slice, int index,
+                                          bool* gl_failed, bool starting,
+                                          const std::function<void()>& render);
+  void charge_measured(const Task& task, std::size_t slice, double render_ms);
+  void fail_slice(Task& task, double render_ms, ErrorInfo error);
+  std::size_t withdraw_slices(Task& task);
   // The worker has been idle for idle_release_ms_: release, trim, and if
   // the process is still well above its leanest idle size, a new renderer.
   void release_when_idle(std::unique_ptr<FrameRenderer>& renderer, int index);
@@ -290,9 +341,13 @@ class RenderService {
   std::atomic<std::int64_t> idle_release_ms_;
   std::atomic<std::uint64_t> idle_releases_{0};
   std::atomic<std::uint64_t> idle_rebuilds_{0};
-  std::size_t traces_in_flight_ = 0;  // queued or tracing on the pool; guarded by mu_
   std::atomic<std::uint64_t> photon_traces_{0};
   std::atomic<std::uint64_t> photon_traces_cancelled_{0};
+  mutable std::mutex cache_mu_;
+  // By worker, guarded by cache_mu_: the counters of its discarded renderers
+  // (a rebuilt renderer starts at zero), and its renderer's last stats.
+  std::map<int, std::pair<SceneGpuCache::Stats, SceneGpuCache::Stats>> cache_stats_;
+  void note_cache(const FrameRenderer* renderer, int index);
   // The lowest RSS after an idle release; set by wait_ready to the size at
   // start plus kRebuildWhenIdleAboveBytes.
   std::atomic<std::uint64_t> idle_rss_floor_{~std::uint64_t{0}};
@@ -328,6 +383,7 @@ class RenderService {
   // tracers (kPhotonTracers, each tracing with the cores less one).
   std::deque<TaskPtr> trace_queue_;  // guarded by mu_
   bool tracers_stopping_ = false;    // guarded by mu_
+  int traces_in_flight_ = 0;         // queued or tracing; guarded by mu_
   std::condition_variable trace_cv_;
   std::vector<SizedThread> tracers_;
   std::mutex encode_mu_;

@@ -437,6 +437,7 @@ void run_method(ServerCore& core, const std::shared_ptr<Connection>& session, Re
         {"interactive", core.renders->queued(WorkClass::kInteractive)},
         {"batch", core.renders->queued(WorkClass::kBatch)}};
     s["renderer_rebuilds"] = core.renders->renderer_rebuilds();
+    s["scene_cache"] = scene_cache_json(core.renders->scene_cache());
     s["encode_threads"] = core.config.encode_threads;
     s["scenes"] = {{"count", core.scenes.count()}, {"bytes", core.scenes.bytes()}};
     session->send(ok_response(id, std::move(s)));

@@ -1,6 +1,8 @@
 #include "protocol/occluders/mesh.hpp"
 
 #include <cmath>
+#include <functional>
+#include <string_view>
 
 #include "protocol/mesh_obj.hpp"
 #include "protocol/occluders/occluder_parse.hpp"
@@ -20,7 +22,19 @@ MeshOccluder MeshOccluder::parse(const OccluderParse& in) {
   MeshOccluder mesh = load_obj_mesh(in.opts.assets_dir, name, xf, mesh_limits, file.path);
   *in.mesh_triangles += static_cast<std::int64_t>(mesh.triangles.size());
   mesh.box = mesh.bounds();
+  mesh.content_key = mesh_content_key(mesh);
   return mesh;
+}
+
+std::string mesh_content_key(const MeshOccluder& mesh) {
+  const std::string_view v(reinterpret_cast<const char*>(mesh.vertices.data()),
+                           mesh.vertices.size() * sizeof(Vec3));
+  const std::string_view t(reinterpret_cast<const char*>(mesh.triangles.data()),
+                           mesh.triangles.size() * sizeof(mesh.triangles[0]));
+  const std::size_t hv = std::hash<std::string_view>{}(v);
+  const std::size_t ht = std::hash<std::string_view>{}(t);
+  return "mesh:" + std::to_string(mesh.vertices.size()) + ":" + std::to_string(hv) + ":" +
+         std::to_string(mesh.triangles.size()) + ":" + std::to_string(ht);
 }
 
 Aabb MeshOccluder::bounds() const {

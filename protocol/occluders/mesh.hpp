@@ -20,6 +20,10 @@ struct MeshOccluder {
   // The vertices' bounds, set by parse; a mesh built by hand leaves it empty
   // and the reference then tests every triangle.
   Aabb box;
+  // Names the vertices and triangles (mesh_content_key), set by parse: the
+  // renderer's key for the uploaded triangles (render/scene_resources.hpp).
+  // Empty for a mesh built by hand: the renderer then computes it.
+  std::string content_key;
 
   static MeshOccluder parse(const OccluderParse& in);
   Aabb bounds() const;
@@ -27,5 +31,9 @@ struct MeshOccluder {
   std::optional<OccluderHit> intersect(const Vec3& o, const Vec3& v, double t_min,
                                        double t_max) const;
 };
+
+// The counts of vertices and triangles and a 64-bit hash (std::hash over
+// the bytes) of each.
+std::string mesh_content_key(const MeshOccluder& mesh);
 
 }  // namespace beamcast

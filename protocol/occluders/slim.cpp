@@ -1,6 +1,9 @@
 #include "protocol/occluders/slim.hpp"
 
 #include <algorithm>
+#include <functional>
+#include <string>
+#include <string_view>
 
 #include "protocol/check.hpp"
 #include "protocol/scene.hpp"
@@ -20,6 +23,30 @@ const std::vector<std::array<double, 2>>& SlimSurface::height_ranges() const {
     for (std::size_t i = 0; i < spheres.size(); ++i) ranges_[i] = slim_height_range(spheres[i]);
   });
   return ranges_;
+}
+
+const std::string& SlimSurface::content_key() const {
+  std::call_once(key_once_, [this] {
+    // The fields one by one (a SlimSphere's padding is not its value).
+    std::string bytes;
+    auto put = [&bytes](const auto& v) {
+      bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
+    };
+    for (const SlimSphere& s : spheres) {
+      put(s.center);
+      put(s.radius);
+      put(s.rotation);
+      put(s.poly.c);
+      put(s.poly2.c);
+      put(static_cast<int>(s.crease));
+    }
+    const std::hash<std::string_view> hash;
+    const std::string_view all(bytes);
+    const std::string_view half = all.substr(all.size() / 2);
+    key_ = "spheres:" + std::to_string(spheres.size()) + ":" + std::to_string(hash(all)) + ":" +
+           std::to_string(hash(half));
+  });
+  return key_;
 }
 
 SlimOccluder SlimOccluder::from_spheres(std::vector<SlimSphere> spheres) {

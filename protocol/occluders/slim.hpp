@@ -34,10 +34,16 @@ struct SlimSurface {
   // scene parse or a CPU render should not pay), then kept by the surface,
   // which every copy of the scene shares. Thread-safe.
   const std::vector<std::array<double, 2>>& height_ranges() const;
+  // Names the spheres' values (their count, a 64-bit hash of all their
+  // values and one of the second half): the renderer's cache key (render/slim_pass.hpp).
+  // Computed on first use and kept, like height_ranges(). Thread-safe.
+  const std::string& content_key() const;
 
  private:
   mutable std::once_flag ranges_once_;
   mutable std::vector<std::array<double, 2>> ranges_;
+  mutable std::once_flag key_once_;
+  mutable std::string key_;
 };
 
 struct SlimOccluder {

@@ -322,6 +322,19 @@ TEST(HostileRenders, MapsTracedOffTheRendererGiveTheSameFrames) {
     // Cached now: neither traces again.
     EXPECT_FALSE(itself.needs_photon_trace(scene, {}));
     EXPECT_FALSE(given.needs_photon_trace(scene, {}));
+    // The server's path (Renderer::submit, then finish) takes the handed
+    // maps too: marked by a trace time of 1e6 ms, which the frame reports
+    // (a trace of these 2e4 photons takes well under a second).
+    auto marked = std::make_shared<PhotonMaps>(*traced_before.photon_maps);
+    marked->trace_ms = 1.0e6;
+    FrameOptions handed;
+    handed.photon_maps = marked;
+    Renderer submitted;
+    const std::vector<FrameResult> c =
+        submitted.finish(submitted.submit(scene, scene.cameras, handed));
+    ASSERT_EQ(c.size(), 1u);
+    EXPECT_GE(c[0].photon_trace_ms, marked->trace_ms) << "the maps handed over were traced again";
+    EXPECT_TRUE(a[0].image.rgb == c[0].image.rgb);
   }
 }
 
