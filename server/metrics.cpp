@@ -37,6 +37,16 @@ void header(std::string& o, const char* name, const char* type, const char* help
   o += '\n';
 }
 
+// A metric of one unlabelled sample: its HELP and TYPE lines, then the value.
+void scalar(std::string& o, const char* name, const char* type, const char* help,
+            const std::string& value) {
+  header(o, name, type, help);
+  o += name;
+  o += ' ';
+  o += value;
+  o += '\n';
+}
+
 }  // namespace
 
 const char* Metrics::stage_name(Stage s) {
@@ -133,48 +143,30 @@ std::string Metrics::prometheus(const Gauges& g) const {
     o += std::string("beamcast_class_queue_depth{class=\"") + class_name(c) + "\"} " +
          std::to_string(g.class_queue_depth[c]) + "\n";
   }
-  header(o, "beamcast_renders_cancelled_total", "counter",
-         "Renders stopped between slices because their client left.");
-  o += "beamcast_renders_cancelled_total " + std::to_string(g.renders_cancelled) + "\n";
-  header(o, "beamcast_slices_dropped_total", "counter",
-         "Render slices (GPU batches) not rendered because their client left.");
-  o += "beamcast_slices_dropped_total " + std::to_string(g.slices_dropped) + "\n";
-  header(o, "beamcast_gpu_seconds_total", "counter", "GPU time of rendered frames (timer queries).");
-  o += "beamcast_gpu_seconds_total " + num(gpu_s_) + "\n";
-  header(o, "beamcast_frames_total", "counter", "Frames sent.");
-  o += "beamcast_frames_total " + std::to_string(g.frames) + "\n";
-  header(o, "beamcast_bytes_out_total", "counter", "Bytes of response frames queued for sending.");
-  o += "beamcast_bytes_out_total " + std::to_string(g.bytes_out) + "\n";
-  header(o, "beamcast_renders_dropped_total", "counter", "Queued renders dropped because their client left.");
-  o += "beamcast_renders_dropped_total " + std::to_string(g.renders_dropped) + "\n";
-  header(o, "beamcast_renderer_rebuilds_total", "counter",
-         "Render contexts discarded and recreated after a GL error.");
-  o += "beamcast_renderer_rebuilds_total " + std::to_string(g.renderer_rebuilds) + "\n";
-  header(o, "beamcast_scene_cache_bytes", "gauge",
-         "Uploads of scene content (occluder triangles, SLIM spheres) kept across renders.");
-  o += "beamcast_scene_cache_bytes " + std::to_string(g.scene_cache_bytes) + "\n";
-  header(o, "beamcast_scene_cache_budget_bytes", "gauge",
-         "The scene-content caches' budget, summed over render workers.");
-  o += "beamcast_scene_cache_budget_bytes " + std::to_string(g.scene_cache_budget_bytes) + "\n";
-  header(o, "beamcast_scene_cache_entries", "gauge", "Entries in the scene-content caches.");
-  o += "beamcast_scene_cache_entries " + std::to_string(g.scene_cache_entries) + "\n";
-  header(o, "beamcast_scene_cache_hits_total", "counter", "Renders that found their upload cached.");
-  o += "beamcast_scene_cache_hits_total " + std::to_string(g.scene_cache_hits) + "\n";
-  header(o, "beamcast_scene_cache_misses_total", "counter", "Renders that made their upload.");
-  o += "beamcast_scene_cache_misses_total " + std::to_string(g.scene_cache_misses) + "\n";
-  header(o, "beamcast_scene_cache_evictions_total", "counter",
-         "Scene-content cache entries evicted (least recently used) for the budget.");
-  o += "beamcast_scene_cache_evictions_total " + std::to_string(g.scene_cache_evictions) + "\n";
-  header(o, "beamcast_queue_depth", "gauge", "Render jobs waiting for a GL worker.");
-  o += "beamcast_queue_depth " + std::to_string(g.queue_depth) + "\n";
-  header(o, "beamcast_inflight", "gauge", "Render jobs admitted and not yet answered.");
-  o += "beamcast_inflight " + std::to_string(g.inflight) + "\n";
-  header(o, "beamcast_connections_open", "gauge", "Open client connections.");
-  o += "beamcast_connections_open " + std::to_string(g.connections_open) + "\n";
-  header(o, "beamcast_connections_total", "counter", "Connections accepted.");
-  o += "beamcast_connections_total " + std::to_string(g.connections_total) + "\n";
-  header(o, "beamcast_uptime_seconds", "gauge", "Seconds since the server started.");
-  o += "beamcast_uptime_seconds " + num(g.uptime_s) + "\n";
+  scalar(o, "beamcast_renders_cancelled_total", "counter",
+         "Renders stopped between slices because their client left.", std::to_string(g.renders_cancelled));
+  scalar(o, "beamcast_slices_dropped_total", "counter",
+         "Render slices (GPU batches) not rendered because their client left.", std::to_string(g.slices_dropped));
+  scalar(o, "beamcast_gpu_seconds_total", "counter", "GPU time of rendered frames (timer queries).", num(gpu_s_));
+  scalar(o, "beamcast_frames_total", "counter", "Frames sent.", std::to_string(g.frames));
+  scalar(o, "beamcast_bytes_out_total", "counter", "Bytes of response frames queued for sending.", std::to_string(g.bytes_out));
+  scalar(o, "beamcast_renders_dropped_total", "counter", "Queued renders dropped because their client left.", std::to_string(g.renders_dropped));
+  scalar(o, "beamcast_renderer_rebuilds_total", "counter",
+         "Render contexts discarded and recreated after a GL error.", std::to_string(g.renderer_rebuilds));
+  scalar(o, "beamcast_scene_cache_bytes", "gauge",
+         "Uploads of scene content (occluder triangles, SLIM spheres) kept across renders.", std::to_string(g.scene_cache_bytes));
+  scalar(o, "beamcast_scene_cache_budget_bytes", "gauge",
+         "The scene-content caches' budget, summed over render workers.", std::to_string(g.scene_cache_budget_bytes));
+  scalar(o, "beamcast_scene_cache_entries", "gauge", "Entries in the scene-content caches.", std::to_string(g.scene_cache_entries));
+  scalar(o, "beamcast_scene_cache_hits_total", "counter", "Renders that found their upload cached.", std::to_string(g.scene_cache_hits));
+  scalar(o, "beamcast_scene_cache_misses_total", "counter", "Renders that made their upload.", std::to_string(g.scene_cache_misses));
+  scalar(o, "beamcast_scene_cache_evictions_total", "counter",
+         "Scene-content cache entries evicted (least recently used) for the budget.", std::to_string(g.scene_cache_evictions));
+  scalar(o, "beamcast_queue_depth", "gauge", "Render jobs waiting for a GL worker.", std::to_string(g.queue_depth));
+  scalar(o, "beamcast_inflight", "gauge", "Render jobs admitted and not yet answered.", std::to_string(g.inflight));
+  scalar(o, "beamcast_connections_open", "gauge", "Open client connections.", std::to_string(g.connections_open));
+  scalar(o, "beamcast_connections_total", "counter", "Connections accepted.", std::to_string(g.connections_total));
+  scalar(o, "beamcast_uptime_seconds", "gauge", "Seconds since the server started.", num(g.uptime_s));
   return o;
 }
 
