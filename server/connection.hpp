@@ -88,7 +88,11 @@ class Connection {
     } while (!inflight_.compare_exchange_weak(current, current + 1));
     return true;
   }
-  void end_render() { inflight_.fetch_sub(1); }
+  // Ends one admitted render. Called after its answer has been queued
+  // (send or send_error): the sessions post the count's decrement behind
+  // that answer on their strand, so the connection is never idle, nor a
+  // new request refused as busy, between the two.
+  virtual void end_render() { release_render(); }
   // False once the client has gone: its queued renders are dropped.
   std::shared_ptr<const std::atomic<bool>> alive_flag() const { return alive_; }
   // Closes the connection; pending writes are dropped.
@@ -112,6 +116,7 @@ class Connection {
 
  protected:
   int renders_in_flight() const { return inflight_.load(); }
+  void release_render() { inflight_.fetch_sub(1); }
   // The client has gone: its queued renders are dropped.
   void mark_gone() { alive_->store(false); }
 

@@ -165,6 +165,9 @@ class WsSession : public Connection, public std::enable_shared_from_this<WsSessi
   void close() override {
     asio::post(ws_.get_executor(), [self = shared_from_this()] { self->close_now(); });
   }
+  void end_render() override {
+    asio::post(ws_.get_executor(), [self = shared_from_this()] { self->release_render(); });
+  }
 
  private:
   // A message is read in pieces (read_some) so that its deadline can start

@@ -306,7 +306,13 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   job.done = [&core, session, id, arrived, ctx, send_result, decision, level, ladder_size,
               budget_ms, jpeg = job.jpeg, jpeg_quality = job.jpeg_quality,
               work_class = job.work_class, video](RenderOutcome&& out) mutable {
-    session->end_render();
+    // The render ends after its answer is queued, on every path out of here
+    // (Connection::end_render): ending it first left a window in which an
+    // idle timeout closed the connection under the answer.
+    struct EndRender {
+      Connection& c;
+      ~EndRender() { c.end_render(); }
+    } end_render{*session};
     if (out.dropped) return;
     // Video: this frame's encode and send under the stream's lock.
     std::unique_lock<std::mutex> video_order;
@@ -356,10 +362,10 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
     log_request(core, id, "render", "ok", timings);
   };
   if (!core.renders->submit(std::move(job))) {
-    session->end_render();
     fail("busy", "", "the server has max_inflight_total (" +
                          std::to_string(core.config.max_inflight_total) +
                          ") renders in flight; retry later");
+    session->end_render();
   }
 }
 

@@ -193,7 +193,7 @@ void Session::on_read_deadline(const boost::system::error_code& ec) {
     if (!read_pending_) return;  // paused, not idle
     // Idle is no traffic and no work in flight: a render longer than
     // idle_timeout_ms keeps its connection (PROTOCOL.md, "Limits").
-    if (renders_in_flight() > 0) {
+    if (renders_in_flight() > 0 || writing_) {
       arm_read_deadline();
       return;
     }
@@ -315,6 +315,10 @@ void Session::on_write(const boost::system::error_code& ec, std::size_t) {
 
 void Session::resume_reading_if_paused() {
   if (writes_.resume() && state_ == ReadState::kIdle && !read_pending_) do_read_header();
+}
+
+void Session::end_render() {
+  asio::post(socket_.get_executor(), [self = shared_from_this()] { self->release_render(); });
 }
 
 void Session::close() {

@@ -33,6 +33,9 @@ class Session : public Connection, public std::enable_shared_from_this<Session> 
   void send_error(const nlohmann::json& id, const ErrorInfo& error) override;
   // Thread-safe: closes the connection (pending writes are dropped).
   void close() override;
+  // Thread-safe: the decrement runs on this session's strand, after every
+  // answer queued before the call (Connection::end_render).
+  void end_render() override;
 
 
  private:
