@@ -56,6 +56,11 @@ if [ "${BEAMCAST_SKIP_ASAN:-0}" != 1 ]; then
   # sweep runs 1/20 of its configurations (every group, same generator): the
   # full 100 000 ran in the first stage; here it looks for memory errors,
   # and the Debug + ASan CPU reference is over 10x slower.
-  BEAMCAST_SOAK_SECONDS=15 BEAMCAST_SWEEP_SIZE=5000 ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -LE bench
+  # The browser and HAProxy tests (labels preview, scaleout) are left out
+  # here: they bound reconnects and first frames in wall seconds, which a
+  # Debug + ASan server misses on a loaded machine (stop 46's red run), and
+  # the server code they drive (HTTP, WebSocket, TLS, restarts) runs under
+  # the sanitizers in the server label's tests. Saves ~125 s of the 2 cores.
+  BEAMCAST_SOAK_SECONDS=15 BEAMCAST_SWEEP_SIZE=5000 ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -LE 'bench|preview|scaleout'
 fi
 stage "done"
