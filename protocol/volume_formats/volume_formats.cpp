@@ -6,6 +6,7 @@
 
 #include "protocol/volume_formats/format_support.hpp"
 #include "protocol/volume_formats/inr.hpp"
+#include "protocol/volume_formats/metaimage.hpp"
 #include "protocol/volume_formats/nrrd.hpp"
 
 namespace beamcast {
@@ -16,6 +17,7 @@ namespace {
 const VolumeFormat kFormats[] = {
     {"nrrd", VolumeSourceType::kNrrd, {".nrrd"}, is_nrrd, read_nrrd_volume},
     {"inr", VolumeSourceType::kInr, {".inr", ".inr.gz"}, is_inr, read_inr_volume},
+    {"metaimage", VolumeSourceType::kFile, {".mha", ".mhd"}, is_metaimage, read_metaimage_volume},
 };
 
 // Enough for every row's signature.
