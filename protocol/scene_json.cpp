@@ -1023,6 +1023,18 @@ std::vector<std::string_view> names(const std::string_view (&list)[N]) {
   return {std::begin(list), std::end(list)};
 }
 
+// Each volume source type's fields besides "type".
+json volume_source_fields() {
+  json out = json::object();
+  for (std::string_view type : volume_source_types()) {
+    out[std::string(type)] = type == "raw" ? names(kVolumeRawFields)
+                             : type == "marschner_lobb" || type == "heat"
+                                 ? names(kVolumeProceduralFields)
+                                 : names(kVolumeFileFields);
+  }
+  return out;
+}
+
 }  // namespace
 
 nlohmann::json scene_capabilities() {
@@ -1050,13 +1062,8 @@ nlohmann::json scene_capabilities() {
           {"medium_region_types", std::vector<std::string_view>(std::begin(kMediumRegionTypes),
                                                                 std::end(kMediumRegionTypes))},
           {"volume_fields", names(kVolumeFields)},
-          {"volume_source_types", names(kVolumeSourceTypes)},
-          {"volume_sources",
-           {{"raw", names(kVolumeRawFields)},
-            {"nrrd", names(kVolumeFileFields)},
-            {"inr", names(kVolumeFileFields)},
-            {"marschner_lobb", names(kVolumeProceduralFields)},
-            {"heat", names(kVolumeProceduralFields)}}},
+          {"volume_source_types", volume_source_types()},
+          {"volume_sources", volume_source_fields()},
           {"volume_raw_formats", names(kVolumeRawFormats)},
           {"volume_transfer_fields", names(kVolumeTransferFields)},
           {"volume_transfer_presets", names(kVolumeTransferPresets)},

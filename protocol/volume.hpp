@@ -33,6 +33,8 @@ enum class VolumeSourceType : std::uint8_t {
   kRaw,            // headerless file: dimensions, sample type, byte order given in the scene
   kNrrd,           // NRRD (attached header; raw or gzip encoding)
   kInr,            // INRIA .inr (256-byte-multiple header; .inr.gz too)
+  kFile,           // a file in another format of the volume-format table
+                   // (protocol/volume_formats/; Volume::file names the file)
   kMarschnerLobb,  // the Marschner-Lobb test signal sampled on [-1, 1]^3 (analytic)
   kHeat,           // a dense smooth field (the seed's heat cube): heat spreading from a
                    // few sources, analytic
@@ -184,10 +186,8 @@ inline constexpr int kMaxVolumeLevel = 4;  // VolumeSettings::level's largest
 // The scene format's names, for the parser and `hello`'s capabilities.
 inline constexpr std::string_view kVolumeFields[] = {"source", "origin",   "spacing",  "rotation",
                                                      "range",  "transfer", "intensity"};
-inline constexpr std::string_view kVolumeSourceTypes[] = {"raw", "nrrd", "inr", "marschner_lobb",
-                                                          "heat"};
-// The fields of each source type besides "type": raw; nrrd and inr;
-// marschner_lobb and heat.
+// The fields of each source type besides "type": raw; the file formats
+// (protocol/volume_formats/); marschner_lobb and heat.
 inline constexpr std::string_view kVolumeRawFields[] = {"file", "dimensions", "format", "endian"};
 inline constexpr std::string_view kVolumeFileFields[] = {"file"};
 inline constexpr std::string_view kVolumeProceduralFields[] = {"resolution"};
@@ -207,6 +207,9 @@ inline constexpr std::string_view kVolumeIntegrations[] = {"point", "preintegrat
 // checked before anything is allocated. Throws ProtocolError with the JSON
 // pointer of the bad field (for a bad file, its "file").
 Volume parse_volume(const json_read::Node& n, const SceneLoadOptions& opts, std::int64_t* voxels);
+// The source types: "raw", the file formats' names (the volume-format
+// table's rows), "marschner_lobb", "heat".
+std::vector<std::string_view> volume_source_types();
 // The scene's "volume" object.
 VolumeSettings parse_volume_settings(const json_read::Node& n);
 

@@ -1,7 +1,8 @@
 // Volume files (issue 17; docs/scene-format.md, "Volumes"): headerless raw
-// files, NRRD (attached header, raw or gzip encoding) and INRIA .inr (also
-// gzip-compressed, .inr.gz), read into their stored sample type, and the
-// normalization of those samples to a VolumeGrid. Internal to protocol/:
+// files read into their stored sample type, and the normalization of any
+// file's samples to a VolumeGrid. Files with a header are read by the
+// readers of the volume-format table (protocol/volume_formats/: one file per
+// format, one row each in volume_formats.cpp). Internal to protocol/:
 // volume_json.cpp calls these. Every failure is a ProtocolError at the JSON
 // pointer of the scene's "file" field (or the field named), code
 // "bad_volume" for what is wrong inside a file; sizes are checked against
@@ -38,15 +39,17 @@ struct VolumeFileData {
   VolumeSampleType type = VolumeSampleType::kU8;
   bool big_endian = false;
   std::vector<unsigned char> bytes;  // dims' product x sample_size(type)
-  std::optional<Vec3> spacing;       // from the header: NRRD spacings, INR VX VY VZ
+  std::optional<Vec3> spacing;       // from the header (NRRD spacings, INR VX VY VZ, ...)
 };
 
 // A volume file named by a scene: where it is, its name as the scene gives
-// it (for messages) and the JSON pointer of the "file" field (for errors).
+// it (for messages), the JSON pointer of the "file" field (for errors) and
+// the assets directory it was resolved in (for files a header names).
 struct VolumeFileRef {
   std::filesystem::path full;
   std::string name;
   std::string json_path;
+  std::filesystem::path assets_dir;
 };
 
 // Dimensions read from a scene or a header, checked in this order: each at
@@ -64,16 +67,6 @@ std::array<int, 3> check_volume_dims(const std::array<std::int64_t, 3>& dims, co
 // longer: "bad_volume", with the byte counts expected and found).
 VolumeFileData read_raw_volume(const VolumeFileRef& f, const std::array<int, 3>& dims,
                                VolumeSampleType type, bool big_endian);
-// An NRRD file with an attached header: dimension 3; types uint8, int8,
-// uint16, int16, float, double (and their NRRD aliases); encoding raw or
-// gzip; "spacings" (or the lengths of "space directions") as its spacing.
-VolumeFileData read_nrrd_volume(const VolumeFileRef& f, const VoxelBudget& budget);
-// An INRIA image: the "#INRIMAGE-4#{" header of 256-byte blocks ending
-// "##}", VDIM=1, TYPE unsigned fixed, signed fixed or float, PIXSIZE 8 to
-// 64 bits, CPU decm/alpha/pc (little-endian) or sun/sgi (big-endian),
-// VX/VY/VZ as its spacing. Gzip-compressed when the name ends ".gz".
-VolumeFileData read_inr_volume(const VolumeFileRef& f, const VoxelBudget& budget);
-
 // The smallest and largest sample; "bad_volume" naming the voxel (index and
 // x, y, z) if a float sample is NaN or infinite.
 std::array<double, 2> volume_data_range(const VolumeFileData& d, const VolumeFileRef& f);

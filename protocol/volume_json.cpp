@@ -13,6 +13,7 @@
 #include "protocol/scene_readers.hpp"
 #include "protocol/volume.hpp"
 #include "protocol/volume_files.hpp"
+#include "protocol/volume_formats/volume_formats.hpp"
 
 namespace beamcast {
 
@@ -50,8 +51,37 @@ VolumeFileRef file_ref(const ObjectReader& s, const SceneLoadOptions& opts) {
   const Node file = s.required("file");
   const std::string name = read_string(file);
   if (name.empty()) fail("invalid_value", file.path, "file must be a non-empty relative path");
-  return {resolve_asset_path(opts.assets_dir, name, file.path, "volume"), name, file.path};
+  return {resolve_asset_path(opts.assets_dir, name, file.path, "volume"), name, file.path,
+          opts.assets_dir};
 }
+
+// What a source's "type" names: raw, a file format or a procedural field.
+struct SourceChoice {
+  VolumeSourceType source;
+  const VolumeFormat* format;  // null but for a file format
+};
+
+std::span<const std::pair<std::string_view, SourceChoice>> source_choices() {
+  static const std::vector<std::pair<std::string_view, SourceChoice>> choices = [] {
+    std::vector<std::pair<std::string_view, SourceChoice>> c{
+        {"raw", {VolumeSourceType::kRaw, nullptr}}};
+    for (const VolumeFormat& f : volume_formats()) c.push_back({f.name, {f.source, &f}});
+    c.push_back({"marschner_lobb", {VolumeSourceType::kMarschnerLobb, nullptr}});
+    c.push_back({"heat", {VolumeSourceType::kHeat, nullptr}});
+    return c;
+  }();
+  return choices;
+}
+
+}  // namespace
+
+std::vector<std::string_view> volume_source_types() {
+  std::vector<std::string_view> names;
+  for (const auto& [name, choice] : source_choices()) names.push_back(name);
+  return names;
+}
+
+namespace {
 
 // The default range of file data: the whole range of 8- and 16-bit unsigned
 // samples, else the data's own (a constant volume maps to 0).
@@ -67,12 +97,14 @@ std::array<double, 2> default_range(const VolumeFileData& d, const std::array<do
 Vec3 read_source(const Node& n, const SceneLoadOptions& opts, const VoxelBudget& budget,
                  const std::optional<std::array<double, 2>>& range, Volume* v) {
   ObjectReader s(n, "a volume source");
-  v->source = read_enum<VolumeSourceType>(s.required("type"),
-                                          {{"raw", VolumeSourceType::kRaw},
-                                           {"nrrd", VolumeSourceType::kNrrd},
-                                           {"inr", VolumeSourceType::kInr},
-                                           {"marschner_lobb", VolumeSourceType::kMarschnerLobb},
-                                           {"heat", VolumeSourceType::kHeat}});
+  // "type": raw, a row of the volume-format table, or a procedural field;
+  // left out beside "file", the format is found from the file itself.
+  SourceChoice choice{VolumeSourceType::kFile, nullptr};  // the format found below
+  if (s.optional("type") || !s.optional("file")) {
+    choice = read_enum<SourceChoice>(s.required("type"), source_choices());
+  }
+  v->source = choice.source;
+  const VolumeFormat* format = choice.format;
   if (v->source == VolumeSourceType::kMarschnerLobb || v->source == VolumeSourceType::kHeat) {
     allow_source_fields(s, kVolumeProceduralFields);
     // 41^3: the classic Marschner-Lobb sampling; 64^3 for the heat field.
@@ -113,8 +145,9 @@ Vec3 read_source(const Node& n, const SceneLoadOptions& opts, const VoxelBudget&
   } else {
     allow_source_fields(s, kVolumeFileFields);
     f = file_ref(s, opts);
-    d = v->source == VolumeSourceType::kNrrd ? read_nrrd_volume(f, budget)
-                                             : read_inr_volume(f, budget);
+    if (!format) format = &detect_volume_format(f);
+    v->source = format->source;
+    d = read_volume_file(*format, f, budget);
   }
   // Always scanned: a NaN voxel is refused whatever the range.
   const std::array<double, 2> data = volume_data_range(d, f);

@@ -450,7 +450,7 @@ TEST(VolumeJson, ResolutionLimits) {
 
 TEST(VolumeJson, Capabilities) {
   const json caps = scene_capabilities();
-  EXPECT_EQ(caps["volume_source_types"], json({"raw", "nrrd", "inr", "marschner_lobb", "heat"}));
+  EXPECT_EQ(caps["volume_source_types"], json({"raw", "nrrd", "inr", "metaimage", "marschner_lobb", "heat"}));
   EXPECT_EQ(caps["volume_sources"]["raw"], json({"file", "dimensions", "format", "endian"}));
   EXPECT_EQ(caps["volume_transfer_presets"], json({"grey", "bone", "ml"}));
   EXPECT_EQ(caps["volume_pyramids"], json({"average", "max", "nonzero"}));
