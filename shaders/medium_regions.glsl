@@ -12,7 +12,8 @@ uniform int u_region_count;
 // Each region's record (RegionGpu, protocol/media/region_base.hpp): a.w its
 // kind's code, a.xyz and b.xyz two points, u_region_r a radius, b.w its
 // sigma_t. Code 0 box: a min, b max; 1 sphere: a centre, r; 2 mesh: a, b
-// its bounds, its triangles in MediumTriangles.
+// its bounds, its triangles in MediumTriangles; 3 cylinder: a, b the ends
+// of its axis, r.
 uniform vec4 u_region_a[16];
 uniform vec4 u_region_b[16];
 uniform float u_region_r[16];
@@ -88,6 +89,33 @@ float region_depth(vec3 o, vec3 v, float t0, float t1) {
       float h = sqrt(h2);
       lo = max(lo, tc - h);
       hi = min(hi, tc + h);
+    } else if (kind == 3) {  // a cylinder: between its caps, within r of its axis
+      vec3 axis = b.xyz - a.xyz;
+      float len = length(axis);
+      vec3 u = axis / len;
+      vec3 w = ow - a.xyz;
+      float wu = dot(w, u), vu = dot(v, u);
+      if (vu != 0.0) {
+        float ta = -wu / vu, tb = (len - wu) / vu;
+        lo = max(lo, min(ta, tb));
+        hi = min(hi, max(ta, tb));
+      } else if (wu < 0.0 || wu > len) {
+        continue;
+      }
+      vec3 wp = w - wu * u, vp = v - vu * u;
+      float r = u_region_r[i];
+      float a2 = dot(vp, vp);
+      if (a2 > 0.0) {
+        float tc = -dot(wp, vp) / a2;
+        vec3 q = wp + tc * vp;
+        float h2 = (r * r - dot(q, q)) / a2;
+        if (h2 <= 0.0) continue;
+        float h = sqrt(h2);
+        lo = max(lo, tc - h);
+        hi = min(hi, tc + h);
+      } else if (dot(wp, wp) > r * r) {
+        continue;
+      }
     } else {  // a box, or a mesh's bounds
       vec3 inv = 1.0 / v;  // +-inf on an axis-parallel ray: the slab test still holds
       vec3 ta = (a.xyz - ow) * inv, tb = (b.xyz - ow) * inv;

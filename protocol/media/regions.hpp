@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "protocol/media/box.hpp"
+#include "protocol/media/cylinder.hpp"
 #include "protocol/media/mesh.hpp"
 #include "protocol/media/sphere.hpp"
 
@@ -19,7 +20,7 @@ namespace json_read {
 struct Node;
 }  // namespace json_read
 
-using RegionShape = std::variant<BoxRegion, SphereRegion, MeshRegion>;
+using RegionShape = std::variant<BoxRegion, SphereRegion, MeshRegion, CylinderRegion>;
 
 // The "type" strings of every kind, in RegionShape's order.
 std::vector<std::string_view> medium_region_types();
