@@ -124,15 +124,19 @@ std::string photon_key(const Scene& scene) {
   }
   k.put(scene.media.size());
   for (const MediumRegion& r : scene.media) {
-    k.put(static_cast<int>(r.shape));
-    k.put(r.lo);
-    k.put(r.hi);
-    k.put(r.radius);
+    // The kind and its GPU record (every number of a convex kind's shape),
+    // then a mesh's triangles.
+    k.put(r.shape.index());
+    const RegionGpu g = r.gpu();
+    k.put(g.code);
+    k.put(g.a);
+    k.put(g.b);
+    k.put(g.r);
     k.put(r.sigma_s);
     k.put(r.sigma_a);
     k.put(r.k);
-    k.put(r.triangles.size());
-    for (const auto& t : r.triangles) {
+    k.put(r.gpu_triangles().size());
+    for (const auto& t : r.gpu_triangles()) {
       for (const Vec3& p : t) k.put(p);
     }
   }

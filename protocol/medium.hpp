@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "protocol/media/regions.hpp"
 #include "protocol/vec.hpp"
 
 
@@ -92,27 +93,18 @@ struct Medium {
 };
 
 // A region of heterogeneous medium (seed 001 section 5.7; "media" in JSON):
-// its own coefficients inside an axis-aligned box, a sphere or a closed
-// triangle mesh, added to the scene-wide medium and to any region it
-// overlaps (the seed's fig 5.6: where A and B overlap, sigma = sigma_A +
-// sigma_B).
+// its own coefficients inside its shape (a kind of RegionShape,
+// protocol/media/: an axis-aligned box, a sphere, a closed triangle mesh),
+// added to the scene-wide medium and to any region it overlaps (the seed's
+// fig 5.6: where A and B overlap, sigma = sigma_A + sigma_B). Each function
+// of the shape is std::visit over its kinds.
 struct MediumRegion {
-  enum class Shape : unsigned char { kBox, kSphere, kMesh };
-  Shape shape = Shape::kBox;
-  Vec3 lo{};            // box: the low corner; sphere: the centre; mesh: its bounds' low corner
-  Vec3 hi{};            // box: the high corner; mesh: its bounds' high corner
-  double radius = 0.0;  // sphere
-  // Mesh: world-space triangles of a closed, consistently wound surface,
-  // wound so their normals (p1 - p0) x (p2 - p0) point outwards. Along a
-  // line the region is where more boundaries were entered (against a
-  // normal) than left (the seed's section 5.7: front faces enter, back
-  // faces leave); a line through an edge or vertex counts one crossing
-  // there (mesh_crossings in medium.cpp).
-  std::vector<std::array<Vec3, 3>> triangles;
+  RegionShape shape;
   double sigma_s = 0.0;
   double sigma_a = 0.0;
   double k = 0.0;
   double sigma_t() const { return sigma_s + sigma_a; }
+  Aabb bounds() const;
   bool contains(const Vec3& x) const;
   // The length of o + t v (|v| = 1), t in [t0, t1], inside the region.
   double chord(const Vec3& o, const Vec3& v, double t0, double t1) const;
@@ -120,21 +112,16 @@ struct MediumRegion {
   // it never is inside.
   double exit(const Vec3& o, const Vec3& v) const;
   // Appends the ray parameters in (0, t_end) where o + t v crosses the
-  // region's boundary (a box or sphere: where it enters and leaves).
+  // region's boundary (a convex kind: where it enters and leaves).
   void crossings(const Vec3& o, const Vec3& v, double t_end, std::vector<double>* out) const;
-
- private:
-  // [a, b]: the part of [t0, t1] inside (empty if b <= a).
-  void clip(const Vec3& o, const Vec3& v, double* a, double* b) const;
+  // Its record for shaders/medium_regions.glsl and the triangles it puts in
+  // the shader's SSBO (none but a mesh's).
+  RegionGpu gpu() const;
+  RegionTriangles gpu_triangles() const;
 };
 
 // Regions per scene (the shaders hold them in uniform arrays of this size).
 inline constexpr int kMaxMediumRegions = 16;
-// Triangles of all mesh regions of a scene together: a shader evaluating
-// optical depth tests every triangle of each mesh whose bounds the ray
-// meets, several times per pixel, so a region boundary is a coarse hull
-// (an icosphere of 320 triangles, a box of 12), not a detailed model.
-inline constexpr std::int64_t kMaxMediumMeshTriangles = 1024;
 
 // The scene-wide medium and the regions together: coefficients at a point,
 // optical depth along a segment (exact: chords of boxes and spheres), and
@@ -181,12 +168,8 @@ inline constexpr double kMediumExtent = 1e12;
 // e^-32 or more (at the default step), below any pixel's resolution.
 inline constexpr int kMaxBeamSubPieces = 32;
 
-// The fields of "medium", for `hello`'s capabilities.
-inline constexpr std::string_view kMediumRegionFields[] = {
-    "type",     "min",      "max",       "center",    "radius",   "vertices", "triangles",
-    "file",     "translate", "scale",    "rotation",  "sigma_s",  "sigma_a",  "k",
-    "g"};
-inline constexpr std::string_view kMediumRegionTypes[] = {"box", "sphere", "mesh"};
+// The fields of "medium", for `hello`'s capabilities (a region's:
+// medium_region_fields, protocol/media/regions.hpp).
 inline constexpr std::string_view kMediumFields[] = {
     "sigma_s", "sigma_a",   "k",      "g",
     "beam_rule", "beam_step", "estimator", "radius", "radius_pixels", "segments"};
@@ -194,11 +177,11 @@ inline constexpr std::string_view kMediumFields[] = {
 // Throws ProtocolError (code, message, JSON path) for a bad field: negative
 // coefficients, |k| >= 1 or |g| > kSchlickMaxG, both k and g.
 Medium parse_medium(const json_read::Node& n);
-// One entry of "media": coordinates and radius bounded by the limits'
-// max_abs_coordinate; a mesh from an OBJ file below the options' assets
-// directory or inline (vertices, triangles), refused ("bad_mesh", with the
-// path) unless closed and consistently wound; `mesh_triangles` counts the
-// scene's mesh-region triangles against kMaxMediumMeshTriangles.
+// One entry of "media": its kind by "type" (parse_region_shape, each
+// kind's parse: coordinates and radii bounded by the limits'
+// max_abs_coordinate, a mesh refused unless closed), then its coefficients;
+// `mesh_triangles` counts the scene's mesh-region triangles against
+// kMaxMediumMeshTriangles.
 MediumRegion parse_medium_region(const json_read::Node& n, const SceneLoadOptions& opts,
                                  std::int64_t* mesh_triangles);
 

@@ -90,7 +90,7 @@ RequestCost estimate_request_cost(const Scene& scene, const std::vector<Camera>&
   double medium_parts = 0.0;
   if (scene.has_medium()) {
     medium_parts = 1.0;
-    for (const MediumRegion& r : scene.media) medium_parts += 1.0 + r.triangles.size();
+    for (const MediumRegion& r : scene.media) medium_parts += 1.0 + r.gpu_triangles().size();
   }
   if (scene.has_gi()) {
     add("lit_pixels", pixels, w.lit_pixel, "/cameras");

@@ -706,18 +706,20 @@ GLint set_medium_uniforms(ProgramPair& program, bool multiview, const FrameConte
               global ? static_cast<float>(global->sigma_t()) : 0.0f);
   const int n = std::min<int>(static_cast<int>(scene.media.size()), kMaxMediumRegions);
   std::array<float, 4 * kMaxMediumRegions> a{}, b{};
+  std::array<float, kMaxMediumRegions> radius{};
   std::array<GLint, 2 * kMaxMediumRegions> tris{};
   GLint first = 0;
   for (int i = 0; i < n; ++i) {
     const MediumRegion& r = scene.media[static_cast<std::size_t>(i)];
-    const bool sphere = r.shape == MediumRegion::Shape::kSphere;
+    const RegionGpu g = r.gpu();
     for (std::size_t k = 0; k < 3; ++k) {
-      a[4 * i + k] = static_cast<float>(r.lo[k]);
-      b[4 * i + k] = static_cast<float>(sphere ? (k == 0 ? r.radius : 0.0) : r.hi[k]);
+      a[4 * i + k] = static_cast<float>(g.a[k]);
+      b[4 * i + k] = static_cast<float>(g.b[k]);
     }
-    a[4 * i + 3] = sphere ? 1.0f : (r.shape == MediumRegion::Shape::kMesh ? 2.0f : 0.0f);
+    a[4 * i + 3] = static_cast<float>(g.code);
     b[4 * i + 3] = static_cast<float>(r.sigma_t());
-    const auto count = static_cast<GLint>(r.triangles.size());
+    radius[static_cast<std::size_t>(i)] = static_cast<float>(g.r);
+    const auto count = static_cast<GLint>(r.gpu_triangles().size());
     tris[2 * i] = first;
     tris[2 * i + 1] = count;
     first += count;
@@ -726,6 +728,7 @@ GLint set_medium_uniforms(ProgramPair& program, bool multiview, const FrameConte
   if (n > 0) {
     glUniform4fv(program.uniform(multiview, "u_region_a"), n, a.data());
     glUniform4fv(program.uniform(multiview, "u_region_b"), n, b.data());
+    glUniform1fv(program.uniform(multiview, "u_region_r"), n, radius.data());
   }
   if (first > 0) {
     glUniform2iv(program.uniform(multiview, "u_region_tris"), n, tris.data());

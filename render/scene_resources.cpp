@@ -263,7 +263,7 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
 void SceneResources::upload_medium_meshes() {
   std::vector<float> data;
   for (const MediumRegion& r : scene_.media) {
-    for (const auto& t : r.triangles) {
+    for (const auto& t : r.gpu_triangles()) {
       for (const Vec3& p : t) {
         data.insert(data.end(), {static_cast<float>(p[0]), static_cast<float>(p[1]),
                                  static_cast<float>(p[2]), 0.0f});

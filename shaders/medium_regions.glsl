@@ -9,8 +9,14 @@
 // regions, made the volume pass 1.6x slower.
 #ifdef BEAMCAST_MEDIUM_REGIONS
 uniform int u_region_count;
-uniform vec4 u_region_a[16];  // box: min (xyz), w 0; sphere: centre (xyz), w 1; mesh: bounds' min, w 2
-uniform vec4 u_region_b[16];  // box, mesh: max (xyz); sphere: x radius; w: sigma_t
+// Each region's record (RegionGpu, protocol/media/region_base.hpp): a.w its
+// kind's code, a.xyz and b.xyz two points, u_region_r a radius, b.w its
+// sigma_t. Code 0 box: a min, b max; 1 sphere: a centre, r; 2 mesh: a, b
+// its bounds, its triangles in MediumTriangles; 3 cylinder: a, b the ends
+// of its axis, r.
+uniform vec4 u_region_a[16];
+uniform vec4 u_region_b[16];
+uniform float u_region_r[16];
 uniform ivec2 u_region_tris[16];  // mesh: its first triangle and their count
 uniform vec3 u_region_eye;
 // The mesh regions' triangles, world space, three vertices (xyz) each.
@@ -71,16 +77,45 @@ float region_depth(vec3 o, vec3 v, float t0, float t1) {
   for (int i = 0; i < u_region_count; ++i) {
     vec4 a = u_region_a[i];
     vec4 b = u_region_b[i];
+    int kind = int(a.w + 0.5);
     float lo = t0, hi = t1;
-    if (a.w > 0.5 && a.w < 1.5) {  // a sphere
+    if (kind == 1) {  // a sphere
       vec3 oc = a.xyz - ow;
       float tc = dot(oc, v);
       vec3 perp = oc - tc * v;
-      float h2 = b.x * b.x - dot(perp, perp);
+      float r = u_region_r[i];
+      float h2 = r * r - dot(perp, perp);
       if (h2 <= 0.0) continue;
       float h = sqrt(h2);
       lo = max(lo, tc - h);
       hi = min(hi, tc + h);
+    } else if (kind == 3) {  // a cylinder: between its caps, within r of its axis
+      vec3 axis = b.xyz - a.xyz;
+      float len = length(axis);
+      vec3 u = axis / len;
+      vec3 w = ow - a.xyz;
+      float wu = dot(w, u), vu = dot(v, u);
+      if (vu != 0.0) {
+        float ta = -wu / vu, tb = (len - wu) / vu;
+        lo = max(lo, min(ta, tb));
+        hi = min(hi, max(ta, tb));
+      } else if (wu < 0.0 || wu > len) {
+        continue;
+      }
+      vec3 wp = w - wu * u, vp = v - vu * u;
+      float r = u_region_r[i];
+      float a2 = dot(vp, vp);
+      if (a2 > 0.0) {
+        float tc = -dot(wp, vp) / a2;
+        vec3 q = wp + tc * vp;
+        float h2 = (r * r - dot(q, q)) / a2;
+        if (h2 <= 0.0) continue;
+        float h = sqrt(h2);
+        lo = max(lo, tc - h);
+        hi = min(hi, tc + h);
+      } else if (dot(wp, wp) > r * r) {
+        continue;
+      }
     } else {  // a box, or a mesh's bounds
       vec3 inv = 1.0 / v;  // +-inf on an axis-parallel ray: the slab test still holds
       vec3 ta = (a.xyz - ow) * inv, tb = (b.xyz - ow) * inv;
@@ -89,7 +124,7 @@ float region_depth(vec3 o, vec3 v, float t0, float t1) {
       hi = min(hi, min(tmax.x, min(tmax.y, tmax.z)));
     }
     if (hi <= lo) continue;
-    tau += b.w * (a.w > 1.5 ? mesh_chord(ow, v, lo, hi, u_region_tris[i]) : hi - lo);
+    tau += b.w * (kind == 2 ? mesh_chord(ow, v, lo, hi, u_region_tris[i]) : hi - lo);
   }
   return tau;
 }

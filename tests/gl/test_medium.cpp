@@ -9,6 +9,8 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include "protocol/scene_json.hpp"
@@ -446,15 +448,18 @@ TEST(Medium, AMeshBoundedLayerIsTheBoxLayer) {
   Scene mesh = box;
   ASSERT_EQ(mesh.media.size(), 1u);
   MediumRegion& r = mesh.media[0];
+  const auto& layer = std::get<BoxRegion>(r.shape);
   std::vector<Vec3> corner;
   for (int i = 0; i < 8; ++i) {
-    corner.push_back({(i & 1 ? r.hi : r.lo)[0], (i & 2 ? r.hi : r.lo)[1], (i & 4 ? r.hi : r.lo)[2]});
+    corner.push_back({(i & 1 ? layer.hi : layer.lo)[0], (i & 2 ? layer.hi : layer.lo)[1],
+                      (i & 4 ? layer.hi : layer.lo)[2]});
   }
-  r.shape = MediumRegion::Shape::kMesh;
+  std::vector<std::array<Vec3, 3>> triangles;
   for (const json& t : test::cube_triangles()) {
-    r.triangles.push_back({corner[t[0].get<std::size_t>()], corner[t[1].get<std::size_t>()],
-                           corner[t[2].get<std::size_t>()]});
+    triangles.push_back({corner[t[0].get<std::size_t>()], corner[t[1].get<std::size_t>()],
+                         corner[t[2].get<std::size_t>()]});
   }
+  r.shape = MeshRegion::from_triangles(std::move(triangles));
   const HdrImage a = renderer().render(box, FrameOptions{.read_hdr = true})[0].hdr;
   const HdrImage b = renderer().render(mesh, FrameOptions{.read_hdr = true})[0].hdr;
   const HdrError e = compare_hdr(b, a);

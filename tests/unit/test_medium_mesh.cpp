@@ -59,7 +59,7 @@ TEST(MediumMesh, ACubeMeshHasTheBoxsChords) {
       scene_with({{"type", "box"}, {"min", {-1, -1, -1}}, {"max", {1, 1, 1}}, {"sigma_a", 1.0}}),
       {});
   ASSERT_EQ(mesh.media.size(), 1u);
-  EXPECT_EQ(mesh.media[0].triangles.size(), 12u);
+  EXPECT_EQ(mesh.media[0].gpu_triangles().size(), 12u);
   const MediumField fm = mesh.medium_field(), fb = box.medium_field();
   for (const Vec3& v : {Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}, Vec3{-1, 0, 0}}) {
     const Vec3 o = -3.0 * v;
