@@ -2,7 +2,8 @@
 # The test command (= CI): installs dependencies, builds everything, runs every
 # test; then clang-tidy (.clang-tidy: clang-analyzer-*) over the project's
 # sources, the fuzz targets (ctest -L fuzz, clang + libFuzzer, protocol/ only)
-# and the whole suite again under ASan + UBSan (build-asan/).
+# and the suite again under ASan + UBSan (build-asan/), less the labels bench,
+# preview and scaleout.
 # Extra arguments go to the main ctest run only (e.g. -L image, -R Shaders) and
 # skip the clang-tidy, fuzz and sanitizer stages; BEAMCAST_SKIP_ASAN=1 skips the ASan stage.
 set -euo pipefail
