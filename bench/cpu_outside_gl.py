@@ -22,14 +22,13 @@ Writes cpu_outside_gl.csv and cpu_outside_gl.md to --out.
 """
 import argparse
 import csv
-import json
 import os
 import statistics
 import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from frame_times import ROOT, SCENES, slim_scenes  # noqa: E402
+from frame_times import ROOT, load_scenes  # noqa: E402
 from beamcast_client import BeamcastClient  # noqa: E402
 
 FIELDS = ["server_ms", "render_ms", "gpu_ms", "readback_ms", "encode_ms", "outside_ms"]
@@ -79,11 +78,7 @@ def main() -> None:
     ap.add_argument("--only", nargs="*", help="only these scene names")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
-    scenes = []
-    for name, what, file in SCENES:
-        with open(os.path.join(ROOT, "examples", file)) as f:
-            scenes.append((name, what, json.load(f)))
-    scenes += slim_scenes(a.slim, a.assets) if a.slim else []
+    scenes = load_scenes(a.slim, a.assets)
     if a.only:
         scenes = [s for s in scenes if s[0] in a.only]
     runs = {"old": [], "new": []}

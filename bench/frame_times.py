@@ -103,6 +103,15 @@ def slim_scenes(pairs, assets):
     return out
 
 
+def load_scenes(slim, assets):
+    """(name, what, scene) for every example row, then each SLIM pair's two."""
+    scenes = []
+    for name, what, file in SCENES:
+        with open(os.path.join(ROOT, "examples", file)) as f:
+            scenes.append((name, what, json.load(f)))
+    return scenes + (slim_scenes(slim, assets) if slim else [])
+
+
 def time_scene(client, name, scene, size, frames, camera=None):
     """Puts `scene` as `name` and renders it `frames` + 1 times, one camera a
     request: the first camera at size x size, or camera(i) for request i
@@ -162,12 +171,7 @@ def main():
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
 
-    scenes = []
-    for name, what, file in SCENES:
-        with open(os.path.join(ROOT, "examples", file)) as f:
-            scenes.append((name, what, json.load(f)))
-    if a.slim:
-        scenes += [(n, w, s) for n, w, s in slim_scenes(a.slim, a.assets)]
+    scenes = load_scenes(a.slim, a.assets)
     if a.only:
         scenes = [s for s in scenes if s[0] in a.only]
 
