@@ -3,7 +3,7 @@
 legal renders in a loop, against two servers in one run, interleaved.
 
     python3 bench/starvation.py NEW_SERVER [OLD_SERVER] [--seconds S] [--rounds R]
-        [--abuser caustic|fog]
+        [--abuser caustic|fog|specular]
 
 Issue 43, must-show "Starvation": each round starts each server in turn
 (--no-demo) and runs, for S seconds each (default 15):
@@ -16,7 +16,10 @@ Issue 43, must-show "Starvation": each round starts each server in turn
    clustering and search trees and the specular pass. `--abuser fog`: a point
    light in a closed sphere of fog, 1e5 photons up to 64 scattering events
    each, 64 x 64 (issue 43's item 3 at a legal size): photon tracing is
-   nearly all of it.
+   nearly all of it. `--abuser specular`: the caustic box at 384 x 384 with
+   4 x 4 specular rays a pixel traced on the CPU and few photons: the CPU
+   `specular` pass inside the slice is most of it (issue 43: a slice of
+   seconds, which a server with turns inside slices cuts into 50 ms turns).
 
 Prints per server the small client's renders, p50 / p99 / max (ms) per phase,
 pooled over the rounds, the abuser's answers, its median render_ms per slice
@@ -64,6 +67,18 @@ def costly_scene(seed):
         scene = json.load(f)
     scene["cameras"][0]["width"] = scene["cameras"][0]["height"] = 128
     scene["gi"] = {"seed": seed, "photons": 1000000, "caustic_photons": 1000000}
+    return scene
+
+
+def specular_scene(seed):
+    # The CPU specular pass inside the slice: the caustic box at 384 x 384
+    # with 4 x 4 rays a mirror or glass pixel and few photons (the trace is
+    # short; the pass is most of the slice). On a hardware GL "auto" traces
+    # these rays on the GPU; "cpu" keeps the abuser the same everywhere.
+    scene = costly_scene(seed)
+    scene["cameras"][0]["width"] = scene["cameras"][0]["height"] = 384
+    scene["gi"] = {"seed": seed, "photons": 20000, "caustic_photons": 20000,
+                   "specular_samples": 4, "specular_tracer": "cpu"}
     return scene
 
 
@@ -117,7 +132,7 @@ def main():
     ap.add_argument("old", nargs="?")
     ap.add_argument("--seconds", type=float, default=15.0)
     ap.add_argument("--rounds", type=int, default=2)
-    ap.add_argument("--abuser", choices=["caustic", "fog"], default="caustic")
+    ap.add_argument("--abuser", choices=["caustic", "fog", "specular"], default="caustic")
     a = ap.parse_args()
     servers = [("new", a.new)] + ([("old", a.old)] if a.old else [])
     results = {name: {"alone": [], "beside": [], "answers": []} for name, _ in servers}
@@ -126,7 +141,8 @@ def main():
         order = servers if r % 2 == 0 else list(reversed(servers))
         for name, path in order:
             one_round(path, a.seconds, results[name],
-                      costly_scene if a.abuser == "caustic" else fog_scene)
+                      {"caustic": costly_scene, "fog": fog_scene,
+                       "specular": specular_scene}[a.abuser])
             print(f"round {r + 1} {name} done, load {os.getloadavg()[0]:.1f}", flush=True)
     print(f"load average at end: {os.getloadavg()[0]:.1f}")
     print("| server | small client | renders | p50 ms | p99 ms | max ms |")

@@ -12,6 +12,7 @@
 
 #include "protocol/camera.hpp"
 #include "protocol/cancel.hpp"
+#include "protocol/turns.hpp"
 #include "render/gl_util.hpp"
 #include "render/gl_validate.hpp"
 #include "render/passes.hpp"
@@ -78,6 +79,16 @@ struct PendingReadback {
   }
 };
 
+// A frame's timestamps (one before the first pass, one after each) and the
+// time given to other renders in turns (protocol/turns.hpp) as each was
+// issued: a pass's own time is its timestamps' difference less the turns
+// between them.
+struct PassStamps {
+  std::vector<GlQuery> queries;
+  std::vector<double> turn_ms;  // turn_ms_taken() when each query was issued
+  double turns() const { return turn_ms.empty() ? 0.0 : turn_ms.back() - turn_ms.front(); }
+};
+
 struct Renderer::Impl {
   std::unique_ptr<EglContext> context;
   std::array<std::unique_ptr<Pass>, kPassCount> passes;  // by PassId
@@ -91,7 +102,7 @@ struct Renderer::Impl {
   // Timestamps (frame start, then one after each pass), one set per read-back
   // slot: a slot's set is read when its read-back completes, before the slot
   // is used again.
-  std::array<std::vector<GlQuery>, 2> query_sets;
+  std::array<PassStamps, 2> query_sets;
   // Double-buffered pixel pack buffers and their read-backs in flight, by slot.
   std::array<GlBuffer, 2> pbos;
   std::array<std::size_t, 2> pbo_bytes{};
@@ -128,36 +139,52 @@ struct Renderer::Impl {
 
   // Clears the plan's targets and runs its passes, with a timestamp before
   // the first and after each (plan.passes.size() + 1 queries).
-  void run_passes(const Scene& scene, FrameContext& ctx, std::vector<GlQuery>& queries) {
+  void run_passes(const Scene& scene, FrameContext& ctx, PassStamps& stamps) {
     const FramePlan& plan = ctx.plan;
+    std::vector<GlQuery>& queries = stamps.queries;
     while (queries.size() < plan.passes.size() + 1) {
       GLuint id = 0;
       glGenQueries(1, &id);
       queries.emplace_back(id);
     }
+    stamps.turn_ms.assign(plan.passes.size() + 1, 0.0);
     glDepthMask(GL_TRUE);
     glQueryCounter(queries[0].get(), GL_TIMESTAMP);
+    stamps.turn_ms[0] = turn_ms_taken();
     ctx.targets.clear(plan, scene.background);
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
       const PassDecl& decl = *plan.passes[i];
       const GlPassLabel label(decl.name);
       passes[static_cast<std::size_t>(decl.id)]->execute(ctx, decl);
       glQueryCounter(queries[i + 1].get(), GL_TIMESTAMP);
+      stamps.turn_ms[i + 1] = turn_ms_taken();
+      // Between passes a long frame may give waiting renders a turn
+      // (protocol/turns.hpp): its own commands complete first, so the turn's
+      // time is the other render's (taken out of the next pass's time).
+      // Where turns may be taken each pass is flushed, so that a software
+      // rasterizer, which draws at a flush, draws it now and the time since
+      // the last turn counts it.
+      if (i + 1 < plan.passes.size() && turn_hook_installed()) {
+        glFlush();
+        turn_point([] { glFinish(); });
+      }
     }
     gl_check("frame");
   }
 
   // Pass times of the last run_passes (waits for the GPU).
-  BatchTiming read_timings(const FramePlan& plan, const std::vector<GlQuery>& queries) {
+  BatchTiming read_timings(const FramePlan& plan, const PassStamps& st) {
     std::vector<GLuint64> stamps(plan.passes.size() + 1);
     for (std::size_t i = 0; i < stamps.size(); ++i) {
-      glGetQueryObjectui64v(queries[i].get(), GL_QUERY_RESULT, &stamps[i]);
+      glGetQueryObjectui64v(st.queries[i].get(), GL_QUERY_RESULT, &stamps[i]);
     }
     BatchTiming t;
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
-      t.passes.push_back({plan.passes[i]->name, (stamps[i + 1] - stamps[i]) * 1e-6});
+      const double turns = st.turn_ms[i + 1] - st.turn_ms[i];
+      t.passes.push_back(
+          {plan.passes[i]->name, std::max(0.0, (stamps[i + 1] - stamps[i]) * 1e-6 - turns)});
     }
-    t.gpu_ms = (stamps.back() - stamps.front()) * 1e-6;
+    t.gpu_ms = std::max(0.0, (stamps.back() - stamps.front()) * 1e-6 - st.turns());
     return t;
   }
 
@@ -281,7 +308,8 @@ struct Renderer::Impl {
 
     const bool wide = scene.output.bit_depth == 16;
     if (synchronous(opts)) {
-      read_batch_now(plan, sub.frames, idx, w, h, wide, slot, ms_since(wall0));
+      read_batch_now(plan, sub.frames, idx, w, h, wide, slot,
+                     ms_since(wall0) - query_sets[static_cast<std::size_t>(slot)].turns());
     } else {
       const std::size_t bytes = 3 * static_cast<std::size_t>(w) * h * k * (wide ? 2 : 1);
       bind_pack_buffer(slot, bytes);
@@ -389,7 +417,7 @@ struct Renderer::Impl {
     p.w = w;
     p.h = h;
     p.wide = wide;
-    p.submit_ms = ms_since(wall0);
+    p.submit_ms = ms_since(wall0) - query_sets[static_cast<std::size_t>(slot)].turns();
   }
 
   // Waits for a fence in bounded steps (kFenceStepNs), up to kFenceLimitMs;

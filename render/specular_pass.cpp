@@ -1,5 +1,6 @@
 #include "render/specular_pass.hpp"
 
+#include <chrono>
 #include <vector>
 
 #include "gi/parallel.hpp"
@@ -12,6 +13,9 @@
 namespace beamcast {
 
 namespace {
+
+// How often the CPU path offers a turn while its rows are traced.
+constexpr std::chrono::milliseconds kTurnCheck{10};
 
 class SpecularPass final : public Pass {
  public:
@@ -83,8 +87,9 @@ class SpecularPass final : public Pass {
       glGetTextureSubImage(albedo_tex, 0, 0, 0, v, w, h, 1, GL_RGBA, GL_FLOAT,
                            static_cast<GLsizei>(albedo.size() * sizeof(float)), albedo.data());
       out.assign(4 * n, 0.0f);
-      // Rows bottom-up, as GL stores them and camera_ray counts them.
-      parallel_items(h, 0, [&](int y) {
+      // Rows bottom-up, as GL stores them and camera_ray counts them; a long
+      // pass gives waiting renders turns between rows (protocol/turns.hpp).
+      parallel_items_with_turns(h, 0, [&](int y) {
         for (int x = 0; x < w; ++x) {
           const std::size_t i = static_cast<std::size_t>(y) * w + x;
           const float material = albedo[4 * i + 3];
@@ -104,7 +109,7 @@ class SpecularPass final : public Pass {
             out[4 * i + static_cast<std::size_t>(k)] = static_cast<float>(c[k]);
           out[4 * i + 3] = 1.0f;
         }
-      });
+      }, [] { glFinish(); }, kTurnCheck);
       if (multi) {
         glTextureSubImage3D(out_tex, 0, 0, 0, v, w, h, 1, GL_RGBA, GL_FLOAT, out.data());
       } else {

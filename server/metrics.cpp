@@ -147,6 +147,8 @@ std::string Metrics::prometheus(const Gauges& g) const {
          "Renders stopped between slices because their client left.", std::to_string(g.renders_cancelled));
   scalar(o, "beamcast_slices_dropped_total", "counter",
          "Render slices (GPU batches) not rendered because their client left.", std::to_string(g.slices_dropped));
+  scalar(o, "beamcast_render_turns_total", "counter",
+         "Cheap slices rendered in turns inside long ones.", std::to_string(g.turns));
   scalar(o, "beamcast_gpu_seconds_total", "counter", "GPU time of rendered frames (timer queries).", num(gpu_s_));
   scalar(o, "beamcast_frames_total", "counter", "Frames sent.", std::to_string(g.frames));
   scalar(o, "beamcast_bytes_out_total", "counter", "Bytes of response frames queued for sending.", std::to_string(g.bytes_out));

@@ -44,6 +44,7 @@ class Metrics {
     std::array<int, kClasses> class_queue_depth{};  // jobs with slices not yet taken
     std::uint64_t renders_cancelled = 0;  // stopped between slices: the client left
     std::uint64_t slices_dropped = 0;     // GPU batches not rendered for that reason
+    std::uint64_t turns = 0;              // slices run in turns inside others
     // The render workers' scene-content caches (RenderService::scene_cache).
     std::uint64_t scene_cache_bytes = 0, scene_cache_budget_bytes = 0, scene_cache_entries = 0;
     std::uint64_t scene_cache_hits = 0, scene_cache_misses = 0, scene_cache_evictions = 0;

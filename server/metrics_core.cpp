@@ -27,6 +27,7 @@ Metrics::Gauges sample_gauges(const ServerCore& core) {
                            core.renders->queued(WorkClass::kBatch)};
     g.renders_cancelled = core.renders->cancelled();
     g.slices_dropped = core.renders->slices_dropped();
+    g.turns = core.renders->turns_taken();
     const SceneGpuCache::Stats c = core.renders->scene_cache();
     g.scene_cache_bytes = c.bytes;
     g.scene_cache_budget_bytes = c.budget;

@@ -17,6 +17,7 @@
 #include "gi/photon_map.hpp"
 #include "protocol/cancel.hpp"
 #include "protocol/check.hpp"
+#include "protocol/turns.hpp"
 
 #include "render/gl_util.hpp"
 #include "render/image.hpp"
@@ -164,6 +165,16 @@ struct RenderService::Task {
                        [](const RenderJob& j) { return j.client_alive->load(); });
   }
   bool streamed() const { return members.size() == 1 && members[0].on_part != nullptr; }
+  // Whether this task's next slice may run in a turn inside `inside`'s
+  // (RenderService::set_turn): another connection's, of the same or a
+  // higher class, not held, estimated cheap, and not waiting for a batch
+  // window to gather (which would block the turn). Under the service's mu_.
+  bool fits_turn(const Task& inside, std::chrono::milliseconds batch_window) const {
+    if (client == inside.client || cls > inside.cls || held) return false;
+    if (!started && batch_key != nullptr && batch_window.count() > 0) return false;
+    const std::size_t n = next_slice < slices.size() ? slices[next_slice].size() : 1;
+    return cost_per_camera * static_cast<double>(n) <= kTurnSliceMaxCost;
+  }
   // The frames of slice `s` as a part of the (single-job) streamed response.
   RenderOutcome part(std::size_t s) {
     RenderOutcome o;
@@ -206,6 +217,7 @@ RenderService::RenderService(RendererFactory factory, int workers, int encode_th
       png_(png),
       max_inflight_(max_inflight),
       idle_release_ms_(kIdleReleaseMs),
+      turn_ms_(kRenderTurnMs),
       encoders_(static_cast<std::size_t>(std::max(1, encode_threads))) {
   for (int i = 0; i < std::max(1, workers); ++i) {
     workers_.emplace_back([this, i] { worker_main(i); });
@@ -316,17 +328,29 @@ void RenderService::enqueue_locked(const TaskPtr& task, bool front) {
 
 namespace {
 
+// Whether a connection of the class has a next task `fits` takes.
+template <class Queue, class Fits>
+bool any_queued(const Queue& q, const Fits& fits) {
+  return std::any_of(q.turns.begin(), q.turns.end(), [&](std::uint64_t client) {
+    const auto it = q.by_client.find(client);
+    return it != q.by_client.end() && !it->second.empty() && fits(*it->second.front());
+  });
+}
+
 // Whether a connection of the class has queued work that is not held
 // (photon tracing off the workers).
 template <class Queue>
 bool has_ready_work(const Queue& q) {
-  return std::any_of(q.turns.begin(), q.turns.end(), [&](std::uint64_t client) {
-    const auto it = q.by_client.find(client);
-    return it != q.by_client.end() && !it->second.empty() && !it->second.front()->held;
-  });
+  return any_queued(q, [](const auto& task) { return !task.held; });
 }
 
 }  // namespace
+
+bool RenderService::turn_work_locked(const Task& inside) const {
+  return std::any_of(queues_.begin(), queues_.end(), [&](const ClassQueue& q) {
+    return any_queued(q, [&](const Task& t) { return t.fits_turn(inside, batch_window_); });
+  });
+}
 
 bool RenderService::has_work_locked() const {
   return std::any_of(queues_.begin(), queues_.end(),
@@ -346,11 +370,16 @@ void RenderService::charge_locked(const Task& task, double ms) {
 // start; of that connection's tasks, the oldest. The connection then goes to the back of the turns.
 // A task's first slice is preceded by a check for photon tracing
 // (Pick::check), which holds its connection until the worker answers.
-RenderService::Pick RenderService::pick_locked(std::unique_lock<std::mutex>& lock) {
+RenderService::Pick RenderService::pick_locked(std::unique_lock<std::mutex>& lock,
+                                              const Task* inside) {
+  // In a turn: only what fits it (Task::fits_turn).
+  const auto fits = [&](const Task& t) {
+    return inside == nullptr ? !t.held : t.fits_turn(*inside, batch_window_);
+  };
   for (;;) {
     ClassQueue* q = nullptr;
     for (ClassQueue& c : queues_) {
-      if (has_ready_work(c)) {
+      if (any_queued(c, fits)) {
         q = &c;
         break;
       }
@@ -367,7 +396,7 @@ RenderService::Pick RenderService::pick_locked(std::unique_lock<std::mutex>& loc
       BEAMCAST_CHECK(queued != q->by_client.end() && !queued->second.empty(),
                      "a connection in the turns has queued work");
       const Task& next = *queued->second.front();
-      if (next.held) continue;
+      if (!fits(next)) continue;
       const auto used = q->used.find(q->turns[i]);
       starts[i] = std::max(q->vtime, used == q->used.end() ? 0.0 : used->second);
       const std::size_t cameras =
@@ -529,8 +558,138 @@ std::size_t RenderService::withdraw_locked(Task& task) {
   return left;
 }
 
+// A worker's turn hook (protocol/turns.hpp), installed while one of its
+// slices renders: once the slice has rendered for turn_ms_ since it started
+// or since its last turn, and a slice that fits a turn is queued
+// (Task::fits_turn), the next such slice runs (RenderService::run_turn) on
+// this worker's second renderer, made on the first turn, and the slice
+// goes on. The turns' wall time is not the slice's: start_slice takes it
+// out of the slice's measured time, so its connection is not charged it.
+class RenderService::WorkerTurns final : public TurnHook {
+ public:
+  WorkerTurns(RenderService* service, int index) : service_(service), index_(index) {}
+  void begin(const Task& task) {
+    running_ = &task;
+    last_ = Clock::now();
+    given_ms_ = 0.0;
+  }
+  void end() { running_ = nullptr; }
+  // Wall time given to turns since begin().
+  double given_ms() const { return given_ms_; }
+  int index() const { return index_; }
+  // Drops the turns' renderer (idle, or after a GL error in a turn).
+  void release() { renderer.reset(); }
+
+  bool due() override {
+    if (running_ == nullptr || unavailable_) return false;
+    if (ms_between(last_, Clock::now()) < static_cast<double>(service_->turn_ms_.load())) {
+      return false;
+    }
+    std::lock_guard lock(service_->mu_);
+    return !service_->stopping_ && service_->turn_work_locked(*running_);
+  }
+  void take() override {
+    const auto t0 = Clock::now();
+    if (!renderer) renderer = service_->make_renderer(index_);
+    if (!renderer) {
+      // No second context on this device: no turns (the slice goes on).
+      unavailable_ = true;
+      return;
+    }
+    // Photon-trace checks (Pick::check) come first for a new task; the
+    // turn ends after one slice, or when nothing fits any more.
+    for (;;) {
+      Pick pick;
+      {
+        std::unique_lock lock(service_->mu_);
+        if (!service_->stopping_) pick = service_->pick_locked(lock, running_);
+      }
+      if (!pick.task) break;
+      service_->run_turn(*this, pick);
+      if (!pick.check) break;
+    }
+    last_ = Clock::now();
+    given_ms_ += ms_between(t0, last_);
+  }
+
+  std::unique_ptr<FrameRenderer> renderer;  // the turns' own (own GL context)
+
+ private:
+  RenderService* service_;
+  int index_;
+  const Task* running_ = nullptr;
+  Clock::time_point last_;
+  double given_ms_ = 0.0;
+  bool unavailable_ = false;
+};
+
+void RenderService::run_turn(WorkerTurns& turns, const Pick& pick) {
+  FrameRenderer* renderer = turns.renderer.get();
+  if (pick.check) {
+    check_prep(pick.task, renderer, turns.index());
+    return;
+  }
+  turns_taken_.fetch_add(1);
+  if (!pick.task->any_alive()) {
+    drop_gone(pick);
+    return;
+  }
+  // Rendered and finished at once: the turn ends with nothing in flight.
+  bool gl_failed = false;
+  std::optional<SubmittedSlice> sub =
+      start_slice(pick.task, pick.slice, renderer, turns.index(), &gl_failed, nullptr);
+  if (sub) end_slice(*sub, renderer, turns.index(), &gl_failed);
+  if (gl_failed) {
+    turns.release();  // a new one at the next turn
+    rebuilds_.fetch_add(1);
+  }
+}
+
+void RenderService::check_prep(const TaskPtr& task, FrameRenderer* renderer, int index) {
+  // Photon tracing goes to the CPU pool (the job's connection waits, this
+  // worker serves others); a job whose clients have gone is dropped at its
+  // slice, after the next pick.
+  bool trace = false;
+  try {
+    trace = renderer && task->any_alive() && !cancel_all_.load() &&
+            renderer->needs_photon_trace(*task->members.front().scene, task->options);
+  } catch (const std::exception& e) {
+    // The render itself reports what went wrong.
+    std::fprintf(stderr, "beamcast-server: render worker %d: %s\n", index, e.what());
+  }
+  after_check(task, trace);
+}
+
+// Between slices: a job whose clients have all gone costs no more GPU time.
+// Its remaining slices leave the queue; nothing is answered.
+void RenderService::drop_gone(const Pick& pick) {
+  const TaskPtr& task = pick.task;
+  std::size_t withdrawn = 0;
+  {
+    std::lock_guard lock(mu_);
+    withdrawn = withdraw_locked(*task);
+  }
+  bool first_cancel = false;
+  {
+    std::lock_guard lock(task->mu);
+    first_cancel = !task->cancelled;
+    task->cancelled = true;
+  }
+  if (first_cancel) {
+    if (pick.slice == 0) {
+      dropped_.fetch_add(task->members.size());  // never reached the GPU
+    } else {
+      cancelled_.fetch_add(1);
+    }
+  }
+  slices_dropped_.fetch_add(1 + withdrawn);
+  slices_finished(task, std::numeric_limits<std::size_t>::max(), 1 + withdrawn);
+}
+
 void RenderService::worker_main(int index) {
   std::unique_ptr<FrameRenderer> renderer = make_renderer(index);
+  // Declared after `renderer`: the turns' renderer goes first.
+  WorkerTurns turns(this, index);
   bool rebuild_pending = false;  // a GL error discarded the renderer, no new one yet
   {
     std::lock_guard lock(mu_);
@@ -578,8 +737,9 @@ void RenderService::worker_main(int index) {
         // its render follows, with what the release would drop.
         if (traces_in_flight_ > 0) continue;
         // Idle: the caches go (server/memory.hpp, kIdleReleaseMs), then
-        // the heap pages they held.
+        // the heap pages they held; the turns' renderer goes whole.
         lock.unlock();
+        turns.release();
         release_when_idle(renderer, index);
         note_cache(renderer.get(), index);
         released = true;
@@ -594,47 +754,16 @@ void RenderService::worker_main(int index) {
     const std::size_t slice = pick.slice;
     if (!task) continue;
     if (pick.check) {
-      // Photon tracing goes to the CPU pool (the job's connection waits,
-      // this worker serves others); a job whose clients have gone is
-      // dropped at its slice, below, after the next pick.
-      bool trace = false;
-      try {
-        trace = renderer && task->any_alive() && !cancel_all_.load() &&
-                renderer->needs_photon_trace(*task->members.front().scene, task->options);
-      } catch (const std::exception& e) {
-        // The render itself reports what went wrong.
-        std::fprintf(stderr, "beamcast-server: render worker %d: %s\n", index, e.what());
-      }
-      after_check(task, trace);
+      check_prep(task, renderer.get(), index);
       continue;
     }
-    // Between slices: a job whose clients have all gone costs no more GPU
-    // time. Its remaining slices leave the queue; nothing is answered.
     if (!task->any_alive()) {
-      std::size_t withdrawn = 0;
-      {
-        std::lock_guard lock(mu_);
-        withdrawn = withdraw_locked(*task);
-      }
-      bool first_cancel = false;
-      {
-        std::lock_guard lock(task->mu);
-        first_cancel = !task->cancelled;
-        task->cancelled = true;
-      }
-      if (first_cancel) {
-        if (slice == 0) {
-          dropped_.fetch_add(task->members.size());  // never reached the GPU
-        } else {
-          cancelled_.fetch_add(1);
-        }
-      }
-      slices_dropped_.fetch_add(1 + withdrawn);
-      slices_finished(task, std::numeric_limits<std::size_t>::max(), 1 + withdrawn);
+      drop_gone(pick);
       continue;
     }
     bool gl_failed = false;
-    std::optional<SubmittedSlice> next = start_slice(task, slice, renderer.get(), index, &gl_failed);
+    std::optional<SubmittedSlice> next =
+        start_slice(task, slice, renderer.get(), index, &gl_failed, &turns);
     if (pending) {
       // The earlier slice's read-back, overlapped by this one's submission.
       end_slice(*pending, renderer.get(), index, &gl_failed);
@@ -795,14 +924,17 @@ std::optional<ErrorInfo> RenderService::guarded_render(Task& task, std::size_t s
 }
 
 std::optional<RenderService::SubmittedSlice> RenderService::start_slice(
-    const TaskPtr& t, std::size_t slice, FrameRenderer* renderer, int index, bool* gl_failed) {
+    const TaskPtr& t, std::size_t slice, FrameRenderer* renderer, int index, bool* gl_failed,
+    WorkerTurns* turns) {
   Task& task = *t;
   SubmittedSlice sub{t, slice, 0, 0.0};
   const auto start = Clock::now();
   std::optional<ErrorInfo> error;
+  if (turns != nullptr) turns->begin(task);
   if (!renderer) {
     error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
   } else {
+    const TurnScope scope(turns);
     error = guarded_render(task, slice, index, gl_failed, true, [&] {
       int inject = inject_failures_.load();
       while (inject > 0 && !inject_failures_.compare_exchange_weak(inject, inject - 1)) {
@@ -816,7 +948,9 @@ std::optional<RenderService::SubmittedSlice> RenderService::start_slice(
       sub.ticket = renderer->submit(*task.members.front().scene, cameras, task.options);
     });
   }
-  sub.render_ms = ms_between(start, Clock::now());
+  // Turns given inside it are the other slices' time, not this one's.
+  sub.render_ms = ms_between(start, Clock::now()) - (turns != nullptr ? turns->given_ms() : 0.0);
+  if (turns != nullptr) turns->end();
   if (!error) return sub;
   charge_measured(task, slice, sub.render_ms);
   fail_slice(task, sub.render_ms, std::move(*error));

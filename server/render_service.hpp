@@ -112,6 +112,15 @@ RendererFactory gl_renderer_factory(const RendererOptions& opts);
 // frames (`quality: "auto"`, the preview) are served before batch work, slice
 // by slice; within a class connections take turns.
 enum class WorkClass { kInteractive = 0, kBatch = 1 };
+
+// Turns inside a slice (RenderService::set_turn, PROTOCOL.md "Scheduling"):
+// how long (ms) a slice renders before a waiting cheap slice gets a turn
+// inside it, and the most a slice may be estimated to cost (cost units,
+// protocol/request_cost.hpp) to run in a turn. 250 admits one 512 x 512
+// camera of beams or of a lit scene's raster passes (10 + 262 144 pixels x
+// 4e-4 = 115); a costly slice waits for the worker as before.
+inline constexpr int kRenderTurnMs = 50;
+inline constexpr double kTurnSliceMaxCost = 250.0;
 inline constexpr int kWorkClasses = 2;
 const char* work_class_name(WorkClass c);
 
@@ -215,6 +224,15 @@ class RenderService {
   // encoders, and the preview frame then has them to itself.
   void set_hold_batch_encodes(bool hold);
 
+  // Turns inside a slice (protocol/turns.hpp): a slice that has rendered for
+  // `turn` lets one waiting cheap slice (estimated at most kTurnSliceMaxCost)
+  // of another connection, of its class or a higher one, run between its
+  // passes or row blocks, on a second renderer of the same worker, and so
+  // on every `turn` after. Default kRenderTurnMs; 0: at every turn point.
+  void set_turn(std::chrono::milliseconds turn) { turn_ms_.store(turn.count()); }
+  // Slices run in turns inside other slices.
+  std::uint64_t turns_taken() const { return turns_taken_.load(); }
+
   // A worker that has rendered nothing for `idle` releases its renderer's
   // caches (FrameRenderer::release_idle_memory) and trims the heap, once
   // per idle spell. Default kIdleReleaseMs (server/memory.hpp).
@@ -280,7 +298,20 @@ class RenderService {
     std::size_t slice = 0;
     bool check = false;
   };
-  Pick pick_locked(std::unique_lock<std::mutex>& lock);
+  // `inside` (a turn, protocol/turns.hpp): the task whose slice is
+  // rendering on this thread; only a slice that may run in its turn is
+  // picked (Task::fits_turn), or none.
+  Pick pick_locked(std::unique_lock<std::mutex>& lock, const Task* inside = nullptr);
+  // Whether a slice that may run in a turn inside `inside` is queued.
+  bool turn_work_locked(const Task& inside) const;
+  // A worker's turns: its hook, and the second renderer that turns run on.
+  class WorkerTurns;
+  void run_turn(WorkerTurns& turns, const Pick& pick);
+  // A Pick::check answered with `renderer` (photon tracing needed or not).
+  void check_prep(const TaskPtr& task, FrameRenderer* renderer, int index);
+  // A picked slice whose clients have all gone: it and the task's remaining
+  // slices leave without rendering.
+  void drop_gone(const Pick& pick);
   // The worker's answer to a Pick::check: traces the maps on the CPU pool
   // (the task's connection still waits) or lets the task's slices be taken.
   void after_check(const TaskPtr& task, bool trace);
@@ -303,8 +334,10 @@ class RenderService {
   };
   // One slice in two steps: submitted (null if it failed, the job answered),
   // then finished and its frames handed to the encoders.
+  // `turns` (null inside a turn): installed as the slice's turn hook.
   std::optional<SubmittedSlice> start_slice(const TaskPtr& task, std::size_t slice,
-                                            FrameRenderer* renderer, int index, bool* gl_failed);
+                                            FrameRenderer* renderer, int index, bool* gl_failed,
+                                            WorkerTurns* turns);
   void end_slice(SubmittedSlice& sub, FrameRenderer* renderer, int index, bool* gl_failed);
   std::optional<ErrorInfo> guarded_render(Task& task, std::size_t slice, int index,
                                           bool* gl_failed, bool starting,
@@ -343,6 +376,8 @@ class RenderService {
   std::atomic<std::uint64_t> idle_rebuilds_{0};
   std::atomic<std::uint64_t> photon_traces_{0};
   std::atomic<std::uint64_t> photon_traces_cancelled_{0};
+  std::atomic<std::int64_t> turn_ms_;
+  std::atomic<std::uint64_t> turns_taken_{0};
   mutable std::mutex cache_mu_;
   // By worker, guarded by cache_mu_: the counters of its discarded renderers
   // (a rebuilt renderer starts at zero), and its renderer's last stats.

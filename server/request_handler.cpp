@@ -439,6 +439,7 @@ void run_method(ServerCore& core, const std::shared_ptr<Connection>& session, Re
     s["renders_dropped"] = core.renders->dropped();
     s["renders_cancelled"] = core.renders->cancelled();
     s["slices_dropped"] = core.renders->slices_dropped();
+    s["turns"] = core.renders->turns_taken();
     s["queue_depth_by_class"] = {
         {"interactive", core.renders->queued(WorkClass::kInteractive)},
         {"batch", core.renders->queued(WorkClass::kBatch)}};

@@ -12,6 +12,7 @@
 
 #include "protocol/camera.hpp"
 #include "protocol/scene_json.hpp"
+#include "protocol/turns.hpp"
 #include "render/egl_context.hpp"
 #include "render/gl_debug.hpp"
 #include "render/gl_util.hpp"
@@ -54,6 +55,47 @@ TEST(Contexts, TwoRenderersInterleavedEqualTheirFramesAlone) {
   }
   b.reset();
   EXPECT_EQ(frame(*a, beams), a_alone) << "after the other renderer was destroyed";
+}
+
+// Turns inside a frame (protocol/turns.hpp), as the server's render worker
+// takes them: renderer A renders the caustic Cornell box (its specular rays
+// on the CPU, in row blocks) with a hook that is always due and renders a
+// beam frame on renderer B at every turn. A's frame equals A's frame alone
+// and every B frame equals B's alone, bit for bit: a turn leaves the other
+// renderer's context, targets and half-done frame as they were. The turns
+// come between passes and between the specular pass's row blocks (48 rows
+// in blocks that start at the core count and grow at most 4x a block: at
+// least 3 blocks, so 2 turns inside that pass).
+TEST(Contexts, TurnsInsideAFrameLeaveBothFramesAsAlone) {
+  Scene caustic = small_example("cornell_caustic", 48);
+  caustic.gi.specular_tracer = SpecularTracer::kCpu;
+  const Scene beams = small_example("paper_1set", 32);
+  Renderer a, b;
+  const auto a_alone = frame(a, caustic);
+  const auto b_alone = frame(b, beams);
+  struct Hook final : TurnHook {
+    Renderer* other = nullptr;
+    const Scene* scene = nullptr;
+    std::vector<std::vector<std::uint16_t>> frames;
+    bool due() override { return true; }
+    void take() override { frames.push_back(frame(*other, *scene)); }
+  } hook;
+  hook.other = &b;
+  hook.scene = &beams;
+  const double before = turn_ms_taken();
+  std::vector<std::uint16_t> a_turned;
+  {
+    const TurnScope scope(&hook);
+    a_turned = frame(a, caustic);
+  }
+  EXPECT_EQ(a_turned, a_alone) << "A's frame changed by the turns inside it";
+  // Passes - 1 boundaries plus the specular pass's 2.
+  EXPECT_GE(hook.frames.size(), 4u);
+  for (std::size_t k = 0; k < hook.frames.size(); ++k) {
+    EXPECT_EQ(hook.frames[k], b_alone) << "B's frame in turn " << k;
+  }
+  EXPECT_GT(turn_ms_taken(), before);
+  EXPECT_EQ(frame(a, caustic), a_alone) << "after the turns";
 }
 
 // A context the caller has current stays current across a render, and a

@@ -20,6 +20,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "protocol/turns.hpp"
 #include "render/gl_util.hpp"
 #include "server/render_service.hpp"
 
@@ -84,9 +85,17 @@ struct FakeRendererControl {
     if (slow) {
       const int ms = slow_ms;
       lock.unlock();
-      std::this_thread::sleep_for(std::chrono::milliseconds(ms));
+      // In 1 ms steps, each followed by a turn point (protocol/turns.hpp)
+      // as a real renderer's passes are; end_slow_renders() cuts it short.
+      const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+      while (std::chrono::steady_clock::now() < end && !slow_end.load()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        turn_point([] {});
+      }
     }
   }
+  // Slow renders in progress and to come return at their next step.
+  void end_slow_renders() { slow_end.store(true); }
 
   std::mutex mu;
   std::condition_variable cv;
@@ -95,6 +104,7 @@ struct FakeRendererControl {
   std::set<std::size_t> held;
   std::string slow_prefix;
   int slow_ms = 0;
+  std::atomic<bool> slow_end{false};
 };
 
 class FakeFrameRenderer final : public FrameRenderer {

@@ -245,6 +245,53 @@ TEST(Scheduling, WithoutTheHoldBatchEncodesRunBesideAnInteractiveRender) {
   check_encode_hold(false);
 }
 
+// Turns inside a slice (RenderService::set_turn, protocol/turns.hpp): one
+// worker renders connection A's slice, which runs until the test ends it
+// (the fake renderer's slow render, a turn point every 1 ms). A cheap render
+// of connection B, submitted meanwhile, is answered while A's slice is
+// still in the renderer; a costly one of connection C (estimated over
+// kTurnSliceMaxCost) is not rendered in a turn and waits for the worker.
+// Without turns B waits for A's whole slice (here: until the 20 s poll fails).
+TEST(Scheduling, ACheapRenderRunsInATurnInsideALongSlice) {
+  auto control = std::make_shared<test::FakeRendererControl>();
+  RenderService service(test::fake_renderer_factory(control), 1, 1, PngSettings{}, 16);
+  service.wait_ready();
+  service.set_turn(std::chrono::milliseconds(5));
+  const auto scene = std::make_shared<const Scene>(parse_scene(test::tiny_scene(8), {}));
+  control->slow_renders("a_", 60000);
+  const auto job = [&](const char* name, std::uint64_t client, double cost,
+                       std::atomic<int>* answered) {
+    RenderJob j;
+    j.scene = scene;
+    j.cameras = {scene->cameras.front()};
+    j.cameras[0].name = name;
+    j.client_alive = std::make_shared<std::atomic<bool>>(true);
+    j.arrived = std::chrono::steady_clock::now();
+    j.client = client;
+    j.cost = cost;
+    j.done = [answered](RenderOutcome&& o) {
+      EXPECT_FALSE(o.error.has_value()) << o.error->message;
+      answered->fetch_add(1);
+    };
+    return j;
+  };
+  std::atomic<int> a{0}, b{0}, c{0};
+  ASSERT_TRUE(service.submit(job("a_0", 1, 10.0, &a)));
+  ASSERT_TRUE(eventually([&] { return control->call_count() == 1; }));
+  ASSERT_TRUE(service.submit(job("c_0", 3, 10.0 * kTurnSliceMaxCost, &c)));
+  ASSERT_TRUE(service.submit(job("b_0", 2, 10.0, &b)));
+  const bool b_in_turn = eventually([&] { return b.load() == 1; });
+  const int a_then = a.load();
+  const auto log_then = control->call_log();
+  control->end_slow_renders();
+  EXPECT_TRUE(b_in_turn) << "the cheap render waited for the long slice";
+  EXPECT_EQ(a_then, 0);
+  for (const auto& call : log_then) EXPECT_NE(call.at(0), "c_0") << "a costly slice ran in a turn";
+  EXPECT_TRUE(eventually([&] { return a.load() == 1 && c.load() == 1; }));
+  EXPECT_GE(service.turns_taken(), 1u);
+  service.stop();
+}
+
 TEST(Scheduling, ADisconnectedClientsJobStopsWithinOneSlice) {
   auto control = std::make_shared<test::FakeRendererControl>();
   test::LocalServer s({}, test::fake_renderer_factory(control));
