@@ -16,10 +16,10 @@
 
 #include "protocol/data_dir.hpp"
 #include "protocol/scene_json.hpp"
+#include "render/accuracy_controller.hpp"
 #include "render/image.hpp"
 #include "render/jpeg.hpp"
 #include "render/renderer.hpp"
-#include "server/accuracy_controller.hpp"
 
 namespace {
 

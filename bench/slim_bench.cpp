@@ -16,8 +16,7 @@
 #include "render/renderer.hpp"
 #include "render/slim_compare.hpp"
 #include "slim/mesh_io.hpp"
-// The generated shapes the tests use (header-only).
-#include "tests/common/slim_shapes.hpp"
+#include "slim/test_shapes.hpp"  // the generated shapes the tests use (header-only)
 
 namespace beamcast::bench {
 

@@ -27,11 +27,11 @@
 
 #include "protocol/data_dir.hpp"
 #include "protocol/scene_json.hpp"
+#include "render/accuracy_controller.hpp"
 #include "render/image.hpp"
 #include "render/jpeg.hpp"
 #include "render/renderer.hpp"
 #include "render/video.hpp"
-#include "server/accuracy_controller.hpp"
 
 namespace {
 

@@ -9,10 +9,10 @@
 #include <optional>
 
 #include "protocol/scene_json.hpp"
+#include "render/accuracy_controller.hpp"
 #include "render/image.hpp"
 #include "render/reference.hpp"
 #include "render/renderer.hpp"
-#include "server/accuracy_controller.hpp"
 
 namespace beamcast::bench {
 
@@ -130,7 +130,7 @@ std::vector<Row> table_rows(bool quick) {
   return rows;
 }
 
-// The preview's ladder for volume scenes (server/accuracy_controller.hpp),
+// The preview's ladder for volume scenes (render/accuracy_controller.hpp),
 // level by level: what a dragging user sees at each step.
 std::vector<Row> ladder_rows(const VolumeSettings& full) {
   std::vector<Row> rows;

@@ -15,7 +15,7 @@ void add_info_command(CLI::App& app);
 void add_server_commands(CLI::App& app);
 // `bench accuracy`: integration settings against the CPU reference (bench/).
 void add_bench_command(CLI::App& app);
-// `load`: a load generator against beamcast-server (load_command.cpp).
+// `load`: a load generator against beamcast-server (bench/load_generator.hpp).
 void add_load_command(CLI::App& app);
 // `slim fit`: a SLIM surface fitted to a triangle mesh (slim/).
 void add_slim_command(CLI::App& app);

@@ -34,7 +34,7 @@ Color trace_radiance(const GiScene& gi, const Vec3& o, const Vec3& v, double t_m
                      const PathTraceOptions& opts, std::mt19937_64& rng);
 
 // Linear radiance of every pixel of `cam`, rows from the top of the picture
-// down (render/image.hpp's HdrImage layout): index y * width + x.
+// down (protocol/hdr_image.hpp's HdrImage layout): index y * width + x.
 std::vector<Color> path_trace(const GiScene& gi, const Camera& cam, const PathTraceOptions& opts);
 
 }  // namespace beamcast

@@ -10,7 +10,7 @@
 
 #include "gi/gi_scene.hpp"
 #include "gi/photon_map.hpp"
-#include "render/image.hpp"
+#include "protocol/hdr_image.hpp"
 
 namespace beamcast {
 

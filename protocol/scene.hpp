@@ -143,7 +143,7 @@ struct GiSettings {
   // first photons in storage order, i.e. whole paths of the first chunks,
   // their power scaled by 1 / share, the default radii taken at the drawn
   // count). Set by the preview's accuracy controller for moving frames
-  // (server/accuracy_controller.hpp): the maps stay cached, nothing is
+  // (render/accuracy_controller.hpp): the maps stay cached, nothing is
   // traced again.
   double display_fraction = 1.0;
   // Not in JSON: the most photon events (surface hits and medium

@@ -8,20 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "protocol/hdr_image.hpp"  // HdrImage
 #include "protocol/scene.hpp"
 
 namespace beamcast {
-
-// Linear radiance/energy, RGB, rows from the top of the picture down.
-struct HdrImage {
-  int width = 0;
-  int height = 0;
-  std::vector<float> rgb;  // 3 * width * height
-  float* at(int x, int y) { return &rgb[3 * (static_cast<std::size_t>(y) * width + x)]; }
-  const float* at(int x, int y) const {
-    return &rgb[3 * (static_cast<std::size_t>(y) * width + x)];
-  }
-};
 
 // Display-encoded RGB, rows from the top down; values 0..255 (bit_depth 8) or
 // 0..65535 (bit_depth 16).

@@ -16,7 +16,7 @@
 
 #include "protocol/errors.hpp"
 #include "protocol/frame_format.hpp"
-#include "server/accuracy_controller.hpp"
+#include "render/accuracy_controller.hpp"
 #include "server/video_stream.hpp"
 
 namespace beamcast {

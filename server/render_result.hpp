@@ -10,7 +10,7 @@
 
 #include "protocol/camera.hpp"
 #include "protocol/render_response.hpp"
-#include "server/accuracy_controller.hpp"
+#include "render/accuracy_controller.hpp"
 #include "server/render_service.hpp"
 
 namespace beamcast {

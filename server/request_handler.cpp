@@ -11,7 +11,7 @@
 #include "server/auth.hpp"
 #include "server/limits.hpp"
 #include "server/session.hpp"
-#include "server/accuracy_controller.hpp"
+#include "render/accuracy_controller.hpp"
 #include "server/render_result.hpp"
 #include "server/connection.hpp"
 

@@ -13,7 +13,7 @@
 #include "protocol/occluders/slim.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/renderer.hpp"
-#include "tests/common/slim_shapes.hpp"
+#include "slim/test_shapes.hpp"
 
 namespace beamcast {
 namespace {

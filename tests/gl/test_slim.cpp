@@ -12,7 +12,7 @@
 #include "render/reference.hpp"
 #include "render/renderer.hpp"
 #include "render/slim_compare.hpp"
-#include "tests/common/slim_shapes.hpp"
+#include "slim/test_shapes.hpp"
 
 namespace beamcast {
 namespace {

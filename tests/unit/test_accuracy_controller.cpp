@@ -1,8 +1,8 @@
-// The accuracy controller (server/accuracy_controller.hpp) without GL: fed
+// The accuracy controller (render/accuracy_controller.hpp) without GL: fed
 // synthetic frame costs and a synthetic clock.
 #include <gtest/gtest.h>
 
-#include "server/accuracy_controller.hpp"
+#include "render/accuracy_controller.hpp"
 
 namespace beamcast {
 namespace {

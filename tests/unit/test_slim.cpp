@@ -16,7 +16,7 @@
 #include "protocol/slim_io.hpp"
 #include "protocol/slim_model.hpp"
 #include "render/slim_compare.hpp"
-#include "tests/common/slim_shapes.hpp"
+#include "slim/test_shapes.hpp"
 
 namespace beamcast {
 namespace {

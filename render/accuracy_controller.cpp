@@ -1,4 +1,4 @@
-#include "server/accuracy_controller.hpp"
+#include "render/accuracy_controller.hpp"
 
 #include <algorithm>
 #include <cmath>

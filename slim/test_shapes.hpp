@@ -2,6 +2,7 @@
 // a sphere, a torus and a plane covered by support spheres whose local
 // quadratics are the shapes' own second-order expansions, so the blended
 // surface lies within a known distance of the exact shape.
+// Header-only; here in slim/ (not tests/) so bench/ can use it too.
 #pragma once
 
 #include <cmath>
