@@ -762,6 +762,15 @@ void RenderService::worker_main(int index) {
       continue;
     }
     bool gl_failed = false;
+    if (pending && task->cost_per_camera * static_cast<double>(task->slices[slice].size()) >
+                       kTurnSliceMaxCost) {
+      // A costly slice next: the earlier slice's frames are finished (and
+      // answered) first, not held for the whole of it.
+      end_slice(*pending, renderer.get(), index, &gl_failed);
+      pending.reset();
+      rebuild_if(gl_failed);
+      gl_failed = false;
+    }
     std::optional<SubmittedSlice> next =
         start_slice(task, slice, renderer.get(), index, &gl_failed, &turns);
     if (pending) {

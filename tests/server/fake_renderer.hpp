@@ -105,6 +105,9 @@ struct FakeRendererControl {
   std::string slow_prefix;
   int slow_ms = 0;
   std::atomic<bool> slow_end{false};
+  // Renderers say they overlap (FrameRenderer::overlaps): the service then
+  // finishes a slice after submitting the next, as with the GL renderer.
+  std::atomic<bool> overlap{false};
 };
 
 class FakeFrameRenderer final : public FrameRenderer {
@@ -131,6 +134,7 @@ class FakeFrameRenderer final : public FrameRenderer {
     return frames;
   }
   void fail_next_render_for_test() override { fail_gl_next_ = true; }
+  bool overlaps() const override { return control_->overlap.load(); }
 
  private:
   std::shared_ptr<FakeRendererControl> control_;

@@ -292,6 +292,53 @@ TEST(Scheduling, ACheapRenderRunsInATurnInsideALongSlice) {
   service.stop();
 }
 
+// A slice whose frames the worker would finish after submitting the next
+// (a renderer that overlaps them, as the GL one does) is finished first when
+// the next slice is costly (estimated over kTurnSliceMaxCost): B's cheap
+// render is answered while A's costly one renders (until the test ends it).
+// Before, B's frames waited in the renderer for all of A's slice.
+TEST(Scheduling, ACheapSlicesFramesDoNotWaitForTheCostlySliceAfterIt) {
+  auto control = std::make_shared<test::FakeRendererControl>();
+  control->overlap = true;
+  RenderService service(test::fake_renderer_factory(control), 1, 1, PngSettings{}, 16);
+  service.wait_ready();
+  const auto scene = std::make_shared<const Scene>(parse_scene(test::tiny_scene(8), {}));
+  control->slow_renders("a_", 60000);
+  const auto job = [&](const char* name, std::uint64_t client, double cost,
+                       std::atomic<int>* answered) {
+    RenderJob j;
+    j.scene = scene;
+    j.cameras = {scene->cameras.front()};
+    j.cameras[0].name = name;
+    j.client_alive = std::make_shared<std::atomic<bool>>(true);
+    j.arrived = std::chrono::steady_clock::now();
+    j.client = client;
+    j.cost = cost;
+    j.done = [answered](RenderOutcome&& o) {
+      EXPECT_FALSE(o.error.has_value()) << o.error->message;
+      answered->fetch_add(1);
+    };
+    return j;
+  };
+  std::atomic<int> x{0}, a{0}, b{0};
+  control->hold_call(1);  // the worker holds X while B and A queue
+  ASSERT_TRUE(service.submit(job("x_0", 3, 10.0, &x)));
+  ASSERT_TRUE(eventually([&] { return control->call_count() == 1; }));
+  ASSERT_TRUE(service.submit(job("b_0", 2, 10.0, &b)));
+  ASSERT_TRUE(service.submit(job("a_0", 1, 10.0 * kTurnSliceMaxCost, &a)));
+  control->release_call(1);
+  const bool b_answered = eventually([&] { return b.load() == 1; });
+  const int a_then = a.load();
+  control->end_slow_renders();
+  EXPECT_TRUE(b_answered) << "the cheap slice's frames waited for the costly slice";
+  EXPECT_EQ(a_then, 0);
+  EXPECT_TRUE(eventually([&] { return a.load() == 1 && x.load() == 1; }));
+  const auto log = control->call_log();
+  ASSERT_EQ(log.size(), 3u);
+  EXPECT_EQ(log[1].at(0), "b_0");  // cheap first (fair turns), then the costly one
+  service.stop();
+}
+
 TEST(Scheduling, ADisconnectedClientsJobStopsWithinOneSlice) {
   auto control = std::make_shared<test::FakeRendererControl>();
   test::LocalServer s({}, test::fake_renderer_factory(control));
