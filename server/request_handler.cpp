@@ -137,6 +137,14 @@ json store_scene(ServerCore& core, const std::string& id, json scene_json, Scene
   return {{"scene_id", id}, {"bytes", bytes}, {"evicted", evicted}};
 }
 
+// A request's error answer, counted and logged under `method`.
+void answer_error(ServerCore& core, Connection& session, const json& id, const std::string& method,
+                  const ErrorInfo& error) {
+  core.metrics.count_request(method, false);
+  log_request(core, id, method, error.code);
+  session.send_error(id, error);
+}
+
 RenderLimits render_limits(const ServerCore& core) {
   return {load_options(core), core.config.max_request_cost};
 }
@@ -351,9 +359,14 @@ void handle_render(ServerCore& core, const std::shared_ptr<Connection>& session,
   RenderJob job = make_render_job(core, *session, r, frame, arrived);
   attach_reply(core, session, id, r, std::move(frame), arrived, &job);
   if (!core.renders->submit(std::move(job))) {
-    fail("busy", "", "the server has max_inflight_total (" +
-                         std::to_string(core.config.max_inflight_total) +
-                         ") renders in flight; retry later");
+    // The job, and with it its `done`, is gone: the render admitted above
+    // ends here, after its answer (Connection::end_render).
+    answer_error(core, *session, id, "render",
+                 {"busy",
+                  "the server has max_inflight_total (" +
+                      std::to_string(core.config.max_inflight_total) +
+                      ") renders in flight; retry later",
+                  ""});
     session->end_render();
   }
 }
@@ -378,9 +391,7 @@ void answering_errors(ServerCore& core, Connection& session, const json& id,
   try {
     fn();
   } catch (const ProtocolError& e) {
-    core.metrics.count_request(method, false);
-    log_request(core, id, method, e.info().code);
-    session.send_error(id, e.info());
+    answer_error(core, session, id, method, e.info());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "beamcast-server: internal error: %s\n", e.what());
     core.metrics.count_request(method, false);
