@@ -518,22 +518,32 @@ enum class FileReads { kNever, kInlineScene, kAlways };
 struct MethodEntry {
   std::string_view name;
   void (*run)(MethodCall&);
+  FileReads file_reads = FileReads::kNever;
   bool presents_token = false;  // checks params.token itself (hello); others need an authenticated connection
   bool refused_when_stopping = false;  // shutting_down while the server stops (new work)
-  FileReads file_reads = FileReads::kNever;
   bool counted_when_answered = false;  // metrics and log line when its answer is ready (render)
 };
 
 constexpr MethodEntry kMethodTable[] = {
-    {"hello", run_hello, true},
-    {"ping", run_ping},
-    {"render", run_render, false, true, FileReads::kInlineScene, true},
-    {"scene.put", run_scene_put, false, true, FileReads::kInlineScene},
-    {"scene.update", run_scene_update, false, true, FileReads::kAlways},
-    {"scene.get", run_scene_get, false, true},
-    {"scene.list", run_scene_list, false, true},
-    {"scene.delete", run_scene_delete, false, true},
-    {"stats", run_stats},
+    {.name = "hello", .run = run_hello, .presents_token = true},
+    {.name = "ping", .run = run_ping},
+    {.name = "render",
+     .run = run_render,
+     .file_reads = FileReads::kInlineScene,
+     .refused_when_stopping = true,
+     .counted_when_answered = true},
+    {.name = "scene.put",
+     .run = run_scene_put,
+     .file_reads = FileReads::kInlineScene,
+     .refused_when_stopping = true},
+    {.name = "scene.update",
+     .run = run_scene_update,
+     .file_reads = FileReads::kAlways,
+     .refused_when_stopping = true},
+    {.name = "scene.get", .run = run_scene_get, .refused_when_stopping = true},
+    {.name = "scene.list", .run = run_scene_list, .refused_when_stopping = true},
+    {.name = "scene.delete", .run = run_scene_delete, .refused_when_stopping = true},
+    {.name = "stats", .run = run_stats},
 };
 
 // The table is protocol's method list (kRequestMethods), in its order.
