@@ -1,6 +1,6 @@
 // libFuzzer target: one request's JSON text through the same validation the
-// server runs (parse_request, then per method parse_render_params, parse_scene,
-// parse_scene_id, output merging), ending with the response serialized the way
+// server runs (parse_request, then per method resolve_render, parse_scene,
+// parse_scene_id), ending with the response serialized the way
 // Session::send does it. Any exception other than ProtocolError is a finding:
 // the server would answer "internal" (or worse) instead of a clear error.
 #include <cstdint>
@@ -9,6 +9,7 @@
 
 #include "fuzz/fuzz_support.hpp"
 #include "protocol/bounded_json.hpp"
+#include "protocol/render_request.hpp"
 #include "protocol/request.hpp"
 #include "protocol/scene_json.hpp"
 
@@ -20,20 +21,17 @@ namespace {
 json handle(const beamcast::Request& req, const beamcast::SceneLoadOptions& opts) {
   const json& params = req.params;
   if (req.method == "render") {
-    const beamcast::RenderParams rp = beamcast::parse_render_params(params, opts.limits);
-    json scene_json = rp.scene ? *rp.scene : beamcast::fuzz::base_scene_json();
-    beamcast::Scene scene;
-    try {
-      scene = beamcast::parse_scene(scene_json, opts);
-    } catch (const ProtocolError& e) {
-      throw ProtocolError(beamcast::with_path_prefix(e.info(), "/params/scene"));
-    }
-    if (rp.output) {
-      json merged = scene_json.value("output", json::object());
-      merged.merge_patch(*rp.output);
-      scene.output = beamcast::parse_output_settings(merged, "/params/output");
-    }
-    return {{"frames", rp.cameras ? rp.cameras->size() : scene.cameras.size()}};
+    // Every scene_id names the base scene, as if stored.
+    static const auto stored = [&opts] {
+      auto s = std::make_shared<beamcast::StoredScene>();
+      s->json = beamcast::fuzz::base_scene_json();
+      s->scene = beamcast::parse_scene(s->json, opts);
+      return std::shared_ptr<const beamcast::StoredScene>(std::move(s));
+    }();
+    // max_request_cost: the server's default (server/config.hpp).
+    const beamcast::ResolvedRender r = beamcast::resolve_render(
+        params, {opts, 120000}, [](const std::string&) { return stored; });
+    return {{"frames", r.cameras.size()}};
   }
   if (req.method == "scene.put" || req.method == "scene.update") {
     const std::string sid = beamcast::parse_scene_id(params, "/params/scene_id");

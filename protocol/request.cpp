@@ -11,9 +11,7 @@
 namespace beamcast {
 
 const std::vector<std::string>& request_methods() {
-  static const std::vector<std::string> kMethods = {
-      "hello",     "ping",      "render",       "scene.put", "scene.update",
-      "scene.get", "scene.list", "scene.delete", "stats"};
+  static const std::vector<std::string> kMethods(kRequestMethods.begin(), kRequestMethods.end());
   return kMethods;
 }
 

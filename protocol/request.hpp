@@ -2,6 +2,7 @@
 // the server's sessions call these, tests and fuzzers call them directly.
 #pragma once
 
+#include <array>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -19,9 +20,14 @@ namespace beamcast {
 
 inline constexpr int kProtocolVersion = 1;
 
-// The request methods, in PROTOCOL.md's order ("## Methods"): the one list the
-// server's dispatcher (its metrics key and unknown-method error) and hello's
-// "methods" read; tests compare it with PROTOCOL.md and with the dispatcher.
+// The request methods, in PROTOCOL.md's order ("## Methods"): the one list
+// the server's dispatch table follows (a static_assert in
+// server/request_handler.cpp), which hello's "methods", the metrics key and
+// the unknown-method error read; tests compare it with PROTOCOL.md and with
+// the server.
+inline constexpr std::array<std::string_view, 9> kRequestMethods = {
+    "hello",     "ping",       "render",       "scene.put", "scene.update",
+    "scene.get", "scene.list", "scene.delete", "stats"};
 const std::vector<std::string>& request_methods();
 bool is_request_method(std::string_view method);
 // "hello, ping, ...", for messages.

@@ -48,10 +48,10 @@ bool http_request_authorized(const ServerConfig& config, std::string_view path,
   return token_matches(authorization_header.substr(kBearer.size()), config.token);
 }
 
-void check_request_token(const ServerConfig& config, const std::string& method,
+void check_request_token(const ServerConfig& config, bool presents_token,
                          const nlohmann::json& params, bool authenticated) {
   if (!token_required(config)) return;
-  if (method != "hello") {
+  if (!presents_token) {
     if (authenticated) return;
     throw ProtocolError({"unauthorized",
                          "this server requires a token: send hello with params.token first", ""});

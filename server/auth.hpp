@@ -36,13 +36,14 @@ bool http_request_authorized(const ServerConfig& config, std::string_view path,
                              std::string_view authorization_header);
 
 // The gate in front of every request (PROTOCOL.md, "Token"); does nothing
-// without a configured token. Every `hello` must carry the token in
+// without a configured token. A method that presents the token (`hello`,
+// `presents_token`: the dispatch table's attribute) must carry it in
 // params.token (a string), also on an already authenticated connection: a
 // missing, non-string or wrong token throws ProtocolError "unauthorized" at
 // /params/token. Any other method on a connection that is not authenticated
 // throws "unauthorized". Passing this check does not authenticate: the caller
 // marks the connection only once its hello has succeeded.
-void check_request_token(const ServerConfig& config, const std::string& method,
+void check_request_token(const ServerConfig& config, bool presents_token,
                          const nlohmann::json& params, bool authenticated);
 
 }  // namespace beamcast

@@ -12,15 +12,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "protocol/scene.hpp"
+#include "protocol/render_request.hpp"  // StoredScene
 
 namespace beamcast {
-
-struct StoredScene {
-  nlohmann::json json;  // as validated (scene.update patches this)
-  Scene scene;
-  std::uint64_t bytes = 0;  // size of the JSON text: what the limit counts
-};
 
 class SceneStore {
  public:

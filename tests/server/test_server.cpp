@@ -464,6 +464,30 @@ TEST(Server, InflightLimitsAnswerBusyInsteadOfQueueing) {
   EXPECT_TRUE(s.healthy());
 }
 
+// A render refused because the server is full (max_inflight_total) gives
+// its connection's slot back: the connection's next render, once the server
+// has room, is admitted, not refused by max_inflight_per_connection forever.
+TEST(Server, BusyForTheTotalLimitLeavesTheConnectionFree) {
+  ServerConfig cfg;
+  cfg.max_inflight_per_connection = 1;
+  cfg.max_inflight_total = 1;
+  TestServer s(cfg);
+  Conn a(s.port()), b(s.port());
+  Conn* refused = nullptr;
+  // Both at once until one finds the other's render in flight (bounded).
+  for (int i = 0; i < 20 && !refused; ++i) {
+    a.send(render_req(i, small_scene(256)));
+    b.send(render_req(i, small_scene(256)));
+    const Reply ra = a.recv(), rb = b.recv();
+    if (!ra.json["ok"]) refused = &a;
+    if (!rb.json["ok"]) refused = &b;
+  }
+  ASSERT_NE(refused, nullptr) << "no render met another in flight in 20 tries";
+  EXPECT_EQ(s.core().stats.errors("busy"), 1u);
+  const Reply r = refused->call(render_req(100, small_scene()));
+  EXPECT_TRUE(r.json["ok"]) << r.json;
+}
+
 TEST(Server, ConnectionLimitRefusesTheExtraClientOnly) {
   ServerConfig cfg;
   cfg.max_connections = 2;
