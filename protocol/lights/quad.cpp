@@ -52,6 +52,22 @@ std::optional<double> QuadLight::hit(const Vec3& o, const Vec3& v, double t_max)
 
 double QuadLight::radiance_scale() const { return 1.0 / (std::numbers::pi * area); }
 
+std::optional<LightOutline> QuadLight::outline() const {
+  return LightOutline{kOutlineCode, corner, edge_u, edge_v, normal};
+}
+
+void QuadLight::outline_triangles(TriangleSink& sink) const {
+  const Vec3 far = corner + edge_u + edge_v;
+  sink.add(corner, corner + edge_u, far, true);
+  sink.add(corner, far, corner + edge_v, true);
+}
+
+void QuadLight::cache_key(LightKey& k) const {
+  k.put(corner);
+  k.put(edge_u);
+  k.put(edge_v);
+}
+
 std::vector<DirectPoint> QuadLight::direct_points(int samples) const {
   // The centres of a k_u x k_v grid of equal cells (k_u k_v close to
   // `samples`, cells near square): the midpoint rule over the area, each
