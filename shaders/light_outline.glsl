@@ -2,7 +2,8 @@
 // protocol/lights/light_base.hpp): a flat one-sided emitter whose emitting
 // part lies inside the parallelogram corner + a u + b v, a and b in [0, 1],
 // and is picked by the kind's code (its kOutlineCode):
-//   1 (quad): all of it.
+//   1 (quad): all of it;
+//   2 (disk): the disk inscribed in the square u, v (|u| = |v|, u . v = 0).
 // A kind with another shape adds its code's branch to both functions.
 
 // Whether the point at (a, b) over the parallelogram emits.
@@ -10,6 +11,7 @@ bool outline_inside(int code, vec2 ab) {
   if (code == 1) {
     return all(greaterThanEqual(ab, vec2(0.0))) && all(lessThanEqual(ab, vec2(1.0)));
   }
+  if (code == 2) return dot(2.0 * ab - 1.0, 2.0 * ab - 1.0) <= 1.0;
   return false;
 }
 
@@ -21,5 +23,6 @@ float outline_outside(int code, vec2 ab, vec2 h) {
     vec2 out_by = max(-ab, ab - 1.0) * h;  // > 0 outside, per pair of edges
     return max(out_by.x, out_by.y);
   }
+  if (code == 2) return (length(2.0 * ab - 1.0) - 1.0) * 0.5 * h.x;  // h.x = |u| = 2 radius
   return 3.0e38;
 }
