@@ -112,20 +112,14 @@ std::vector<DirectPoint> DiskLight::direct_points(int samples) const {
   const Vec3 lift = (1e-5 * radius) * normal;  // as the quad: its shadow map sees its plane behind
   std::vector<DirectPoint> out;
   out.reserve(static_cast<std::size_t>(k) * static_cast<std::size_t>(k));
-  for (int bj = 0; bj < k; bj += 2) {
-    for (int bi = 0; bi < k; bi += 2) {
-      for (int c = 0; c < 4; ++c) {
-        const int i = bi + (c & 1), j = bj + (c >> 1);
-        if (i >= k || j >= k) continue;
-        DirectPoint p;
-        p.position = point((i + 0.5) / k, (j + 0.5) / k) + lift;
-        p.axis = normal;
-        p.mode = DirectPoint::Mode::kCosine;
-        p.scale = 1.0 / (kPi * k * k);
-        out.push_back(p);
-      }
-    }
-  }
+  for_each_cell_in_blocks(k, k, [&](int i, int j) {
+    DirectPoint p;
+    p.position = point((i + 0.5) / k, (j + 0.5) / k) + lift;
+    p.axis = normal;
+    p.mode = DirectPoint::Mode::kCosine;
+    p.scale = 1.0 / (kPi * k * k);
+    out.push_back(p);
+  });
   return out;
 }
 

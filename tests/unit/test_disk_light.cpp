@@ -16,6 +16,7 @@
 #include "protocol/errors.hpp"
 #include "protocol/lights/disk.hpp"
 #include "protocol/scene_json.hpp"
+#include "tests/common/lit_shapes.hpp"
 
 namespace beamcast {
 namespace {
@@ -165,16 +166,7 @@ TEST(DiskLight, PhotonsOnAFloorMatchTheDiskToDiskViewFactor) {
   EXPECT_TRUE(trace_photons(up_scene, up_surfaces).global.empty());
 }
 
-Camera make_camera(const Vec3& pos, const Vec3& target, double fov_y, int w, int h) {
-  Camera c;
-  c.position = pos;
-  c.target = target;
-  c.fov_y_deg = fov_y;
-  c.width = w;
-  c.height = h;
-  c.far_plane = 1e4;
-  return c;
-}
+using test::make_camera;
 
 // The path tracer's floor under the disk: its radiance is rho L F with F =
 // R^2 / (R^2 + h^2), the view factor from a floor point on the axis to the
