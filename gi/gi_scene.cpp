@@ -71,16 +71,14 @@ std::optional<OccluderHit> user_hit(const Element& e, const Context& c, double l
         },
         c.scene->occluders[static_cast<std::size_t>(e.occluder)].shape);
   }
+  // A seen light (an element only if it has an outline), with its outline's normal.
   return std::visit(
       [&](const auto& kind) -> std::optional<OccluderHit> {
-        using Kind = std::decay_t<decltype(kind)>;
-        if constexpr (std::is_same_v<Kind, QuadLight>) {
-          const auto t = kind.hit(c.o, c.v, hi);
-          if (!t || *t <= lo) return std::nullopt;
-          return OccluderHit{*t, kind.normal};
-        } else {
-          return std::nullopt;
-        }
+        const std::optional<LightOutline> outline = kind.outline();
+        if (!outline) return std::nullopt;
+        const auto t = kind.hit(c.o, c.v, hi);
+        if (!t || *t <= lo) return std::nullopt;
+        return OccluderHit{*t, outline->normal};
       },
       c.scene->lights[static_cast<std::size_t>(e.light)].shape);
 }
@@ -213,7 +211,7 @@ GiScene::GiScene(const Scene& scene) : impl_(std::make_unique<Impl>()), scene_(&
         [&](const auto& kind) {
           const Aabb b = kind.bounds();
           extent.grow(b);
-          if constexpr (std::is_same_v<std::decay_t<decltype(kind)>, QuadLight>) {
+          if (kind.outline()) {  // seen: rays that meet it end there
             Element e;
             e.light = static_cast<int>(i);
             add_user(std::move(e), b);

@@ -76,37 +76,10 @@ std::string photon_key(const Scene& scene) {
   for (const Light& l : scene.lights) {
     k.put(l.shape.index());
     k.put(l.flux);
-    std::visit(
-        [&](const auto& kind) {
-          using Kind = std::decay_t<decltype(kind)>;
-          if constexpr (std::is_same_v<Kind, PointLight>) {
-            k.put(kind.position);
-          } else if constexpr (std::is_same_v<Kind, SpotLight>) {
-            k.put(kind.position);
-            k.put(kind.direction);
-            k.put(kind.inner_deg);
-            k.put(kind.outer_deg);
-          } else if constexpr (std::is_same_v<Kind, BeamEmitter>) {
-            std::visit(
-                [&](const auto& beam) {
-                  const BeamGpu g = beam.gpu(Vec3{0.0, 0.0, 0.0});
-                  k.put(g.p0);
-                  k.put(g.axis);
-                  k.put(g.length);
-                  k.put(g.caps_kind);
-                },
-                kind.shape);
-            k.put(kind.radius);
-            k.put(kind.density_key.size());
-            k.text(kind.density_key);
-          } else {
-            static_assert(std::is_same_v<Kind, QuadLight>, "a light kind missing from photon_key");
-            k.put(kind.corner);
-            k.put(kind.edge_u);
-            k.put(kind.edge_v);
-          }
-        },
-        l.shape);
+    LightKey lk;
+    std::visit([&](const auto& kind) { kind.cache_key(lk); }, l.shape);
+    k.put(lk.bytes.size());
+    k.text(lk.bytes);
   }
   // The settings tracing reads (radius and kernel only shape the splats).
   k.put(scene.gi.photons);

@@ -14,6 +14,7 @@
 
 #include "protocol/beams/beam_parse.hpp"
 #include "protocol/camera.hpp"
+#include "protocol/check.hpp"
 #include "protocol/json_reader.hpp"
 #include "protocol/kinds.hpp"
 #include "protocol/lights/light_parse.hpp"
@@ -276,15 +277,17 @@ Light parse_gi_light(const Node& n, const SceneLimits& limits) {
     }
   }
   l.flux = power * color;
-  if (const auto* quad = std::get_if<QuadLight>(&l.shape)) {
-    if (auto r = o.optional("radiance")) {
-      if (c || p) {
-        fail("invalid_value", r->path,
-             "give a quad light either radiance or color and power, not both");
-      }
-      // A Lambertian emitter of radiance L sends pi L area into its hemisphere.
-      l.flux = (std::numbers::pi * quad->area) * read_color(*r);
+  // Only kinds that list "radiance" in kFields (area lights) get here with it.
+  if (auto r = o.optional("radiance")) {
+    if (c || p) {
+      fail("invalid_value", r->path,
+           "give an area light either radiance or color and power, not both");
     }
+    // Radiance is radiance_scale() x flux (a Lambertian emitter of radiance
+    // L sends pi L area into its hemisphere).
+    const double scale = std::visit([](const auto& k) { return k.radiance_scale(); }, l.shape);
+    BEAMCAST_CHECK(scale > 0.0, "a light kind accepting radiance has an area");
+    l.flux = (1.0 / scale) * read_color(*r);
   }
   check_light_values(l, o.path());
   return l;
@@ -295,8 +298,9 @@ void add_beam_lights(Scene* scene, const std::string& beams_path) {
   for (std::size_t i = 0; i < scene->beams.size(); ++i) {
     const Beam& b = scene->beams[i];
     if (!b.emit) continue;
-    Light l{BeamEmitter::from_beam(b.shape, b.radius, b.density, static_cast<int>(i)), {}};
-    const double m = std::get<BeamEmitter>(l.shape).volume_mass();
+    BeamEmitter e = BeamEmitter::from_beam(b.shape, b.radius, b.density, static_cast<int>(i));
+    const double m = e.volume_mass();
+    Light l{std::move(e), {}};
     // The glow is measured in radii (docs/scene-format.md, Units): per world
     // length it is color x intensity x f / radius.
     for (std::size_t k = 0; k < 3; ++k) {

@@ -382,13 +382,14 @@ class DirectPass final : public Pass {
 constexpr float kSplatMinCos = 0.906f;
 constexpr float kSplatMaxPlane = 0.1f;
 
-// The pixels a quad light's projection can touch, 2 pixels wider on each
-// side (a pixel meets the light only if its square meets the light's
-// projection; the outline test's rays are within the pixel); every pixel if
-// a corner has no place in the image (at or behind the near plane).
-std::array<int, 4> light_pixel_rect(const QuadLight& q, const Camera& cam, const CameraBasis& b) {
-  const Vec3 corners[4] = {q.corner, q.corner + q.edge_u, q.corner + q.edge_v,
-                           q.corner + q.edge_u + q.edge_v};
+// The pixels a seen light's projection can touch (its outline's
+// parallelogram), 2 pixels wider on each side (a pixel meets the light only
+// if its square meets the light's projection; the outline test's rays are
+// within the pixel); every pixel if a corner has no place in the image (at
+// or behind the near plane).
+std::array<int, 4> light_pixel_rect(const LightOutline& q, const Camera& cam,
+                                    const CameraBasis& b) {
+  const Vec3 corners[4] = {q.corner, q.corner + q.u, q.corner + q.v, q.corner + q.u + q.v};
   return pixel_rect(corners, cam, b, 2);
 }
 
@@ -425,29 +426,34 @@ class GiResolvePass final : public Pass {
       bind_view_placeholder(ctx, 4);  // compiled in, not read
     }
     begin_additive(ctx);
-    // Quad lights whose outlines are antialiased: corners relative to the
+    // Seen lights whose outlines are antialiased: corners relative to the
     // first one's (in double, then float).
-    std::vector<const Light*> quads;
+    std::vector<std::pair<LightOutline, Color>> seen;
     if (ctx.scene.gi.light_antialias) {
       for (const Light& l : ctx.scene.lights) {
-        if (std::holds_alternative<QuadLight>(l.shape) && quads.size() < kMaxAaLights) {
-          quads.push_back(&l);
-        }
+        std::visit(
+            [&](const auto& kind) {
+              const std::optional<LightOutline> o = kind.outline();
+              if (o && seen.size() < kMaxAaLights) {
+                seen.emplace_back(*o, kind.radiance_scale() * l.flux);
+              }
+            },
+            l.shape);
       }
     }
-    const Vec3 anchor = quads.empty() ? Vec3{} : std::get<QuadLight>(quads[0]->shape).corner;
-    glUniform1i(program.uniform(multi, "u_aa_lights"), static_cast<GLint>(quads.size()));
-    for (std::size_t k = 0; k < quads.size(); ++k) {
-      const auto& q = std::get<QuadLight>(quads[k]->shape);
-      const Color radiance = q.radiance_scale() * quads[k]->flux;
+    const Vec3 anchor = seen.empty() ? Vec3{} : seen[0].first.corner;
+    glUniform1i(program.uniform(multi, "u_aa_lights"), static_cast<GLint>(seen.size()));
+    for (std::size_t k = 0; k < seen.size(); ++k) {
+      const auto& [q, radiance] = seen[k];
       const std::string i = "[" + std::to_string(k) + "]";
       auto set = [&](const char* name, const Vec3& v) {
         glUniform3f(program.uniform(multi, (name + i).c_str()), static_cast<float>(v[0]),
                     static_cast<float>(v[1]), static_cast<float>(v[2]));
       };
+      glUniform1i(program.uniform(multi, ("u_light_code" + i).c_str()), q.code);
       set("u_light_corner", q.corner - anchor);
-      set("u_light_u", q.edge_u);
-      set("u_light_v", q.edge_v);
+      set("u_light_u", q.u);
+      set("u_light_v", q.v);
       set("u_light_radiance", Vec3{radiance[0], radiance[1], radiance[2]});
       // The pixels whose outline test can find the light (one camera; a
       // multi-view batch tests every pixel).

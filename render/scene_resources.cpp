@@ -502,15 +502,25 @@ void SceneResources::upload_direct() {
   gl_check("upload direct points");
 }
 
-// Lit scenes: quad lights are drawn as what a camera sees of them, their
-// radiance from the front (G-buffer material code kEmitterMaterial).
-static std::vector<std::pair<const QuadLight*, Color>> emitters_of(const Scene& scene) {
-  std::vector<std::pair<const QuadLight*, Color>> out;
+// Lit scenes: the seen lights (those with an outline) are drawn as what a
+// camera sees of them, their radiance from the front (G-buffer material code
+// kEmitterMaterial).
+struct SeenEmitter {
+  const Light* light;
+  LightOutline outline;
+  Color radiance;
+};
+static std::vector<SeenEmitter> emitters_of(const Scene& scene) {
+  std::vector<SeenEmitter> out;
   if (!scene.has_gi()) return out;
   for (const Light& l : scene.lights) {
-    if (const auto* q = std::get_if<QuadLight>(&l.shape)) {
-      out.emplace_back(q, q->radiance_scale() * l.flux);
-    }
+    std::visit(
+        [&](const auto& kind) {
+          if (const std::optional<LightOutline> o = kind.outline()) {
+            out.push_back({&l, *o, kind.radiance_scale() * l.flux});
+          }
+        },
+        l.shape);
   }
   return out;
 }
@@ -538,9 +548,13 @@ std::string SceneResources::occluder_key(const Scene& scene) {
         },
         occ.shape);
   }
-  for (const auto& [q, radiance] : emitters_of(scene)) {
+  for (const SeenEmitter& e : emitters_of(scene)) {
     key += "|emitter";
-    for (const Vec3* v : {&q->corner, &q->edge_u, &q->edge_v, &radiance}) append_raw(&key, *v);
+    LightKey k;
+    std::visit([&](const auto& kind) { kind.cache_key(k); }, e.light->shape);
+    key += std::to_string(e.light->shape.index()) + ":" + std::to_string(k.bytes.size()) + ":";
+    key += k.bytes;
+    append_raw(&key, e.radiance);
   }
   return key;
 }
@@ -563,7 +577,9 @@ void SceneResources::upload_occluders(SceneGpuCache* content) {
         },
         occ.shape);
   }
-  for (const auto& e : emitters_of(scene)) bounds.grow(e.first->bounds());
+  for (const SeenEmitter& e : emitters_of(scene)) {
+    bounds.grow(std::visit([](const auto& kind) { return kind.bounds(); }, e.light->shape));
+  }
   mesh_bounds_ = bounds;
   if (!bounds.empty()) {
     mesh_anchor_ = bounds.centre();
@@ -604,11 +620,9 @@ std::shared_ptr<const OccluderGeometry> SceneResources::make_geometry() const {
         occ.shape);
   }
   sink.material = kEmitterMaterial;
-  for (const auto& [q, radiance] : emitters_of(scene_)) {
-    sink.albedo = radiance;  // the surface shader writes it as emitted radiance
-    const Vec3 far = q->corner + q->edge_u + q->edge_v;
-    sink.add(q->corner, q->corner + q->edge_u, far, true);
-    sink.add(q->corner, far, q->corner + q->edge_v, true);
+  for (const SeenEmitter& e : emitters_of(scene_)) {
+    sink.albedo = e.radiance;  // the surface shader writes it as emitted radiance
+    std::visit([&](const auto& kind) { kind.outline_triangles(sink); }, e.light->shape);
   }
   if (verts.empty()) return nullptr;
   auto g = std::make_shared<OccluderGeometry>();

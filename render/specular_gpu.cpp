@@ -34,7 +34,7 @@ Vec4f v4(const Vec3& v, double w) {
 }
 
 // Material types of shaders/specular_trace.comp: MaterialType's codes, and
-// 3 for a quad light (albedo.rgb its radiance).
+// 3 for a seen light (albedo.rgb its radiance).
 constexpr double kLightMaterial = 3.0;
 
 struct MaterialRecord {
@@ -263,13 +263,16 @@ SpecularGpu::SpecularGpu(const Scene& scene, const PhotonMaps& maps, bool skip_d
   }
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& l = scene.lights[i];
-    if (const auto* q = std::get_if<QuadLight>(&l.shape)) {
-      const double s = q->radiance_scale();
-      materials.push_back({v4(s * l.flux, kLightMaterial), {}});
-      shapes.push_back({v4(q->corner - anchor_, 2.0), v4(q->edge_u, 0.0),
-                        v4(q->edge_v, static_cast<double>(materials.size() - 1)),
-                        v4(cross(q->edge_u, q->edge_v), 0.0)});
-    }
+    std::visit(
+        [&](const auto& kind) {
+          const std::optional<LightOutline> q = kind.outline();
+          if (!q) return;  // never seen
+          materials.push_back({v4(kind.radiance_scale() * l.flux, kLightMaterial), {}});
+          shapes.push_back({v4(q->corner - anchor_, 2.0), v4(q->u, 0.0),
+                            v4(q->v, static_cast<double>(materials.size() - 1)),
+                            v4(cross(q->u, q->v), static_cast<double>(q->code))});
+        },
+        l.shape);
   }
   shape_count_ = static_cast<int>(shapes.size());
   std::vector<SpecularBvhNode> nodes = BvhBuilder(tris, 4.0f * eps_).build();

@@ -4,7 +4,8 @@
 // pixel divided by its share (gi_share.frag: the kernel-weighted share of
 // its disk that lies on its own surface, in the target's alpha; at least
 // 0.25), times the pixel's albedo.
-// The same pass antialiases the outline of quad lights: the G-buffer shows a
+// The same pass antialiases the outlines of seen lights (light_outline.glsl;
+// an outline is convex): the G-buffer shows a
 // light where a pixel's centre sees it, with its full radiance, while the
 // pixel's true value (the reference's, averaged over the pixel) is its
 // radiance times the share of the pixel that sees it. Against the dim
@@ -26,9 +27,10 @@ uniform int u_splat_scale;  // u_indirect has 1/u_splat_scale of the pixels per 
 uniform ivec2 u_band_layout;
 
 const int kMaxAaLights = 8;
-uniform int u_aa_lights;        // quad lights to antialias (the first kMaxAaLights)
+uniform int u_aa_lights;        // seen lights to antialias (the first kMaxAaLights)
+uniform int u_light_code[kMaxAaLights];     // LightOutline::code
 uniform vec3 u_light_offset;    // the lights' anchor minus the eye
-uniform vec3 u_light_corner[kMaxAaLights];  // relative to the anchor
+uniform vec3 u_light_corner[kMaxAaLights];  // the outline's parallelogram, relative to the anchor
 uniform vec3 u_light_u[kMaxAaLights];
 uniform vec3 u_light_v[kMaxAaLights];
 uniform vec3 u_light_radiance[kMaxAaLights];
@@ -92,9 +94,8 @@ vec4 light_hit(vec2 f, int k) {
               t * ray.cos_axis, 1.0);
 }
 
-bool inside(vec4 h, float zlim) {
-  return h.w > 0.0 && h.z <= zlim && all(greaterThanEqual(h.xy, vec2(0.0))) &&
-         all(lessThanEqual(h.xy, vec2(1.0)));
+bool inside(vec4 h, float zlim, int k) {
+  return h.w > 0.0 && h.z <= zlim && outline_inside(u_light_code[k], h.xy);
 }
 
 // The area of the quadrilateral q (window positions, either winding) inside
@@ -147,12 +148,14 @@ float light_coverage(ivec2 px, int k, float zlim) {
   float foot = 2.0 * dist * pixel / max(abs(dot(ray.dir, n)) / area, 1e-3);
   // Distances to the edge lines: a in units of the height over edge v, b over edge u.
   vec2 h = vec2(area / length(u_light_v[k]), area / length(u_light_u[k]));
-  vec2 out_by = max(-hc.xy, hc.xy - 1.0) * h;  // > 0 outside, per pair of edges
-  if (max(out_by.x, out_by.y) > foot) return 0.0;
-  if (max(out_by.x, out_by.y) < -foot) return hc.z <= zlim ? 1.0 : 0.0;
+  float out_by = outline_outside(u_light_code[k], hc.xy, h);
+  if (out_by > foot) return 0.0;
+  if (out_by < -foot) return hc.z <= zlim ? 1.0 : 0.0;
   bool all_in = true;
   int misses = 0;
-  bvec4 beyond = bvec4(true);  // a < 0, a > 1, b < 0, b > 1 at every corner so far
+  // a < 0, a > 1, b < 0, b > 1 at every corner so far (beyond a line of the
+  // parallelogram: outside any outline within it)
+  bvec4 beyond = bvec4(true);
   for (int i = 0; i < 4; ++i) {
     vec4 h = light_hit(vec2(px) + vec2(i & 1, i >> 1), k);
     if (h.w == 0.0) {
@@ -160,7 +163,7 @@ float light_coverage(ivec2 px, int k, float zlim) {
       all_in = false;
       continue;
     }
-    all_in = all_in && inside(h, zlim);
+    all_in = all_in && inside(h, zlim, k);
     beyond = bvec4(beyond.x && h.x < 0.0, beyond.y && h.x > 1.0, beyond.z && h.y < 0.0,
                    beyond.w && h.y > 1.0);
   }
@@ -170,11 +173,13 @@ float light_coverage(ivec2 px, int k, float zlim) {
   for (int j = 0; j < 16; ++j) {
     vec2 f = vec2(px) + (vec2(j & 3, j >> 2) + 0.5) / 4.0;
     vec4 h = light_hit(f, k);
-    if (inside(h, 3.0e38)) {
+    if (inside(h, 3.0e38, k)) {
       hits += 1.0;
       if (h.z <= zlim) seen += 1.0;
     }
   }
+  // Other outlines than the whole parallelogram: the rays' share.
+  if (u_light_code[k] != 1) return seen / 16.0;
   vec3 c = u_light_corner[k] + u_light_offset;
   vec2 q[4];
   if (!(window_of(c, q[0]) && window_of(c + u_light_u[k], q[1]) &&

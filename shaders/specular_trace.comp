@@ -4,7 +4,7 @@
 // LitShading does on the CPU (gi/photon_gather.hpp): a diffuse surface
 // shows the fixed-radius photon estimate (both maps, each with its radius
 // and the splat tests) plus, with gi.direct "shadow_maps", the direct
-// points' light with shadow rays; a quad light seen from its front its
+// points' light with shadow rays; a seen light (quad, ...) from its front its
 // radiance; nothing, the background. A mirror multiplies by its
 // reflectance, glass adds F x the reflected and (1 - F) x tint x the
 // refracted branch (exact unpolarized Fresnel), every branch followed (a
@@ -14,8 +14,9 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 // a.w: 0 plane (a.xyz a point, b.xyz the unit normal), 1 sphere (a.xyz the
-// centre, b.w the radius), 2 quad light (a.xyz the corner, b.xyz and c.xyz
-// the edges, d.xyz cross(edge_u, edge_v)); c.w: the material.
+// centre, b.w the radius), 2 seen light (LightOutline: a.xyz the corner, b.xyz
+// and c.xyz the edges u and v, d.xyz cross(u, v), d.w the outline code,
+// light_outline.glsl); c.w: the material.
 struct Shape {
   vec4 a;
   vec4 b;
@@ -130,7 +131,7 @@ Hit nearest(vec3 o, vec3 v, float t_min, float t_max) {
       h.t = t;
       h.n = s.b.xyz;
       h.material = int(s.c.w);
-    } else {  // QuadLight::hit: front only
+    } else {  // a seen light's hit(): front only
       vec3 n = s.d.xyz;
       float denom = dot(v, n);
       if (!(denom < 0.0)) continue;
@@ -140,7 +141,7 @@ Hit nearest(vec3 o, vec3 v, float t_min, float t_max) {
       float n2 = dot(n, n);
       float a = dot(cross(p, s.c.xyz), n) / n2;
       float b = dot(cross(s.b.xyz, p), n) / n2;
-      if (a < 0.0 || a > 1.0 || b < 0.0 || b > 1.0) continue;
+      if (!outline_inside(int(s.d.w), vec2(a, b))) continue;
       h.t = t;
       h.n = normalize(n);
       h.material = int(s.c.w);

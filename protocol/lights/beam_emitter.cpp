@@ -201,4 +201,19 @@ std::vector<DirectPoint> BeamEmitter::direct_points(int samples) const {
       shape);
 }
 
+void BeamEmitter::cache_key(LightKey& k) const {
+  std::visit(
+      [&](const auto& beam) {
+        const BeamGpu g = beam.gpu(Vec3{0.0, 0.0, 0.0});
+        k.put(g.p0);
+        k.put(g.axis);
+        k.put(g.length);
+        k.put(g.caps_kind);
+      },
+      shape);
+  k.put(radius);
+  k.put(density_key.size());
+  k.text(density_key);
+}
+
 }  // namespace beamcast

@@ -63,6 +63,10 @@ struct BeamEmitter {
   std::optional<double> hit(const Vec3& o, const Vec3& v, double t_max) const;
   std::vector<DirectPoint> direct_points(int samples) const;
   double radiance_scale() const { return 0.0; }
+  // Its glow is drawn by the beam pass, not as a seen emitter.
+  std::optional<LightOutline> outline() const { return std::nullopt; }
+  void outline_triangles(TriangleSink& /*sink*/) const {}
+  void cache_key(LightKey& k) const;
 
  private:
   Vec3 sample_point(const LightRandom& u) const;

@@ -1,9 +1,11 @@
-// What every light kind provides to the parser, the photon tracer and the CPU
-// path tracer (gi/). A kind is one struct in its own files here (point, spot,
-// quad) holding its geometry; the emitted flux (color x power) stays in Light
-// (scene.hpp) and is passed in:
+// What every light kind provides to the parser, the photon tracer, the CPU
+// path tracer (gi/) and the GPU passes (render/). A kind is one struct in its
+// own files here (point, spot, quad, beam_emitter) holding its geometry; the
+// emitted flux (color x power) stays in Light (scene.hpp) and is passed in:
 //   static constexpr std::string_view kType;   its "type" in scene JSON
-//   static constexpr std::array kFields;       its own JSON keys
+//   static constexpr std::array kFields;       its own JSON keys ("radiance"
+//                                              among them: the flux may be
+//                                              given as radiance instead)
 //   static T parse(const LightParse& in);      validation, JSON-pointer errors
 //   Aabb bounds() const;
 //   Emission emit(u) const;                    a photon's origin and direction
@@ -12,7 +14,14 @@
 //   double radiance_scale() const;             emitted radiance per unit flux
 //   std::vector<DirectPoint> direct_points(n) const;  the points the raster
 //                                              direct-light pass shades from
-// Dispatch over the kinds is std::visit over LightShape (lights.hpp).
+//   std::optional<LightOutline> outline() const;  what a camera sees of it
+//                                              (none: never seen)
+//   void outline_triangles(TriangleSink&) const;  the same, as one-sided
+//                                              triangles for the raster G-buffer
+//   void cache_key(LightKey&) const;           the numbers its emission and
+//                                              outline depend on (caches)
+// Dispatch over the kinds is std::visit over LightShape (lights.hpp): a kind
+// that lacks a member fails to compile where it is needed.
 // Radiometry: flux in watts per channel; a point light's intensity is
 // flux / 4 pi; a spot's falls from the inner to the outer cone and its
 // total over the sphere is the flux; a quad is a one-sided Lambertian emitter
@@ -21,8 +30,12 @@
 
 #include <array>
 #include <optional>
+#include <string>
+#include <string_view>
+#include <type_traits>
 #include <vector>
 
+#include "protocol/occluders/occluder_base.hpp"
 #include "protocol/vec.hpp"
 
 namespace beamcast {
@@ -68,6 +81,33 @@ struct DirectPoint {
   double scale = 0.0;
   double cos_inner = 1.0;
   double cos_outer = 1.0;
+};
+
+// What a camera sees of a light (the G-buffer, gi_resolve's outline
+// antialiasing, the GPU's specular rays; the CPU path tracer uses hit()): a
+// flat one-sided emitter of constant radiance (radiance_scale() x flux),
+// seen from the side `normal` (unit, along cross(u, v)) points to. Its
+// emitting part lies inside the parallelogram corner + a u + b v (a, b in
+// [0, 1]); `code` tells the shaders which part (shaders/light_outline.glsl:
+// the kind's kOutlineCode; 1 all of it, the quad).
+struct LightOutline {
+  int code = 0;
+  Vec3 corner{};
+  Vec3 u{};
+  Vec3 v{};
+  Vec3 normal{};
+};
+
+// The bytes of the numbers a light's emission and outline depend on: the
+// photon cache's key (gi/photon_cache.cpp) and the render side's geometry key.
+struct LightKey {
+  std::string bytes;
+  template <class T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes.append(reinterpret_cast<const char*>(&v), sizeof(T));
+  }
+  void text(std::string_view s) { bytes.append(s); }
 };
 
 }  // namespace beamcast

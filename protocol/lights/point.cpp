@@ -34,6 +34,8 @@ std::optional<double> PointLight::hit(const Vec3&, const Vec3&, double) const {
   return std::nullopt;  // a point is never seen
 }
 
+void PointLight::cache_key(LightKey& k) const { k.put(position); }
+
 std::vector<DirectPoint> PointLight::direct_points(int /*samples*/) const {
   DirectPoint p;
   p.position = position;

@@ -19,6 +19,10 @@ struct PointLight {
   std::optional<double> hit(const Vec3& o, const Vec3& v, double t_max) const;
   std::vector<DirectPoint> direct_points(int samples) const;
   double radiance_scale() const { return 0.0; }
+  // A point: never seen.
+  std::optional<LightOutline> outline() const { return std::nullopt; }
+  void outline_triangles(TriangleSink& /*sink*/) const {}
+  void cache_key(LightKey& k) const;
 };
 
 }  // namespace beamcast

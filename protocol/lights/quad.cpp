@@ -52,6 +52,22 @@ std::optional<double> QuadLight::hit(const Vec3& o, const Vec3& v, double t_max)
 
 double QuadLight::radiance_scale() const { return 1.0 / (std::numbers::pi * area); }
 
+std::optional<LightOutline> QuadLight::outline() const {
+  return LightOutline{kOutlineCode, corner, edge_u, edge_v, normal};
+}
+
+void QuadLight::outline_triangles(TriangleSink& sink) const {
+  const Vec3 far = corner + edge_u + edge_v;
+  sink.add(corner, corner + edge_u, far, true);
+  sink.add(corner, far, corner + edge_v, true);
+}
+
+void QuadLight::cache_key(LightKey& k) const {
+  k.put(corner);
+  k.put(edge_u);
+  k.put(edge_v);
+}
+
 std::vector<DirectPoint> QuadLight::direct_points(int samples) const {
   // The centres of a k_u x k_v grid of equal cells (k_u k_v close to
   // `samples`, cells near square): the midpoint rule over the area, each
@@ -65,22 +81,14 @@ std::vector<DirectPoint> QuadLight::direct_points(int samples) const {
   const Vec3 lift = (1e-5 * std::max(lu, lv)) * normal;
   std::vector<DirectPoint> out;
   out.reserve(static_cast<std::size_t>(ku) * static_cast<std::size_t>(kv));
-  // 2 x 2 blocks of cells in row order, each block's cells in the order
-  // (0, 0), (1, 0), (0, 1), (1, 1) (a block at an odd edge has fewer).
-  for (int bj = 0; bj < kv; bj += 2) {
-    for (int bi = 0; bi < ku; bi += 2) {
-      for (int k = 0; k < 4; ++k) {
-        const int i = bi + (k & 1), j = bj + (k >> 1);
-        if (i >= ku || j >= kv) continue;
-        DirectPoint p;
-        p.position = corner + ((i + 0.5) / ku) * edge_u + ((j + 0.5) / kv) * edge_v + lift;
-        p.axis = normal;
-        p.mode = DirectPoint::Mode::kCosine;
-        p.scale = 1.0 / (std::numbers::pi * ku * kv);
-        out.push_back(p);
-      }
-    }
-  }
+  for_each_cell_in_blocks(ku, kv, [&](int i, int j) {
+    DirectPoint p;
+    p.position = corner + ((i + 0.5) / ku) * edge_u + ((j + 0.5) / kv) * edge_v + lift;
+    p.axis = normal;
+    p.mode = DirectPoint::Mode::kCosine;
+    p.scale = 1.0 / (std::numbers::pi * ku * kv);
+    out.push_back(p);
+  });
   return out;
 }
 

@@ -14,6 +14,8 @@ struct QuadLight {
   static constexpr std::string_view kType = "quad";
   static constexpr std::array<std::string_view, 4> kFields{"corner", "edge_u", "edge_v",
                                                            "radiance"};
+  // shaders/light_outline.glsl: the whole parallelogram.
+  static constexpr int kOutlineCode = 1;
   Vec3 corner{};
   Vec3 edge_u{1.0, 0.0, 0.0};
   Vec3 edge_v{0.0, 0.0, 1.0};
@@ -30,6 +32,9 @@ struct QuadLight {
   // interleaved quarters, gi.direct_interleave) spans the whole light.
   std::vector<DirectPoint> direct_points(int samples) const;
   double radiance_scale() const;
+  std::optional<LightOutline> outline() const;
+  void outline_triangles(TriangleSink& sink) const;
+  void cache_key(LightKey& k) const;
 };
 
 }  // namespace beamcast

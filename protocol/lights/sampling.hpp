@@ -49,4 +49,20 @@ inline Vec3 cosine_hemisphere(const Vec3& n, double u1, double u2) {
   return from_local(n, r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - u1)));
 }
 
+// Calls f(i, j) for every cell of a ku x kv grid, 2 x 2 cells by 2 x 2
+// cells in row order, each block's cells in the order (0, 0), (1, 0),
+// (0, 1), (1, 1) (a block at an odd edge has fewer): with both even, every
+// fourth cell spans the whole grid (the direct pass's interleaved quarters).
+template <class F>
+void for_each_cell_in_blocks(int ku, int kv, F&& f) {
+  for (int bj = 0; bj < kv; bj += 2) {
+    for (int bi = 0; bi < ku; bi += 2) {
+      for (int k = 0; k < 4; ++k) {
+        const int i = bi + (k & 1), j = bj + (k >> 1);
+        if (i < ku && j < kv) f(i, j);
+      }
+    }
+  }
+}
+
 }  // namespace beamcast

@@ -86,4 +86,11 @@ std::vector<DirectPoint> SpotLight::direct_points(int /*samples*/) const {
   return {p};
 }
 
+void SpotLight::cache_key(LightKey& k) const {
+  k.put(position);
+  k.put(direction);
+  k.put(inner_deg);
+  k.put(outer_deg);
+}
+
 }  // namespace beamcast

@@ -8,6 +8,18 @@
 
 namespace beamcast::test {
 
+// A perspective camera (fov_y in degrees) with a far plane out of the way.
+inline Camera make_camera(const Vec3& pos, const Vec3& target, double fov_y, int w, int h) {
+  Camera c;
+  c.position = pos;
+  c.target = target;
+  c.fov_y_deg = fov_y;
+  c.width = w;
+  c.height = h;
+  c.far_plane = 1e4;
+  return c;
+}
+
 inline Occluder quad_occluder(const Vec3& corner, const Vec3& eu, const Vec3& ev, Material m = {},
                               Color albedo = {0.8, 0.8, 0.8}) {
   Occluder o;

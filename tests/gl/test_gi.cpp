@@ -18,6 +18,7 @@
 #include "protocol/scene_json.hpp"
 #include "render/pass_plan.hpp"
 #include "render/renderer.hpp"
+#include "tests/common/outline_shares.hpp"
 
 namespace beamcast {
 namespace {
@@ -699,49 +700,28 @@ TEST(Gi, QuadLightOutlinesGetTheShareOfEachPixel) {
                   {"gi", {{"photons", 1000}, {"light_antialias", aa}}},
                   {"cameras", {cam}}};
     };
-    // The covered share of each pixel (rows from the top, as the HDR image):
-    // 32 x 32 rays a pixel met with the light's plane z = 0.
+    // The covered share of each pixel: 32 x 32 rays a pixel met with the
+    // light's plane z = 0.
     const Scene probe = parse_scene(scene_json(true), {});
-    const Camera& cam = probe.cameras[0];
-    const CameraBasis basis = camera_basis(cam);
-    std::vector<double> share(kSize * kSize, 0.0);
-    constexpr int kSub = 32;
-    for (int row = 0; row < kSize; ++row) {
-      for (int col = 0; col < kSize; ++col) {
-        int in = 0;
-        for (int j = 0; j < kSub; ++j) {
-          for (int i = 0; i < kSub; ++i) {
-            const double nx = 2.0 * (col + (i + 0.5) / kSub) / kSize - 1.0;
-            const double ny = 1.0 - 2.0 * (row + (j + 0.5) / kSub) / kSize;
-            const Ray r = camera_ray_ndc(cam, basis, nx, ny);
-            const double t = -r.origin[2] / r.dir[2];
-            const double x = r.origin[0] + t * r.dir[0] - x0;
-            const double y = r.origin[1] + t * r.dir[1] - y0;
-            // (x, y) = u (c, s) a + v (-s, c) b, the edges being orthogonal.
-            const double u = (x * c + y * s) / a, v = (-x * s + y * c) / b;
-            if (u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0) ++in;
-          }
-        }
-        share[row * kSize + col] = static_cast<double>(in) / (kSub * kSub);
-      }
-    }
+    const std::vector<double> share =
+        test::plane_z0_shares(probe.cameras[0], kSize, [&](double px, double py) {
+          const double x = px - x0, y = py - y0;
+          // (x, y) = u (c, s) a + v (-s, c) b, the edges being orthogonal.
+          const double u = (x * c + y * s) / a, v = (-x * s + y * c) / b;
+          return u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0;
+        });
     double err[2] = {0.0, 0.0};
     for (int aa = 0; aa < 2; ++aa) {
       const Scene scene = parse_scene(scene_json(aa == 1), {});
       const auto frames = renderer().render(scene, FrameOptions{.read_hdr = true});
       ASSERT_EQ(frames.size(), 1u);
       ASSERT_EQ(frames[0].hdr.rgb.size(), 3u * kSize * kSize);
-      double diff = 0.0, total = 0.0;
-      int lost = 0;  // pixels half covered or more that read under a fifth of their share
-      for (std::size_t p = 0; p < share.size(); ++p) {
-        diff += std::abs(frames[0].hdr.rgb[3 * p] - L * share[p]);
-        total += L * share[p];
-        if (share[p] >= 0.5 && frames[0].hdr.rgb[3 * p] < 0.2 * L * share[p]) ++lost;
-      }
-      err[aa] = diff / total;
-      // No pixel of the light goes dark (a 4 x 4 count errs by at most a
-      // quarter of a pixel; a pixel outside the tested bounds reads 0).
-      EXPECT_EQ(lost, 0);
+      // No pixel half covered or more goes dark (under a fifth of its share:
+      // a 4 x 4 count errs by at most a quarter of a pixel; a pixel outside
+      // the tested bounds reads 0).
+      const test::OutlineError e = test::outline_error(frames[0].hdr.rgb, share, L, 0.5);
+      err[aa] = e.relative_l1;
+      EXPECT_EQ(e.lost, 0);
       std::printf("light outline (%s) %s: relative L1 %.4f\n",
                   perspective ? "perspective" : "orthographic", aa ? "antialiased" : "aliased",
                   err[aa]);

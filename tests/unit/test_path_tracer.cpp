@@ -20,16 +20,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-Camera make_camera(const Vec3& pos, const Vec3& target, double fov_y, int w, int h) {
-  Camera c;
-  c.position = pos;
-  c.target = target;
-  c.fov_y_deg = fov_y;
-  c.width = w;
-  c.height = h;
-  c.far_plane = 1e4;
-  return c;
-}
+using test::make_camera;
 
 using test::quad_light;
 using test::quad_occluder;
