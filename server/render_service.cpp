@@ -559,7 +559,8 @@ std::size_t RenderService::withdraw_locked(Task& task) {
 }
 
 // A worker's turn hook (protocol/turns.hpp), installed while one of its
-// slices renders: once the slice has rendered for turn_ms_ since it started
+// slices renders; for a costly slice (estimated over kTurnSliceMaxCost):
+// once the slice has rendered for turn_ms_ since it started
 // or since its last turn, and a slice that fits a turn is queued
 // (Task::fits_turn), the next such slice runs (RenderService::run_turn) on
 // this worker's second renderer, made on the first turn, and the slice
@@ -568,8 +569,13 @@ std::size_t RenderService::withdraw_locked(Task& task) {
 class RenderService::WorkerTurns final : public TurnHook {
  public:
   WorkerTurns(RenderService* service, int index) : service_(service), index_(index) {}
-  void begin(const Task& task) {
-    running_ = &task;
+  // Only a costly slice (estimated over kTurnSliceMaxCost) gives turns: a
+  // cheap one that runs long on a loaded machine does not (the second
+  // renderer is made only beside costly work).
+  void begin(const Task& task, std::size_t slice) {
+    const bool costly = task.cost_per_camera * static_cast<double>(task.slices[slice].size()) >
+                        kTurnSliceMaxCost;
+    running_ = costly ? &task : nullptr;
     last_ = Clock::now();
     given_ms_ = 0.0;
   }
@@ -939,7 +945,7 @@ std::optional<RenderService::SubmittedSlice> RenderService::start_slice(
   SubmittedSlice sub{t, slice, 0, 0.0};
   const auto start = Clock::now();
   std::optional<ErrorInfo> error;
-  if (turns != nullptr) turns->begin(task);
+  if (turns != nullptr) turns->begin(task, slice);
   if (!renderer) {
     error = ErrorInfo{"internal", "no renderer: " + failure_, ""};
   } else {

@@ -224,11 +224,12 @@ class RenderService {
   // encoders, and the preview frame then has them to itself.
   void set_hold_batch_encodes(bool hold);
 
-  // Turns inside a slice (protocol/turns.hpp): a slice that has rendered for
-  // `turn` lets one waiting cheap slice (estimated at most kTurnSliceMaxCost)
-  // of another connection, of its class or a higher one, run between its
-  // passes or row blocks, on a second renderer of the same worker, and so
-  // on every `turn` after. Default kRenderTurnMs; 0: at every turn point.
+  // Turns inside a slice (protocol/turns.hpp): a costly slice (estimated
+  // over kTurnSliceMaxCost) that has rendered for `turn` lets one waiting
+  // cheap slice (estimated at most kTurnSliceMaxCost) of another connection,
+  // of its class or a higher one, run between its passes or row blocks, on
+  // a second renderer of the same worker, and so on every `turn` after.
+  // Default kRenderTurnMs; 0: at every turn point.
   void set_turn(std::chrono::milliseconds turn) { turn_ms_.store(turn.count()); }
   // Slices run in turns inside other slices.
   std::uint64_t turns_taken() const { return turns_taken_.load(); }

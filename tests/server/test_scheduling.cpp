@@ -246,7 +246,7 @@ TEST(Scheduling, WithoutTheHoldBatchEncodesRunBesideAnInteractiveRender) {
 }
 
 // Turns inside a slice (RenderService::set_turn, protocol/turns.hpp): one
-// worker renders connection A's slice, which runs until the test ends it
+// worker renders connection A's costly slice, which runs until the test ends it
 // (the fake renderer's slow render, a turn point every 1 ms). A cheap render
 // of connection B, submitted meanwhile, is answered while A's slice is
 // still in the renderer; a costly one of connection C (estimated over
@@ -276,7 +276,7 @@ TEST(Scheduling, ACheapRenderRunsInATurnInsideALongSlice) {
     return j;
   };
   std::atomic<int> a{0}, b{0}, c{0};
-  ASSERT_TRUE(service.submit(job("a_0", 1, 10.0, &a)));
+  ASSERT_TRUE(service.submit(job("a_0", 1, 10.0 * kTurnSliceMaxCost, &a)));
   ASSERT_TRUE(eventually([&] { return control->call_count() == 1; }));
   ASSERT_TRUE(service.submit(job("c_0", 3, 10.0 * kTurnSliceMaxCost, &c)));
   ASSERT_TRUE(service.submit(job("b_0", 2, 10.0, &b)));
@@ -289,6 +289,38 @@ TEST(Scheduling, ACheapRenderRunsInATurnInsideALongSlice) {
   for (const auto& call : log_then) EXPECT_NE(call.at(0), "c_0") << "a costly slice ran in a turn";
   EXPECT_TRUE(eventually([&] { return a.load() == 1 && c.load() == 1; }));
   EXPECT_GE(service.turns_taken(), 1u);
+  service.stop();
+}
+
+// A cheap slice that runs long (a loaded machine) gives no turns: the
+// second renderer is made only beside costly work. A's slice is estimated
+// cheap and held 300 ms; B's render waits for it (answered after A's).
+TEST(Scheduling, ACheapSliceGivesNoTurns) {
+  auto control = std::make_shared<test::FakeRendererControl>();
+  RenderService service(test::fake_renderer_factory(control), 1, 1, PngSettings{}, 16);
+  service.wait_ready();
+  service.set_turn(std::chrono::milliseconds(5));
+  const auto scene = std::make_shared<const Scene>(parse_scene(test::tiny_scene(8), {}));
+  control->slow_renders("a_", 300);
+  std::atomic<int> order{0}, a_at{0}, b_at{0};
+  const auto job = [&](const char* name, std::uint64_t client, std::atomic<int>* at) {
+    RenderJob j;
+    j.scene = scene;
+    j.cameras = {scene->cameras.front()};
+    j.cameras[0].name = name;
+    j.client_alive = std::make_shared<std::atomic<bool>>(true);
+    j.arrived = std::chrono::steady_clock::now();
+    j.client = client;
+    j.cost = 10.0;
+    j.done = [&order, at](RenderOutcome&&) { at->store(++order); };
+    return j;
+  };
+  ASSERT_TRUE(service.submit(job("a_0", 1, &a_at)));
+  ASSERT_TRUE(eventually([&] { return control->call_count() == 1; }));
+  ASSERT_TRUE(service.submit(job("b_0", 2, &b_at)));
+  ASSERT_TRUE(eventually([&] { return a_at.load() > 0 && b_at.load() > 0; }));
+  EXPECT_LT(a_at.load(), b_at.load());
+  EXPECT_EQ(service.turns_taken(), 0u);
   service.stop();
 }
 

@@ -117,6 +117,20 @@ TEST(Soak, MixedLoadWithFaultsLeavesNoErrorsNoLeaksAndCorrectFrames) {
                              {"params", {{"scene_id", "soak"}, {"cameras", {pose(i)}}}}})
                       .json.value("ok", false));
     }
+    // The largest frames of the run too (the two-camera renders and the slow
+    // reader's four 256x256 cameras), twice so that both encode threads and
+    // the renderer's buffers have seen them: the caches that grow with the
+    // largest frame are in the baseline, and what grows after is the run's.
+    json big = {pose(1), pose(2), pose(3), pose(4)};
+    for (auto& cam : big) cam["width"] = cam["height"] = 256;
+    for (int i = 0; i < 2; ++i) {
+      ASSERT_TRUE(warm.call({{"id", 3}, {"method", "render"},
+                             {"params", {{"scene_id", "soak"}, {"cameras", {pose(0), pose(1)}}}}})
+                      .json.value("ok", false));
+      ASSERT_TRUE(warm.call({{"id", 4}, {"method", "render"},
+                             {"params", {{"scene_id", "soak"}, {"cameras", big}}}})
+                      .json.value("ok", false));
+    }
   }
   const double rss_base = settled_rss_mib();
 
