@@ -203,7 +203,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
       FrameResult last;
       for (int r = 0; r < std::max(1, opts.repeats); ++r) {
         fo.read_targets.clear();
-        if (r + 1 == std::max(1, opts.repeats)) fo.read_targets = {"slim_surface"};
+        if (r + 1 == std::max(1, opts.repeats)) fo.read_targets = {TargetId::kSlimSurface};
         auto frames = renderer.render(scene, fo);
         gpu.push_back(frames[0].gpu_ms);
         double s = 0.0;
@@ -218,7 +218,7 @@ int run_slim_bench(const SlimBenchOptions& opts) {
                    evaluation_name(st.slim.evaluation));
       for (auto& [name, ms] : pass_ms) std::fprintf(stderr, " %s %.1f", name.c_str(), median(ms));
       std::fputc('\n', stderr);
-      const SlimPixels pts = slim_from_surface(last.targets["slim_surface"], size, size);
+      const SlimPixels pts = slim_from_surface(last.targets[TargetId::kSlimSurface], size, size);
       const SlimErrors e = compare_slim(pts, ref->second, model_size);
       const char* eval_name = evaluation_name(st.slim.evaluation);
       if (opts.images && st.knob.rfind("zoom", 0) == 0) {

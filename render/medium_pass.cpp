@@ -20,10 +20,10 @@ class MediumPass final : public Pass {
     const bool multi = ctx.views > 0;
     ProgramPair& program = programs_.get(ctx.scene);
     glUseProgram(program.get(multi));
-    const bool surfaces = ctx.plan.written("view_depth");
+    const bool surfaces = ctx.plan.written(TargetId::kViewDepth);
     glUniform1i(program.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
     const GLint region_eye = set_medium_uniforms(program, multi, ctx);
-    bind_view_target_or_placeholder(ctx, 0, "view_depth");
+    bind_view_target_or_placeholder(ctx, 0, TargetId::kViewDepth);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ZERO, GL_SRC_COLOR);  // hdr *= transmittance
     glBlendEquation(GL_FUNC_ADD);
@@ -59,7 +59,7 @@ class VolumePhotonPass final : public Pass {
     const bool multi = ctx.views > 0;
     ProgramPair& program = programs_.get(ctx.scene);
     glUseProgram(program.get(multi));
-    const bool surfaces = ctx.plan.written("view_depth");
+    const bool surfaces = ctx.plan.written(TargetId::kViewDepth);
     glUniform1i(program.uniform(multi, "u_has_surfaces"), surfaces ? 1 : 0);
     glUniform1f(program.uniform(multi, "u_radius"),
                 static_cast<float>(ctx.resources.volume_radius()));
@@ -71,7 +71,7 @@ class VolumePhotonPass final : public Pass {
     glUniform1i(program.uniform(multi, "u_segments"), medium.segments);
     glUniform1f(program.uniform(multi, "u_power_scale"), static_cast<float>(1.0 / share));
     set_photon_lod(program, multi, ctx.scene.gi);
-    bind_view_target_or_placeholder(ctx, 0, "view_depth");
+    bind_view_target_or_placeholder(ctx, 0, TargetId::kViewDepth);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, ctx.resources.volume_buffer());
     begin_additive(ctx);
     int view = 0;

@@ -3,11 +3,12 @@
 // uploads. A frame's plan (the passes that run, the targets they need, the
 // uploads) is derived from those declarations alone, so the server can report
 // it, tests can check it without a GL context, and the renderer runs exactly
-// what the plan lists (render/passes.cpp makes one executor per PassId).
+// what the plan lists (each catalog row makes its executor).
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -24,32 +25,54 @@ bool interleaves_direct_points(const GiSettings& gi, std::size_t points);
 // which gi_resolve filters).
 bool interleaves_direct(const Scene& scene);
 
-// Every pass the renderer can execute. The executor of each is made by
-// make_pass (render/passes.cpp), whose switch over this enum has no default:
-// a new id without an executor does not compile (-Wswitch) and fails the
-// renderer's construction check.
-enum class PassId {
-  kSurfaces,
-  kGbuffer,
-  kSlimDepth,
-  kSlimAccumulate,
-  kSlimResolve,
-  kSlimGbuffer,
-  kDirect,
+// Every render target a pass can read or write (target_catalog() declares
+// each one's format, size and start value). Passes name targets by these
+// enumerators, so a misspelt target does not compile.
+enum class TargetId {
+  kHdr,
+  kViewDepth,
+  kDepth,
+  kOutput,
+  kUpscaled,
+  kGbNormal,
+  kGbAlbedo,
+  kGiIndirect,
+  kSlimNear,
+  kSlimRadius,
+  kSlimZbuf,
+  kSlimSumAlbedo,
+  kSlimSumField,
+  kSlimSumWeight,
+  kSlimSumField2,
+  kSlimSumWeight2,
+  kSlimSurface,
+  kVolumeT0,
+  kVolumeT1,
   kDirectSplit,
-  kPhotons,
-  kGiResolve,
   kSpecular,
-  kMedium,
-  kVolumePhotons,
-  kVolumeGrid,
-  kVolumes,
-  kVolumesForBeams,
-  kBeams,
-  kTonemap,
-  kUpscale
 };
-inline constexpr std::size_t kPassCount = static_cast<std::size_t>(PassId::kUpscale) + 1;
+inline constexpr std::size_t kTargetCount = static_cast<std::size_t>(TargetId::kSpecular) + 1;
+
+// The per-scene data a pass needs uploaded before the frame (SceneResources
+// makes each group the plan lists, in this order).
+enum class UploadGroup {
+  kBeams,          // tables, beam instances
+  kOccluders,      // triangles, analytic occluders
+  kPhotons,        // the surface photon maps (traced unless cached)
+  kVolumePhotons,  // the medium's scattering events as splats
+  kVolumeGrid,     // the same events for the world grid
+  kShadows,        // direct points and their shadow maps
+  kSlim,           // SLIM surfaces
+  kVolumes,        // scalar volumes' textures
+  kSpecular,       // mirror and glass rays (CPU or GPU tracer)
+};
+// The group's name in messages and documents ("volume_photons").
+const char* upload_group_name(UploadGroup g);
+
+class Pass;  // an executor (render/passes.hpp); GL, so only named here
+// Makes a pass's executor; called with a GL context current. Captureless
+// lambdas convert to it, so a catalog row can pick an executor's variant.
+using PassFactory = std::unique_ptr<Pass> (*)();
 
 // The texel layout of a kSplat target. llvmpipe rasterizes a framebuffer in
 // 64 x 64 tiles, one thread a tile: a splat grid of one tile (64 x 64 at
@@ -109,7 +132,8 @@ enum class TargetSize {
 };
 
 struct TargetDecl {
-  std::string name;
+  TargetId id{};
+  std::string name;  // in messages
   TargetFormat format = TargetFormat::kRgba32f;
   TargetSize size = TargetSize::kRender;
   TargetClear clear = TargetClear::kNone;
@@ -122,20 +146,22 @@ struct PlanInput {
   bool scaled() const { return resolution_scale > 0.0 && resolution_scale < 1.0; }
 };
 
+// One row of the pass catalog (render/pass_catalog.cpp): when a frame needs
+// the pass, what it reads and writes, what it uploads, and its executor.
 struct PassDecl {
-  PassId id{};
   std::string name;  // as reported in `passes` and pass_ms
   bool (*needed)(const PlanInput& in) = nullptr;
-  std::vector<std::string> reads;           // must hold data (cleared or written earlier)
-  std::vector<std::string> optional_reads;  // used only if a planned pass writes them
+  std::vector<TargetId> reads;           // must hold data (cleared or written earlier)
+  std::vector<TargetId> optional_reads;  // used only if a planned pass writes them
   // Colour targets in attachment order (fragment output locations), then at
   // most one depth target.
-  std::vector<std::string> writes;
-  std::vector<std::string> uploads;  // per-scene resource groups (SceneResources)
+  std::vector<TargetId> writes;
+  std::vector<UploadGroup> uploads;  // per-scene data (SceneResources)
+  PassFactory make = nullptr;        // null only in the plan tests' own catalogs
 };
 
-// Broken pass declarations: a required read nobody provides, an unknown
-// target, two passes with one id. A programming error, never a client's.
+// Broken pass declarations: a required read nobody provides, a target
+// missing from the target catalog. A programming error, never a client's.
 class PlanError : public std::logic_error {
  public:
   using std::logic_error::logic_error;
@@ -144,8 +170,8 @@ class PlanError : public std::logic_error {
 struct FramePlan {
   std::vector<const PassDecl*> passes;  // execution order
   std::vector<const TargetDecl*> targets;  // read or written by a planned pass, allocated
-  std::vector<std::string> uploads;        // union of the planned passes' uploads
-  std::string final_target;                // the last pass's first write: what is read back
+  std::vector<UploadGroup> uploads;        // union of the planned passes' uploads
+  TargetId final_target = TargetId::kOutput;  // the last pass's first write: what is read back
   int splat_scale = 1;  // kSplat targets' divisor: the scene's gi.splat_scale (0: auto_splat_scale)
   // The largest divisor auto_splat_scale may pick: 2 when a caustic map is
   // drawn (its disks, a quarter of the global radius, fall between the
@@ -154,14 +180,17 @@ struct FramePlan {
   int auto_splat_cap = 1 << 30;
 
   // True if a planned pass (not just the frame-start clear) writes `target`.
-  bool written(std::string_view target) const;
-  bool uses(std::string_view target) const;
-  bool uploads_group(std::string_view group) const;
+  bool written(TargetId target) const;
+  bool uses(TargetId target) const;
+  bool uploads_group(UploadGroup group) const;
   std::vector<std::string> names() const;
 };
 
-// The built-in targets and passes, in execution order.
+// The built-in targets, one per TargetId in its order (render/pass_plan.cpp).
 const std::vector<TargetDecl>& target_catalog();
+// The built-in passes in execution order, each with its executor: defined in
+// render/pass_catalog.cpp (the GL library, beside the executors it makes),
+// the one file a new pass adds a row to.
 const std::vector<PassDecl>& pass_catalog();
 
 // The plan of one frame; it points into `catalog` and `targets`, which must
@@ -172,7 +201,8 @@ const std::vector<PassDecl>& pass_catalog();
 FramePlan make_plan(const PlanInput& in, const std::vector<PassDecl>& catalog = pass_catalog(),
                     const std::vector<TargetDecl>& targets = target_catalog());
 
-// The names of the passes a frame of `scene` runs, in execution order.
+// The names of the passes a frame of `scene` runs, in execution order
+// (render/pass_catalog.cpp).
 std::vector<std::string> plan_passes(const Scene& scene, double resolution_scale = 1.0);
 
 }  // namespace beamcast

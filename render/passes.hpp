@@ -1,7 +1,8 @@
-// Pass executors and the GPU-side state a frame passes between passes. A new
-// effect (photon splatting, media, point surfaces, volumes) is a declaration in
-// pass_plan.cpp (rule, targets, uploads) and its executor here; the frame loop
-// does not change.
+// What pass executors share: the frame's targets, the frame context, the
+// Pass interface and the helpers executors draw with. A new effect (photon
+// splatting, media, point surfaces, volumes) is a row in pass_catalog.cpp
+// (rule, targets, uploads, executor factory) and its executor's own file,
+// which includes this one; the frame loop does not change.
 #pragma once
 
 #include <algorithm>
@@ -39,7 +40,9 @@ class FrameTargets {
               int bits, int layer_count = 0);
   // Clears every cleared target of the plan (all layers) to its start value.
   void clear(const FramePlan& plan, const Color& background);
-  GLuint texture(std::string_view name) const;  // 0: not allocated
+  // The texture of `target`; throws GlError if this frame's plan did not
+  // allocate it (a pass reading a target it did not declare).
+  GLuint texture(TargetId target) const;
   // A 1x1 (x1 layer) R32F texture of `target` holding 0, for a sampler that
   // a program has compiled in but does not read in this frame: the spec
   // leaves sampling unit with no texture undefined (GL 4.5 core 8.17).
@@ -65,10 +68,10 @@ class FrameTargets {
   int render_w_ = 0, render_h_ = 0, camera_w_ = 0, camera_h_ = 0, bits_ = 0, layers_ = 0;
   int splat_scale_ = 1;
   SplatBands splat_bands_;
-  std::vector<Target> targets_;
-  std::array<PassFbos, kPassCount> fbos_;
+  std::array<Target, kTargetCount> targets_{};  // by TargetId; decl null: not allocated
+  std::map<const PassDecl*, PassFbos> fbos_;     // by catalog row
   std::map<GLenum, GlTexture> placeholders_;  // by target; kept across sizes
-  const Target* find(std::string_view name) const;
+  const Target* find(TargetId id) const;
   GLuint make_fbo(const PassDecl& pass, int layer);
 };
 
@@ -247,17 +250,13 @@ void bind_gbuffer(const FrameContext& ctx);
 // sampler2DArray in multi-view batches) to `unit` if a planned pass writes
 // it, else that sampler's placeholder (FrameTargets::placeholder). Returns
 // whether the target is there.
-bool bind_view_target_or_placeholder(FrameContext& ctx, GLuint unit, const char* name);
+bool bind_view_target_or_placeholder(FrameContext& ctx, GLuint unit, TargetId target);
 // The VIEW_SAMPLER placeholder alone, for a sampler compiled in but unread.
 void bind_view_placeholder(FrameContext& ctx, GLuint unit);
 
 // The photon LOD uniforms of shaders/photon_splat.vert (GiSettings::lod_*),
 // for the passes that draw photons with it.
 void set_photon_lod(ProgramPair& program, bool multiview, const GiSettings& gi);
-
-// The executor of a catalog pass; programs are compiled here, so a GL context
-// must be current. Multi-view programs are compiled on first use.
-std::unique_ptr<Pass> make_pass(PassId id);
 
 // A rectangle of pixels, lower-left and upper-right inclusive, in window
 // coordinates (y up); kEveryPixel: no bound.

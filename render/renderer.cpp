@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <map>
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -91,7 +93,7 @@ struct PassStamps {
 
 struct Renderer::Impl {
   std::unique_ptr<EglContext> context;
-  std::array<std::unique_ptr<Pass>, kPassCount> passes;  // by PassId
+  std::map<const PassDecl*, std::unique_ptr<Pass>> passes;  // by catalog row
   TableCache tables;
   PhotonCache photons;  // photon maps by what they depend on (gi/photon_cache.hpp)
   VolumeTextureCache volumes;  // volume textures across frames (render/volume_pass.hpp)
@@ -119,13 +121,12 @@ struct Renderer::Impl {
         tables(opts.table_cache_entries),
         scene_cache(opts.scene_cache_bytes) {
     const EglContext::Current current(*context);
-    // One executor per catalog pass: a declaration the renderer cannot run is
-    // an error here, not a pass silently missing from frames.
+    // One executor per catalog row: a row the renderer cannot run is an
+    // error here, not a pass silently missing from frames.
     for (const PassDecl& decl : pass_catalog()) {
-      passes[static_cast<std::size_t>(decl.id)] = make_pass(decl.id);
-    }
-    for (std::size_t i = 0; i < passes.size(); ++i) {
-      if (!passes[i]) throw GlError("pass id " + std::to_string(i) + " has no catalog entry");
+      std::unique_ptr<Pass> pass = decl.make ? decl.make() : nullptr;
+      if (!pass) throw GlError("pass " + decl.name + " has no executor");
+      passes[&decl] = std::move(pass);
     }
     GLuint id = 0;
     glCreateVertexArrays(1, &id);
@@ -155,7 +156,7 @@ struct Renderer::Impl {
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
       const PassDecl& decl = *plan.passes[i];
       const GlPassLabel label(decl.name);
-      passes[static_cast<std::size_t>(decl.id)]->execute(ctx, decl);
+      passes.at(&decl)->execute(ctx, decl);
       glQueryCounter(queries[i + 1].get(), GL_TIMESTAMP);
       stamps.turn_ms[i + 1] = turn_ms_taken();
       // Between passes a long frame may give waiting renders a turn
@@ -249,7 +250,7 @@ struct Renderer::Impl {
       result.hdr.width = hw;
       result.hdr.height = hh;
       std::vector<float> buf(hrow * hh);
-      glGetTextureImage(targets.texture("hdr"), 0, GL_RGB, GL_FLOAT,
+      glGetTextureImage(targets.texture(TargetId::kHdr), 0, GL_RGB, GL_FLOAT,
                         static_cast<GLsizei>(buf.size() * sizeof(float)), buf.data());
       gl_check("glGetTextureImage(hdr)");
       result.hdr.rgb.resize(buf.size());
@@ -258,10 +259,10 @@ struct Renderer::Impl {
       }
     }
 
-    for (const std::string& name : opts.read_targets) {
-      // Debug and bench read-back of named targets (RGBA float, top-down).
+    for (const TargetId name : opts.read_targets) {
+      // Debug and bench read-back of targets (RGBA float, top-down).
+      if (!plan.uses(name)) continue;  // not in this frame's plan
       const GLuint tex = targets.texture(name);
-      if (tex == 0) continue;  // not in this frame's plan
       const int tw = cam.width, th = cam.height;
       const std::size_t trow = 4 * static_cast<std::size_t>(tw);
       std::vector<float> buf(trow * th);
@@ -324,7 +325,7 @@ struct Renderer::Impl {
     if (opts.read_hdr) {
       complete_slot(slot);
       std::vector<float> all(3 * static_cast<std::size_t>(w) * h * k);
-      glGetTextureImage(layered.texture("hdr"), 0, GL_RGB, GL_FLOAT,
+      glGetTextureImage(layered.texture(TargetId::kHdr), 0, GL_RGB, GL_FLOAT,
                         static_cast<GLsizei>(all.size() * sizeof(float)), all.data());
       gl_check("glGetTextureImage(hdr layers)");
       for (std::size_t v = 0; v < k; ++v) {
@@ -626,8 +627,9 @@ HdrImage box_downsample(const HdrImage& big, int k) {
 bool Renderer::needs_photon_trace(const Scene& scene, const FrameOptions& opts) const {
   if (opts.photon_maps || scene.lights.empty()) return false;
   const FramePlan plan = make_plan(PlanInput{scene, opts.resolution_scale});
-  const bool uses = plan.uploads_group("photons") || plan.uploads_group("volume_photons") ||
-                    plan.uploads_group("specular");
+  const bool uses = plan.uploads_group(UploadGroup::kPhotons) ||
+                    plan.uploads_group(UploadGroup::kVolumePhotons) ||
+                    plan.uploads_group(UploadGroup::kSpecular);
   return uses && !impl_->photons.holds(photon_key(scene));
 }
 

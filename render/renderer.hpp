@@ -71,8 +71,8 @@ struct FrameOptions {
   double resolution_scale = 1.0;
   // Single-camera frames (batch off): also read back these targets of the
   // plan (render size, RGBA float, rows top-down) into FrameResult::targets;
-  // names the plan does not use are skipped. For tests and benches.
-  std::vector<std::string> read_targets{};
+  // targets the plan does not use are skipped. For tests and benches.
+  std::vector<TargetId> read_targets{};
   // The scene's photon maps, traced before the render on another thread
   // (trace_photons over GiScene(scene): what the render would trace itself;
   // Renderer::needs_photon_trace): used, and cached, in place of tracing.
@@ -120,7 +120,7 @@ struct FrameResult {
   double photon_trace_ms = 0.0;
   double photon_upload_ms = 0.0;
   // FrameOptions::read_targets: width x height x 4 floats each.
-  std::map<std::string, std::vector<float>> targets{};
+  std::map<TargetId, std::vector<float>> targets{};
   // SLIM surfaces: the sample slots the point passes processed (single-camera
   // frames; 0 in multi-view batches).
   std::int64_t slim_points = 0;

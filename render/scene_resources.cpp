@@ -218,39 +218,49 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
                                PhotonCache* photons, VolumeTextureCache* volumes,
                                SceneGpuCache* content)
     : scene_(scene) {
-  if (plan.uploads_group("beams")) upload_beams(tables);
-  if (plan.uploads_group("occluders")) upload_occluders(content);
-  if (plan.uploads_group("photons")) {
-    if (!photons) throw GlError("the plan splats photons but the renderer has no photon cache");
-    // Photons straight from a light are left out when the direct pass
-    // carries direct light.
-    upload_photons(*photons, plan.uploads_group("shadows"));
-  }
-  if (plan.uploads_group("volume_photons")) {
-    if (!photons)
-      throw GlError("the plan splats volume photons but the renderer has no photon cache");
-    upload_volume_photons(*photons);
-  }
-  if (plan.uploads_group("volume_grid")) {
-    if (!photons) throw GlError("the plan bins volume photons but the renderer has no photon cache");
-    upload_volume_grid(*photons);
-  }
-  if (plan.uploads_group("shadows")) upload_direct();
-  if (plan.uploads_group("slim")) slim_ = std::make_unique<SlimResources>(scene, content);
-  if (plan.uploads_group("volumes")) volumes_ = std::make_unique<VolumeResources>(scene, volumes);
   upload_medium_meshes();
-  if (plan.uploads_group("specular")) {
-    if (!photons)
-      throw GlError("the plan traces specular rays but the renderer has no photon cache");
-    if (!maps_) maps_ = photons->get(scene);
-    const SpecularTracer tracer = scene.gi.specular_tracer;
-    const bool gpu = tracer == SpecularTracer::kGpu ||
-                     (tracer == SpecularTracer::kAuto && !software_gl());
-    if (gpu && gpu_traces_specular(scene)) {
-      specular_gpu_ = std::make_unique<SpecularGpu>(scene, *maps_, plan.uploads_group("shadows"));
-    } else {
-      gi_scene_ = std::make_unique<GiScene>(scene);
-      photon_gather_ = photons->gather(maps_, plan.uploads_group("shadows"));
+  const bool shadows = plan.uploads_group(UploadGroup::kShadows);
+  auto need = [&](const char* what) -> PhotonCache& {
+    if (!photons) {
+      throw GlError(std::string("the plan ") + what + " but the renderer has no photon cache");
+    }
+    return *photons;
+  };
+  // Every group the plan lists, in UploadGroup order (the switch has no
+  // default: a new group without its upload does not compile, -Wswitch).
+  for (std::size_t g = 0; g <= static_cast<std::size_t>(UploadGroup::kSpecular); ++g) {
+    const auto group = static_cast<UploadGroup>(g);
+    if (!plan.uploads_group(group)) continue;
+    switch (group) {
+      case UploadGroup::kBeams:
+        upload_beams(tables);
+        break;
+      case UploadGroup::kOccluders:
+        upload_occluders(content);
+        break;
+      case UploadGroup::kPhotons:
+        // Photons straight from a light are left out when the direct pass
+        // carries direct light.
+        upload_photons(need("splats photons"), shadows);
+        break;
+      case UploadGroup::kVolumePhotons:
+        upload_volume_photons(need("splats volume photons"));
+        break;
+      case UploadGroup::kVolumeGrid:
+        upload_volume_grid(need("bins volume photons"));
+        break;
+      case UploadGroup::kShadows:
+        upload_direct();
+        break;
+      case UploadGroup::kSlim:
+        slim_ = std::make_unique<SlimResources>(scene, content);
+        break;
+      case UploadGroup::kVolumes:
+        volumes_ = std::make_unique<VolumeResources>(scene, volumes);
+        break;
+      case UploadGroup::kSpecular:
+        upload_specular(need("traces specular rays"), shadows);
+        break;
     }
   }
   GLuint id = 0;
@@ -258,6 +268,20 @@ SceneResources::SceneResources(const Scene& scene, TableCache& tables, const Fra
   camera_ubo_ = GlBuffer(id);
   glNamedBufferStorage(id, sizeof(CameraBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   gl_check("create scene buffers");
+}
+
+void SceneResources::upload_specular(PhotonCache& photons, bool shadows) {
+  const Scene& scene = scene_;
+  if (!maps_) maps_ = photons.get(scene);
+  const SpecularTracer tracer = scene.gi.specular_tracer;
+  const bool gpu =
+      tracer == SpecularTracer::kGpu || (tracer == SpecularTracer::kAuto && !software_gl());
+  if (gpu && gpu_traces_specular(scene)) {
+    specular_gpu_ = std::make_unique<SpecularGpu>(scene, *maps_, shadows);
+  } else {
+    gi_scene_ = std::make_unique<GiScene>(scene);
+    photon_gather_ = photons.gather(maps_, shadows);
+  }
 }
 
 void SceneResources::upload_medium_meshes() {

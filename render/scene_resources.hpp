@@ -61,9 +61,10 @@ struct OccluderGeometry {
 
 class SceneResources {
  public:
-  // Uploads the resource groups the plan's passes declare: "beams" (tables,
-  // beam instances), "occluders" (triangles, analytic occluders), "photons"
-  // (the scene's photon maps from `photons`, traced there unless cached).
+  // Uploads the resource groups the plan's passes declare (UploadGroup):
+  // kBeams (tables, beam instances), kOccluders (triangles, analytic
+  // occluders), kPhotons (the scene's photon maps from `photons`, traced
+  // there unless cached), and so on.
   // `content`: where uploads that depend only on the scene's content are
   // kept across renders (null: made for this render alone).
   SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan,
@@ -187,6 +188,7 @@ class SceneResources {
   GlBuffer direct_ssbo_;
   GlBuffer medium_tri_ssbo_;
   void upload_medium_meshes();
+  void upload_specular(PhotonCache& photons, bool shadows);
   std::vector<DirectPoint> direct_points_;
   std::vector<Color> direct_flux_;  // each point's light's flux
   int direct_interleaved_ = 0;

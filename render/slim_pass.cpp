@@ -318,10 +318,10 @@ class SlimPointsPass final : public Pass {
         slim->plan_views({ctx.camera}, {ctx.basis}, ctx.scene.slim);
       }
     }
-    glBindTextureUnit(0, ctx.targets.texture("view_depth"));
+    glBindTextureUnit(0, ctx.targets.texture(TargetId::kViewDepth));
     if (!depth_) {
-      glBindTextureUnit(1, ctx.targets.texture("slim_near"));
-      glBindTextureUnit(2, ctx.targets.texture("slim_radius"));
+      glBindTextureUnit(1, ctx.targets.texture(TargetId::kSlimNear));
+      glBindTextureUnit(2, ctx.targets.texture(TargetId::kSlimRadius));
     }
     for (ProgramPair* p : {&program, creases}) {
       if (!p) continue;
@@ -453,21 +453,21 @@ class SlimPointsPass final : public Pass {
 // Pass 3: normalization into the surfaces' targets.
 class SlimResolvePass final : public Pass {
  public:
-  SlimResolvePass() : program_("slim_resolve") {}
+  explicit SlimResolvePass(bool gbuffer) : program_("slim_resolve"), gbuffer_(gbuffer) {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     if (!ctx.resources.slim() || ctx.resources.slim()->sphere_count() == 0) return;
     const bool multi = ctx.views > 0;
     glUseProgram(program_.get(multi));
-    glUniform1i(program_.uniform(multi, "u_gi"), self.id == PassId::kSlimGbuffer ? 1 : 0);
+    glUniform1i(program_.uniform(multi, "u_gi"), gbuffer_ ? 1 : 0);
     glUniform1i(program_.uniform(multi, "u_field"),
                 ctx.scene.slim.evaluation != SlimEvaluation::kBlend ? 1 : 0);
-    glBindTextureUnit(1, ctx.targets.texture("slim_sum_albedo"));
-    glBindTextureUnit(2, ctx.targets.texture("slim_sum_field"));
-    glBindTextureUnit(3, ctx.targets.texture("slim_sum_weight"));
-    glBindTextureUnit(4, ctx.targets.texture("slim_near"));
-    glBindTextureUnit(5, ctx.targets.texture("slim_sum_field2"));
-    glBindTextureUnit(6, ctx.targets.texture("slim_sum_weight2"));
-    glBindTextureUnit(7, ctx.targets.texture("slim_radius"));
+    glBindTextureUnit(1, ctx.targets.texture(TargetId::kSlimSumAlbedo));
+    glBindTextureUnit(2, ctx.targets.texture(TargetId::kSlimSumField));
+    glBindTextureUnit(3, ctx.targets.texture(TargetId::kSlimSumWeight));
+    glBindTextureUnit(4, ctx.targets.texture(TargetId::kSlimNear));
+    glBindTextureUnit(5, ctx.targets.texture(TargetId::kSlimSumField2));
+    glBindTextureUnit(6, ctx.targets.texture(TargetId::kSlimSumWeight2));
+    glBindTextureUnit(7, ctx.targets.texture(TargetId::kSlimRadius));
     glUniform1f(program_.uniform(multi, "u_step"), kSlimFieldStep);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_TEST);
@@ -484,23 +484,15 @@ class SlimResolvePass final : public Pass {
 
  private:
   ProgramPair program_;
+  bool gbuffer_;  // the "slim_gbuffer" row: into a lit scene's G-buffer
 };
 
 }  // namespace
 
-std::unique_ptr<Pass> make_slim_pass(PassId id) {
-  switch (id) {
-    case PassId::kSlimDepth:
-      return std::make_unique<SlimPointsPass>(true);
-    case PassId::kSlimAccumulate:
-      return std::make_unique<SlimPointsPass>(false);
-    case PassId::kSlimResolve:
-    case PassId::kSlimGbuffer:
-      return std::make_unique<SlimResolvePass>();
-    default:
-      break;
-  }
-  throw GlError("make_slim_pass: not a slim pass");
+std::unique_ptr<Pass> make_slim_depth_pass() { return std::make_unique<SlimPointsPass>(true); }
+std::unique_ptr<Pass> make_slim_accumulate_pass() { return std::make_unique<SlimPointsPass>(false); }
+std::unique_ptr<Pass> make_slim_resolve_pass(bool gbuffer) {
+  return std::make_unique<SlimResolvePass>(gbuffer);
 }
 
 }  // namespace beamcast

@@ -125,7 +125,11 @@ class SlimResources {
   std::vector<std::int64_t> slots_;
 };
 
-// The executor of a slim pass id.
-std::unique_ptr<Pass> make_slim_pass(PassId id);
+// The executors of the slim passes (rows in render/pass_catalog.cpp):
+// "slim_depth", "slim_accumulate", and "slim_resolve" (gbuffer false) or
+// "slim_gbuffer" (true).
+std::unique_ptr<Pass> make_slim_depth_pass();
+std::unique_ptr<Pass> make_slim_accumulate_pass();
+std::unique_ptr<Pass> make_slim_resolve_pass(bool gbuffer);
 
 }  // namespace beamcast

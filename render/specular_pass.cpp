@@ -27,7 +27,7 @@ class SpecularPass final : public Pass {
       trace_on_cpu(ctx);
     }
     glUseProgram(program_.get(ctx.views > 0));
-    glBindTextureUnit(0, ctx.targets.texture("specular"));
+    glBindTextureUnit(0, ctx.targets.texture(TargetId::kSpecular));
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
     glBlendEquation(GL_FUNC_ADD);
@@ -48,8 +48,8 @@ class SpecularPass final : public Pass {
     glUseProgram(program);
     gpu.bind(program);
     glUniform1i(trace.uniform(multi, "u_samples"), ctx.scene.gi.specular_samples);
-    glBindTextureUnit(0, ctx.targets.texture("gb_albedo"));
-    glBindImageTexture(0, ctx.targets.texture("specular"), 0, multi ? GL_TRUE : GL_FALSE, 0,
+    glBindTextureUnit(0, ctx.targets.texture(TargetId::kGbAlbedo));
+    glBindImageTexture(0, ctx.targets.texture(TargetId::kSpecular), 0, multi ? GL_TRUE : GL_FALSE, 0,
                        GL_WRITE_ONLY, GL_RGBA32F);
     const GLint eye = trace.uniform(multi, "u_eye");
     const int views = multi ? ctx.views : 1;
@@ -74,8 +74,8 @@ class SpecularPass final : public Pass {
     const LitShading shading(ctx.scene, *surfaces, *gather);
     const bool multi = ctx.views > 0;
     const int views = multi ? ctx.views : 1;
-    const GLuint albedo_tex = ctx.targets.texture("gb_albedo");
-    const GLuint out_tex = ctx.targets.texture("specular");
+    const GLuint albedo_tex = ctx.targets.texture(TargetId::kGbAlbedo);
+    const GLuint out_tex = ctx.targets.texture(TargetId::kSpecular);
     std::vector<float> albedo, out;
     const int samples = ctx.scene.gi.specular_samples;  // K x K rays a pixel
     for (int v = 0; v < views; ++v) {

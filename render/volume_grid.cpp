@@ -193,7 +193,7 @@ class VolumeGridPass final : public Pass {
 
     ProgramPair& march = programs_.get(ctx.scene);
     glUseProgram(march.get(multi));
-    glUniform1i(march.uniform(multi, "u_has_surfaces"), ctx.plan.written("view_depth") ? 1 : 0);
+    glUniform1i(march.uniform(multi, "u_has_surfaces"), ctx.plan.written(TargetId::kViewDepth) ? 1 : 0);
     glUniform3f(march.uniform(multi, "u_grid_size"), static_cast<float>(g.cell * g.dims[0]),
                 static_cast<float>(g.cell * g.dims[1]), static_cast<float>(g.cell * g.dims[2]));
     glUniform1f(march.uniform(multi, "u_cell"), static_cast<float>(g.cell));
@@ -201,7 +201,7 @@ class VolumeGridPass final : public Pass {
     const GLint region_eye = set_medium_uniforms(march, multi, ctx);
     const GLint march_offset = march.uniform(multi, "u_grid_offset");
 
-    bind_view_target_or_placeholder(ctx, 0, "view_depth");
+    bind_view_target_or_placeholder(ctx, 0, TargetId::kViewDepth);
     glBindTextureUnit(1, grid->texture());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, grid->photon_buffer());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, grid->start_buffer());

@@ -298,14 +298,15 @@ std::array<double, 9> rotation_matrix(const std::array<double, 4>& q) {
 
 class VolumePass final : public Pass {
  public:
+  explicit VolumePass(bool knots) : knots_(knots) {}
   void execute(FrameContext& ctx, const PassDecl& self) override {
     const VolumeResources* res = ctx.resources.volumes();
     if (!res) throw GlError("volume pass: the scene's volumes were not uploaded");
     const VolumeSettings& s = ctx.scene.volume;
-    const bool knots = self.id == PassId::kVolumesForBeams;
+    const bool knots = knots_;
     const bool multi = ctx.views > 0;
-    const bool surfaces = ctx.plan.written("view_depth");
-    bind_view_target_or_placeholder(ctx, 0, "view_depth");
+    const bool surfaces = ctx.plan.written(TargetId::kViewDepth);
+    bind_view_target_or_placeholder(ctx, 0, TargetId::kViewDepth);
     // hdr = volume colour + (1 - volume opacity) hdr, hdr's alpha kept; the
     // transmittance knots multiplied over the volumes.
     glEnable(GL_BLEND);
@@ -382,11 +383,12 @@ class VolumePass final : public Pass {
     return programs_.get(std::string("volume_cast") + (preint ? "_preint" : "") +
                          (skip ? "_skip" : "") + (knots ? "_knots" : ""));
   }
+  bool knots_;  // the row with beams: also writes the transmittance knots
   LazyPrograms programs_;
 };
 
 }  // namespace
 
-std::unique_ptr<Pass> make_volume_pass() { return std::make_unique<VolumePass>(); }
+std::unique_ptr<Pass> make_volume_pass(bool knots) { return std::make_unique<VolumePass>(knots); }
 
 }  // namespace beamcast

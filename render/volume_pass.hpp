@@ -139,6 +139,8 @@ inline bool preintegrated(const VolumeSettings& s) {
   return s.integration == VolumeIntegration::kPreintegrated && s.opacity_correction;
 }
 
-std::unique_ptr<Pass> make_volume_pass();
+// The "volumes" pass; knots: the row of scenes with beams, which also
+// writes volume_t0/volume_t1.
+std::unique_ptr<Pass> make_volume_pass(bool knots);
 
 }  // namespace beamcast

@@ -151,7 +151,7 @@ TEST(Passes, BeamOnlySceneRunsNoSurfacePass) {
   scene.cameras[0].width = scene.cameras[0].height = 64;
   const auto frames = shared_renderer().render(scene);
   const FramePlan plan = make_plan(PlanInput{scene});
-  EXPECT_FALSE(plan.written("view_depth"));
+  EXPECT_FALSE(plan.written(TargetId::kViewDepth));
   ASSERT_EQ(frames[0].passes.size(), plan.passes.size());
   for (std::size_t i = 0; i < plan.passes.size(); ++i) {
     EXPECT_EQ(frames[0].passes[i].name, plan.passes[i]->name);

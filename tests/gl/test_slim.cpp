@@ -52,10 +52,10 @@ SlimFrame render_slim(const Scene& scene, bool hdr = false) {
   FrameOptions opts;
   opts.batch = false;
   opts.read_hdr = hdr;
-  opts.read_targets = {"slim_surface"};
+  opts.read_targets = {TargetId::kSlimSurface};
   auto frames = renderer().render(scene, opts);
   const Camera& cam = scene.cameras[0];
-  SlimPixels gpu = slim_from_surface(frames[0].targets["slim_surface"], cam.width, cam.height);
+  SlimPixels gpu = slim_from_surface(frames[0].targets[TargetId::kSlimSurface], cam.width, cam.height);
   return {std::move(frames[0]), std::move(gpu)};
 }
 

@@ -83,12 +83,12 @@ TEST(Volumes, OnlyScenesWithBeamsGetTheTransmittanceKnots) {
   // The knots' two float targets (cleared and blended every frame) are
   // planned only where beams read them.
   const Scene vol = parse_scene(ml_scene(16, json::object()), {});
-  EXPECT_FALSE(make_plan(PlanInput{vol, 1.0}).uses("volume_t0"));
+  EXPECT_FALSE(make_plan(PlanInput{vol, 1.0}).uses(TargetId::kVolumeT0));
   json j = ml_scene(16, json::object());
   j["beams"] = {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 0.5}}};
   const FramePlan with_beams = make_plan(PlanInput{parse_scene(j, {}), 1.0});
-  EXPECT_TRUE(with_beams.written("volume_t0"));
-  EXPECT_TRUE(with_beams.written("volume_t1"));
+  EXPECT_TRUE(with_beams.written(TargetId::kVolumeT0));
+  EXPECT_TRUE(with_beams.written(TargetId::kVolumeT1));
   const auto names = with_beams.names();
   EXPECT_EQ(std::count(names.begin(), names.end(), "volumes"), 1);
 }

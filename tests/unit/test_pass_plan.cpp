@@ -38,30 +38,30 @@ TEST(PassPlan, BeamOnlySceneAllocatesNoSurfaceTargets) {
   EXPECT_EQ(plan.names(), (std::vector<std::string>{"beams", "tonemap"}));
   // view_depth is an optional read of the beams: nobody writes it, so it is
   // neither allocated nor reported as written; nor is the depth buffer.
-  EXPECT_FALSE(plan.written("view_depth"));
+  EXPECT_FALSE(plan.written(TargetId::kViewDepth));
   EXPECT_EQ(target_names(plan), (std::vector<std::string>{"hdr", "output"}));
-  EXPECT_EQ(plan.uploads, (std::vector<std::string>{"beams"}));
-  EXPECT_EQ(plan.final_target, "output");
+  EXPECT_EQ(plan.uploads, (std::vector<UploadGroup>{UploadGroup::kBeams}));
+  EXPECT_EQ(plan.final_target, TargetId::kOutput);
 }
 
 TEST(PassPlan, VolumesWriteTransmittanceKnotsThatBeamsRead) {
   const FramePlan plan =
       make_plan(PlanInput{scene_with(true, false, false, false, false, false, true)});
   EXPECT_EQ(plan.names(), (std::vector<std::string>{"volumes", "beams", "tonemap"}));
-  EXPECT_TRUE(plan.written("volume_t0"));
+  EXPECT_TRUE(plan.written(TargetId::kVolumeT0));
   EXPECT_EQ(target_names(plan),
             (std::vector<std::string>{"hdr", "output", "volume_t0", "volume_t1"}));
-  EXPECT_EQ(plan.uploads, (std::vector<std::string>{"volumes", "beams"}));
+  EXPECT_EQ(plan.uploads, (std::vector<UploadGroup>{UploadGroup::kVolumes, UploadGroup::kBeams}));
 }
 
 TEST(PassPlan, OccludersWriteViewDepthThatBeamsRead) {
   const FramePlan plan = make_plan(PlanInput{scene_with(true, true)});
   EXPECT_EQ(plan.names(), (std::vector<std::string>{"surfaces", "beams", "tonemap"}));
-  EXPECT_TRUE(plan.written("view_depth"));
+  EXPECT_TRUE(plan.written(TargetId::kViewDepth));
   EXPECT_EQ(target_names(plan),
             (std::vector<std::string>{"depth", "hdr", "output", "view_depth"}));
-  EXPECT_TRUE(plan.uploads_group("occluders"));
-  EXPECT_TRUE(plan.uploads_group("beams"));
+  EXPECT_TRUE(plan.uploads_group(UploadGroup::kOccluders));
+  EXPECT_TRUE(plan.uploads_group(UploadGroup::kBeams));
 }
 
 TEST(PassPlan, EmptySceneOnlyTonemapsTheClearedBackground) {
@@ -73,7 +73,7 @@ TEST(PassPlan, EmptySceneOnlyTonemapsTheClearedBackground) {
 TEST(PassPlan, ScaledFramesEndWithUpscale) {
   const FramePlan plan = make_plan(PlanInput{scene_with(true, false), 0.5});
   EXPECT_EQ(plan.names(), (std::vector<std::string>{"beams", "tonemap", "upscale"}));
-  EXPECT_EQ(plan.final_target, "upscaled");
+  EXPECT_EQ(plan.final_target, TargetId::kUpscaled);
   // Scale 1 (and out-of-range values, which the server never sends) is native.
   EXPECT_EQ(plan_passes(scene_with(true, false), 1.0).back(), "tonemap");
 }
@@ -122,28 +122,26 @@ TEST(PassPlan, EveryCatalogPassIsReachable) {
 bool always(const PlanInput&) { return true; }
 
 TEST(PassPlan, ReadingATargetNobodyWritesFailsAtPlanTime) {
-  std::vector<TargetDecl> targets = target_catalog();
-  targets.push_back({"gbuffer.normal", TargetFormat::kRgba32f, TargetSize::kRender,
-                     TargetClear::kNone});
-  const PassDecl lighting{PassId::kBeams, "lighting", always, {"gbuffer.normal"}, {}, {"hdr"}, {}};
-  const PassDecl gbuffer{PassId::kSurfaces, "gbuffer", always, {}, {}, {"gbuffer.normal"}, {}};
+  // gb_normal: a target with no start value (TargetClear::kNone).
+  const PassDecl lighting{"lighting", always, {TargetId::kGbNormal}, {}, {TargetId::kHdr}, {}};
+  const PassDecl gbuffer{"gbuffer", always, {}, {}, {TargetId::kGbNormal}, {}};
   const Scene scene = scene_with(true, false);
   try {
-    make_plan(PlanInput{scene}, {lighting}, targets);
+    make_plan(PlanInput{scene}, {lighting});
     FAIL() << "expected PlanError";
   } catch (const PlanError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "pass \"lighting\" reads target \"gbuffer.normal\", which no earlier planned pass "
+              "pass \"lighting\" reads target \"gb_normal\", which no earlier planned pass "
               "writes and nothing clears");
   }
   // Written too late is not written.
-  EXPECT_THROW(make_plan(PlanInput{scene}, {lighting, gbuffer}, targets), PlanError);
+  EXPECT_THROW(make_plan(PlanInput{scene}, {lighting, gbuffer}), PlanError);
   // Written by an earlier pass: planned, and the target is allocated. (A plan
   // points into its catalog, which must outlive it.)
   const std::vector<PassDecl> catalog{gbuffer, lighting};
-  const FramePlan plan = make_plan(PlanInput{scene}, catalog, targets);
+  const FramePlan plan = make_plan(PlanInput{scene}, catalog);
   EXPECT_EQ(plan.names(), (std::vector<std::string>{"gbuffer", "lighting"}));
-  EXPECT_TRUE(plan.uses("gbuffer.normal"));
+  EXPECT_TRUE(plan.uses(TargetId::kGbNormal));
 }
 
 // gi.direct_interleave 4 (the default) shares out the points of each light
@@ -157,11 +155,11 @@ TEST(PassPlan, QuadLightsInterleaveTheirDirectPoints) {
   const FramePlan plan = make_plan(PlanInput{quad});
   EXPECT_EQ(plan.names(),
             (std::vector<std::string>{"gbuffer", "direct", "photons", "gi_resolve", "tonemap"}));
-  EXPECT_TRUE(plan.uses("direct_split"));
+  EXPECT_TRUE(plan.uses(TargetId::kDirectSplit));
   const auto resolve = std::find_if(plan.passes.begin(), plan.passes.end(),
-                                    [](const PassDecl* p) { return p->id == PassId::kGiResolve; });
+                                    [](const PassDecl* p) { return p->name == "gi_resolve"; });
   ASSERT_NE(resolve, plan.passes.end());
-  EXPECT_EQ((*resolve)->optional_reads, std::vector<std::string>{"direct_split"});
+  EXPECT_EQ((*resolve)->optional_reads, std::vector<TargetId>{TargetId::kDirectSplit});
   // The quad's points, 2 x 2 cells at a time: every fourth spans the light.
   const auto points = std::get<QuadLight>(quad.lights[0].shape).direct_points(16);
   ASSERT_EQ(points.size(), 16u);
@@ -175,7 +173,7 @@ TEST(PassPlan, QuadLightsInterleaveTheirDirectPoints) {
   EXPECT_FALSE(interleaves_direct(quad));
   EXPECT_EQ(make_plan(PlanInput{quad}).names(),
             (std::vector<std::string>{"gbuffer", "direct", "photons", "gi_resolve", "tonemap"}));
-  EXPECT_FALSE(make_plan(PlanInput{quad}).uses("direct_split"));
+  EXPECT_FALSE(make_plan(PlanInput{quad}).uses(TargetId::kDirectSplit));
   EXPECT_FALSE(interleaves_direct(scene_with(false, true, true)));  // a point light
 }
 
@@ -186,23 +184,23 @@ TEST(PassPlan, LitScenesSplatPhotonsOverAGbuffer) {
   const FramePlan plan = make_plan(PlanInput{scene_with(true, true, true)});
   EXPECT_EQ(plan.names(),
             (std::vector<std::string>{"gbuffer", "direct", "photons", "gi_resolve", "beams", "tonemap"}));
-  EXPECT_TRUE(plan.uploads_group("shadows"));
+  EXPECT_TRUE(plan.uploads_group(UploadGroup::kShadows));
   Scene photons_only = scene_with(true, true, true);
   photons_only.gi.direct = DirectLightMethod::kPhotons;
   EXPECT_EQ(make_plan(PlanInput{photons_only}).names(),
             (std::vector<std::string>{"gbuffer", "photons", "gi_resolve", "beams", "tonemap"}));
-  EXPECT_FALSE(make_plan(PlanInput{photons_only}).uploads_group("shadows"));
+  EXPECT_FALSE(make_plan(PlanInput{photons_only}).uploads_group(UploadGroup::kShadows));
   EXPECT_EQ(target_names(plan),
             (std::vector<std::string>{"depth", "gb_albedo", "gb_normal", "gi_indirect", "hdr",
                                       "output", "view_depth"}));
-  EXPECT_TRUE(plan.uploads_group("photons"));
-  EXPECT_TRUE(plan.written("view_depth"));
+  EXPECT_TRUE(plan.uploads_group(UploadGroup::kPhotons));
+  EXPECT_TRUE(plan.written(TargetId::kViewDepth));
   // Mirror or glass surfaces add the specular pass after the splats' resolve.
   const FramePlan mirror = make_plan(PlanInput{scene_with(true, true, true, false, true)});
   EXPECT_EQ(mirror.names(), (std::vector<std::string>{"gbuffer", "direct", "photons", "gi_resolve",
                                                       "specular", "beams", "tonemap"}));
-  EXPECT_TRUE(mirror.uploads_group("specular"));
-  EXPECT_FALSE(plan.uploads_group("specular"));
+  EXPECT_TRUE(mirror.uploads_group(UploadGroup::kSpecular));
+  EXPECT_FALSE(plan.uploads_group(UploadGroup::kSpecular));
   // A caustic map's small disks cap the automatic splat size at 1/2
   // (docs/gi.md, "Caustics and the splat size"); no caustic photons, no cap.
   EXPECT_EQ(mirror.auto_splat_cap, 2);
@@ -213,7 +211,7 @@ TEST(PassPlan, LitScenesSplatPhotonsOverAGbuffer) {
   EXPECT_EQ(make_plan(PlanInput{scene_with(true, false, true)}).names(),
             (std::vector<std::string>{"beams", "tonemap"}));
   // Unlit scenes never upload photons.
-  EXPECT_FALSE(make_plan(PlanInput{scene_with(true, true)}).uploads_group("photons"));
+  EXPECT_FALSE(make_plan(PlanInput{scene_with(true, true)}).uploads_group(UploadGroup::kPhotons));
 }
 
 // SLIM surfaces run their three point passes after the other occluders'
@@ -227,24 +225,30 @@ TEST(PassPlan, SlimSurfacesRunThePointPasses) {
   EXPECT_EQ(lit.names(), (std::vector<std::string>{"gbuffer", "slim_depth", "slim_accumulate",
                                                    "slim_gbuffer", "direct", "photons", "gi_resolve",
                                                    "tonemap"}));
-  EXPECT_TRUE(lit.uploads_group("slim"));
+  EXPECT_TRUE(lit.uploads_group(UploadGroup::kSlim));
   for (bool lit_scene : {false, true}) {
     const FramePlan plan = make_plan(PlanInput{scene_with(true, true, lit_scene)});
-    EXPECT_FALSE(plan.uploads_group("slim"));
-    EXPECT_FALSE(plan.uses("slim_near"));
+    EXPECT_FALSE(plan.uploads_group(UploadGroup::kSlim));
+    EXPECT_FALSE(plan.uses(TargetId::kSlimNear));
   }
 }
 
-TEST(PassPlan, UnknownTargetsAndRepeatedIdsFail) {
-  std::vector<PassDecl> catalog = pass_catalog();
-  // The tonemap pass (planned for every frame) names a target that does not exist.
-  for (PassDecl& p : catalog) {
-    if (p.id == PassId::kTonemap) p.writes = {"outptu"};
+// The target catalog holds one declaration per TargetId, in its order
+// (FrameTargets indexes by it); every pass row has an executor factory; a
+// target missing from the catalog a plan is made with fails at plan time.
+TEST(PassPlan, CatalogsAreCompleteAndMissingTargetsFail) {
+  const std::vector<TargetDecl>& targets = target_catalog();
+  ASSERT_EQ(targets.size(), kTargetCount);
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    EXPECT_EQ(static_cast<std::size_t>(targets[i].id), i) << targets[i].name;
   }
-  EXPECT_THROW(make_plan(PlanInput{scene_with(false, false)}, catalog), PlanError);
-  catalog = pass_catalog();
-  catalog[1].id = PassId::kSurfaces;
-  EXPECT_THROW(make_plan(PlanInput{scene_with(false, false)}, catalog), PlanError);
+  for (const PassDecl& p : pass_catalog()) EXPECT_NE(p.make, nullptr) << p.name;
+  std::vector<TargetDecl> no_output;
+  for (const TargetDecl& t : targets) {
+    if (t.id != TargetId::kOutput) no_output.push_back(t);
+  }
+  // The tonemap pass (planned for every frame) writes output.
+  EXPECT_THROW(make_plan(PlanInput{scene_with(false, false)}, pass_catalog(), no_output), PlanError);
 }
 
 }  // namespace
