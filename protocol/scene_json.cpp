@@ -1054,7 +1054,6 @@ nlohmann::json scene_capabilities() {
           {"material_types", {"diffuse", "mirror", "glass"}},
           {"gi_kernels", {"box", "cone", "epanechnikov"}},
           {"gi_direct", {"shadow_maps", "photons"}},
-          {"max_supersample", kMaxSupersample},
           {"camera_rigs", enum_names(kRigKinds)},
           {"slim_settings",
            std::vector<std::string_view>(kSlimSettingFields.begin(), kSlimSettingFields.end())},
@@ -1071,13 +1070,7 @@ nlohmann::json scene_capabilities() {
           {"volume_transfer_presets", names(kVolumeTransferPresets)},
           {"volume_settings", names(kVolumeSettingFields)},
           {"volume_pyramids", names(kVolumePyramids)},
-          {"volume_integrations", names(kVolumeIntegrations)},
-          {"volume_limits",
-           {{"max_volumes", kMaxVolumes},
-            {"max_volume_voxels", kMaxVolumeVoxels},
-            {"max_volume_dimension", kMaxVolumeDimension},
-            {"max_transfer_points", kMaxTransferPoints},
-            {"max_volume_level", kMaxVolumeLevel}}}};
+          {"volume_integrations", names(kVolumeIntegrations)}};
 }
 
 }  // namespace beamcast

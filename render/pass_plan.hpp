@@ -109,6 +109,11 @@ inline SplatBands splat_bands(int w, int h) {
   return b;
 }
 
+// Views in one multi-view batch: the size of the shaders' camera array
+// (BEAMCAST_MAX_VIEWS in shaders/multiview*.glsl; 64 blocks of 176 bytes fit
+// the 16 KiB every GL 4.5 driver must allow a uniform block).
+inline constexpr int kMaxBatchViews = 64;
+
 // Pixel formats of targets (the GL side maps them to internal formats).
 enum class TargetFormat {
   kRgba32f,  // linear HDR colour

@@ -100,10 +100,6 @@ struct FrameContext {
   const std::vector<CameraBasis>* view_bases = nullptr;
 };
 
-// Views in one multi-view batch: the size of the shaders' camera array
-// (BEAMCAST_MAX_VIEWS in shaders/multiview*.glsl; 64 blocks of 176 bytes fit
-// the 16 KiB every GL 4.5 driver must allow a uniform block).
-inline constexpr int kMaxBatchViews = 64;
 
 // The size of a TargetSize::kSplat target for a render size.
 inline int splat_size(int render_size, int scale) { return (render_size + scale - 1) / scale; }

@@ -1,5 +1,7 @@
 // Every limit and knob of the server, with defaults (documented in
-// protocol/PROTOCOL.md, "Limits"); each is a command-line option of beamcast-server.
+// protocol/PROTOCOL.md, "Limits", and docs/guide/server-options.md); each
+// is a row of the settings table (server/settings.cpp), which makes it a
+// command-line option of beamcast-server and reports it.
 #pragma once
 
 #include <cstdint>
@@ -19,6 +21,7 @@ struct ServerConfig {
   std::string token;
   bool insecure_no_token = false;
   bool request_log = false;  // one JSON line per request on stderr (beamcast-server: on)
+  bool preload_demo = true;  // beamcast-server: store the scene "demo" before listening
   unsigned short port = 7878;  // 0: any free port
   // HTTP listener (preview page, WebSocket, GET endpoints) on `bind`; -1: none,
   // 0: any free port. beamcast-server turns it on (7879) by default.

@@ -43,10 +43,6 @@ namespace http = beast::http;
 namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
 
-// Headers beyond this are refused (413). A body may hold up to
-// max_message_bytes (POST /v1/render carries a scene), at least this much.
-constexpr std::size_t kMaxHttpHeaderBytes = 16 * 1024;
-constexpr std::size_t kMaxHttpBodyBytes = 16 * 1024;
 // After refusing a request whose body was not read, up to this much of it is
 // read and dropped before closing, so that the client gets the answer rather
 // than a reset (closing a socket with unread data sends RST).

@@ -8,6 +8,7 @@
 // must be thread-safe. Binds loopback by default, like the TCP port.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <string>
@@ -20,6 +21,12 @@
 namespace beamcast {
 
 struct ServerCore;
+
+// Headers beyond this are refused (413). A body may hold up to
+// max_message_bytes (POST /v1/render carries a scene), at least this much.
+// Fixed; reported by hello's limits (server/settings.cpp).
+inline constexpr std::size_t kMaxHttpHeaderBytes = 16 * 1024;
+inline constexpr std::size_t kMaxHttpBodyBytes = 16 * 1024;
 
 struct HttpReply {
   HttpReply() = default;

@@ -1,8 +1,10 @@
 // beamcast-server: the Beamcast render service (protocol/PROTOCOL.md).
 #include <cstdint>
 #include <cstdio>
-#include <vector>
 #include <exception>
+#include <map>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -11,126 +13,81 @@
 #include "protocol/data_dir.hpp"
 #include "protocol/request.hpp"
 #include "server/demo_scene.hpp"
-#include "server/limits.hpp"
+#include "server/settings.hpp"
 #include "server/server.hpp"
 
 int main(int argc, char** argv) {
   using namespace beamcast;
-  ServerConfig c;
+  ServerConfig c = server_defaults();
   c.assets_dir = find_data_dir("examples");
-  c.http_port = 7879;
-  std::string assets = c.assets_dir.string();
-  bool no_demo = false;
 
   CLI::App app{"beamcast-server: headless energy-beam render service (protocol/PROTOCOL.md)"};
-  app.add_option("--bind", c.bind, "Address to listen on")->capture_default_str();
-  app.add_option("--token", c.token,
-                 "Shared token clients must send in hello (params.token); required to bind a "
-                 "non-loopback address")
-      ->envname("BEAMCAST_TOKEN");
-  app.add_flag("--insecure-no-token", c.insecure_no_token,
-               "Allow a non-loopback bind without a token (anyone who can reach the port may "
-               "render; docs/security.md)");
-  app.add_option("--port", c.port, "TCP port; 0 picks a free one (printed on the first line)")
-      ->capture_default_str();
-  app.add_option("--http-port", c.http_port,
-                 "HTTP port of the preview page and WebSocket (same address as --bind); "
-                 "0 picks a free one, -1 turns HTTP off")
-      ->check(CLI::Range(-1, 65535))->capture_default_str();
-  auto* tls_cert = app.add_option("--tls-cert", c.tls_cert_file,
-                                  "PEM certificate (chain) file: serve the HTTP listener as HTTPS "
-                                  "and WSS (the BCP1 TCP port stays plain); needs --tls-key");
-  auto* tls_key = app.add_option("--tls-key", c.tls_key_file,
-                                 "PEM private key file of --tls-cert");
-  tls_cert->needs(tls_key);
-  tls_key->needs(tls_cert);
-  app.add_option("--device", c.device_index, "EGL device index (-1: automatic)")->capture_default_str();
-  app.add_option("--platform", c.egl_platform, "EGL platform: auto, device or surfaceless")
-      ->check(CLI::IsMember({"auto", "device", "surfaceless"}));
-  app.add_option("--render-workers", c.render_workers, "Render threads, each with a GL context")
-      ->check(CLI::Range(1, 64))->capture_default_str();
-  app.add_option("--encode-threads", c.encode_threads,
-                 "Frame encoding threads; 0: the cores less the render workers and network "
-                 "threads, at least 2 (hello and stats report the number)")
-      ->check(CLI::Range(0, 256))->capture_default_str();
-  app.add_option("--batch-window-ms", c.batch_window_ms,
-                 "Batch renders of one stored scene arriving within this window into one "
-                 "multi-view pass (0: off)")
-      ->check(CLI::Range(0, 10000))->capture_default_str();
-  app.add_option("--slice-views", c.slice_views,
-                 "Cameras per slice of a render (one GPU batch; the scheduler runs other work "
-                 "between slices)")
-      ->check(CLI::Range(1, 64))->capture_default_str();
-  app.add_option("--slice-pixels", c.slice_pixels,
-                 "Pixels per slice at most (cameras x width x height; at least one camera)")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 30))->capture_default_str();
-  app.add_option("--preview-bitrate", c.preview_bitrate_kbps,
-                 "Target bitrate in kbit/s of the preview's video stream (render param \"video\") "
-                 "when a request names none")
-      ->check(CLI::Range(kMinVideoBitrateKbps, kMaxVideoBitrateKbps))->capture_default_str();
-  bool no_encode_hold = false;
-  app.add_flag("--no-encode-hold", no_encode_hold,
-               "Let batch frames' encodes run while an interactive frame renders");
-  app.add_option("--network-threads", c.network_threads, "Threads running connections")
-      ->check(CLI::Range(1, 64))->capture_default_str();
-  std::string png_encoder = "libdeflate";
-  app.add_option("--png-encoder", png_encoder,
-                 "PNG encoder of still frames: libdeflate, or libpng (the setting before issue 39, "
-                 "with level 2; docs/performance.md, \"Frame encoders\")")
-      ->check(CLI::IsMember({"libdeflate", "libpng"}))->capture_default_str();
-  int png_level = -1;
-  app.add_option("--png-level", png_level,
-                 "Compression level of PNG frames: libdeflate 0..12 (default 1), libpng (zlib) "
-                 "0..9 (default 2)")
-      ->check(CLI::Range(-1, 12));
-  std::string png_filter = "sub";
-  app.add_option("--png-filter", png_filter,
-                 "PNG row filter: none, sub or up; libpng also paeth or adaptive")
-      ->check(CLI::IsMember({"none", "sub", "up", "paeth", "adaptive"}))->capture_default_str();
-  app.add_option("--assets", assets, "Directory scenes' mesh files are read from")->capture_default_str();
-  app.add_flag("--no-demo", no_demo, "Do not preload the scene 'demo'");
-  bool quiet_requests = false;
-  app.add_flag("--quiet-requests", quiet_requests,
-               "No per-request log lines on stderr (one JSON object per answered request)");
-  // Every limit of PROTOCOL.md's table is an option, from the one table (server/limits.hpp).
-  std::vector<std::int64_t> limit_values;
-  for (const LimitEntry& e : limit_table()) limit_values.push_back(e.get(c));
-  for (std::size_t i = 0; i < limit_table().size(); ++i) {
-    const LimitEntry& e = limit_table()[i];
-    app.add_option(e.option(), limit_values[i], std::string(e.help))
-        ->check(CLI::Range(e.min, e.max))
-        ->capture_default_str();
+  // One option per row of the settings table (server/settings.cpp), fixed
+  // rows aside; each value is held here until the command line is read.
+  const std::vector<Setting>& table = settings_table();
+  std::vector<std::int64_t> integers(table.size());
+  std::vector<std::string> texts(table.size());
+  std::vector<char> flags(table.size(), 0);
+  std::vector<CLI::Option*> options(table.size(), nullptr);
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    const Setting& s = table[i];
+    const std::string help(s.help);
+    switch (s.type) {
+      case SettingType::kInteger:
+        if (s.kind == SettingKind::kFixed) break;
+        integers[i] = s.get(c).get<std::int64_t>();
+        options[i] = app.add_option(s.option(), integers[i], help)
+                         ->check(CLI::Range(s.min, s.max))
+                         ->capture_default_str();
+        break;
+      case SettingType::kText: {
+        texts[i] = s.get(c).get<std::string>();
+        options[i] = app.add_option(s.option(), texts[i], help);
+        if (!s.secret) options[i]->capture_default_str();
+        if (!s.env.empty()) options[i]->envname(std::string(s.env));
+        if (!s.choices.empty()) {
+          options[i]->check(CLI::IsMember(std::vector<std::string>(s.choices.begin(), s.choices.end())));
+        }
+        break;
+      }
+      case SettingType::kFlag:
+        options[i] = app.add_flag(s.option(), help);
+        break;
+      case SettingType::kNumber:
+        break;  // fixed rows only
+    }
   }
-  app.add_option("--drain-timeout-ms", c.drain_timeout_ms,
-                 "On SIGINT/SIGTERM: how long in-flight work may finish before the server exits")
-      ->check(CLI::Range(0, 3600000))
-      ->capture_default_str();
+  bool print_settings = false;
+  app.add_flag("--settings-markdown", print_settings,
+               "Print the table of every setting (docs/guide/server-settings.md) and exit");
   CLI11_PARSE(app, argc, argv);
-  for (std::size_t i = 0; i < limit_table().size(); ++i) limit_table()[i].set(c, limit_values[i]);
-  c.assets_dir = assets;
-  c.request_log = !quiet_requests;
-  c.hold_batch_encodes = !no_encode_hold;
-  const bool libpng = png_encoder == "libpng";
-  c.png.encoder = libpng ? PngEncoder::kLibpng : PngEncoder::kLibdeflate;
-  c.png.level = png_level >= 0 ? png_level : (libpng ? 2 : 1);
-  if (libpng && c.png.level > 9) {
-    std::fprintf(stderr, "beamcast-server: --png-level %d: libpng (zlib) levels are 0..9\n", png_level);
+  if (print_settings) {
+    std::fputs(settings_markdown(server_defaults()).c_str(), stdout);
+    return 0;
+  }
+  std::map<std::string, bool> given;
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    const Setting& s = table[i];
+    if (!options[i]) continue;
+    given[std::string(s.name)] = options[i]->count() > 0;
+    switch (s.type) {
+      case SettingType::kInteger:
+        s.set(c, integers[i]);
+        break;
+      case SettingType::kText:
+        s.set(c, texts[i]);
+        break;
+      case SettingType::kFlag:
+        s.set(c, options[i]->count() > 0);
+        break;
+      case SettingType::kNumber:
+        break;
+    }
+  }
+  if (const std::string problem = finish_settings(c, given); !problem.empty()) {
+    std::fprintf(stderr, "beamcast-server: %s\n", problem.c_str());
     return 1;
   }
-  if (!libpng && (png_filter == "paeth" || png_filter == "adaptive")) {
-    std::fprintf(stderr, "beamcast-server: --png-filter %s needs --png-encoder libpng\n",
-                 png_filter.c_str());
-    return 1;
-  }
-  // libpng's PNG_FILTER_* masks; libdeflate's encoder writes one filter type.
-  c.png.libpng_filters = png_filter == "none"    ? 0x08
-                         : png_filter == "sub"   ? 0x10
-                         : png_filter == "up"    ? 0x20
-                         : png_filter == "paeth" ? 0x80
-                                                 : 0xF8;
-  c.png.row_filter = png_filter == "none" ? PngRowFilter::kNone
-                     : png_filter == "up" ? PngRowFilter::kUp
-                                          : PngRowFilter::kSub;
 
   try {
     RendererOptions ropts;
@@ -139,7 +96,7 @@ int main(int argc, char** argv) {
     // The demo scene is checked against this server's limits before it
     // listens: a limit it exceeds is a start-up error that names it.
     std::shared_ptr<StoredScene> demo;
-    if (!no_demo) {
+    if (c.preload_demo) {
       try {
         const auto j = parse_json_or_throw(kDemoSceneJson, c.json_limits);
         SceneLoadOptions opts{c.assets_dir, c.scene_limits};

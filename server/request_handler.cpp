@@ -9,7 +9,7 @@
 #include "protocol/scene_json.hpp"
 #include "render/pass_plan.hpp"
 #include "server/auth.hpp"
-#include "server/limits.hpp"
+#include "server/settings.hpp"
 #include "server/session.hpp"
 #include "render/accuracy_controller.hpp"
 #include "server/render_result.hpp"
@@ -88,9 +88,7 @@ json hello_result(const ServerCore& core, const json& params, FrameFormat format
                                            : "libpng"},
                        {"quality", {"full", "auto"}},
                        {"video", {{"codecs", {"vp8", "vp9"}},
-                                  {"bitrate_kbps", core.config.preview_bitrate_kbps},
-                                  {"min_bitrate_kbps", kMinVideoBitrateKbps},
-                                  {"max_bitrate_kbps", kMaxVideoBitrateKbps}}},
+                                  {"bitrate_kbps", core.config.preview_bitrate_kbps}}},
                        {"encodings", {"binary", "base64"}},
                        {"batch_window_ms", core.config.batch_window_ms},
                        {"stream", true},
@@ -450,6 +448,7 @@ void run_stats(MethodCall& c) {
   s["renderer_rebuilds"] = core.renders->renderer_rebuilds();
   s["scene_cache"] = scene_cache_json(core.renders->scene_cache());
   s["encode_threads"] = core.config.encode_threads;
+  s["settings"] = settings_json(core.config);
   s["scenes"] = {{"count", core.scenes.count()}, {"bytes", core.scenes.bytes()}};
   c.session->send(ok_response(c.id, std::move(s)));
 }

@@ -1,5 +1,7 @@
-// The limits table (server/limits.hpp) against PROTOCOL.md's: the same names,
-// the same defaults, and hello reports exactly the table.
+// The settings table (server/settings.hpp) against the documents: its limit
+// rows against PROTOCOL.md's "Limits" table (the same names, the same
+// defaults), every row against the guide's table, which is its output; hello
+// and stats report exactly the table; the command line is made from it.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -7,8 +9,11 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
-#include "server/limits.hpp"
+#include "protocol/scene_json.hpp"
+#include "protocol/volume.hpp"
+#include "server/settings.hpp"
 
 namespace beamcast {
 namespace {
@@ -74,33 +79,114 @@ std::map<std::string, std::int64_t> protocol_md_limits() {
   return out;
 }
 
+std::vector<const Setting*> rows_of(SettingKind kind) {
+  std::vector<const Setting*> out;
+  for (const Setting& s : settings_table()) {
+    if (s.kind == kind) out.push_back(&s);
+  }
+  return out;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(std::string(BEAMCAST_SOURCE_DIR) + "/" + path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 TEST(Limits, TableMatchesProtocolMd) {
   const auto documented = protocol_md_limits();
   const ServerConfig defaults;
   ASSERT_FALSE(documented.empty());
-  for (const LimitEntry& e : limit_table()) {
-    const auto it = documented.find(std::string(e.name));
-    ASSERT_NE(it, documented.end()) << e.name << " is a limit but not in PROTOCOL.md's table";
-    EXPECT_EQ(it->second, e.get(defaults)) << e.name << ": PROTOCOL.md and ServerConfig disagree";
+  for (const Setting* e : rows_of(SettingKind::kLimit)) {
+    const auto it = documented.find(std::string(e->name));
+    ASSERT_NE(it, documented.end()) << e->name << " is a limit but not in PROTOCOL.md's table";
+    EXPECT_EQ(it->second, e->get(defaults).get<std::int64_t>())
+        << e->name << ": PROTOCOL.md and ServerConfig disagree";
   }
   for (const auto& [name, value] : documented) {
-    bool found = false;
-    for (const LimitEntry& e : limit_table()) found |= e.name == name;
-    EXPECT_TRUE(found) << name << " is in PROTOCOL.md's table but not in server/limits.cpp";
+    const Setting* s = find_setting(name);
+    EXPECT_TRUE(s && s->kind == SettingKind::kLimit)
+        << name << " is in PROTOCOL.md's table but not a limit row of server/settings.cpp";
   }
+}
+
+// docs/guide/server-settings.md holds settings_markdown()'s table between its
+// markers (regenerate: build/bin/beamcast-server --settings-markdown).
+TEST(Limits, TheGuidesTableIsTheSettingsTable) {
+  const std::string doc = read_file("docs/guide/server-settings.md");
+  const std::string begin = "<!-- settings table: begin -->\n", end = "<!-- settings table: end -->";
+  const std::size_t a = doc.find(begin), b = doc.find(end);
+  ASSERT_NE(a, std::string::npos);
+  ASSERT_NE(b, std::string::npos);
+  EXPECT_EQ(doc.substr(a + begin.size(), b - a - begin.size()), settings_markdown(server_defaults()))
+      << "regenerate the table with build/bin/beamcast-server --settings-markdown";
 }
 
 TEST(Limits, HelloReportsEveryLimitAndSetWritesTheConfig) {
   ServerConfig c;
-  for (const LimitEntry& e : limit_table()) e.set(c, e.get(c) == 1 ? 2 : e.get(c) - 1);
-  const nlohmann::json j = limits_json(c);
-  EXPECT_EQ(j.size(), limit_table().size());
-  for (const LimitEntry& e : limit_table()) {
-    EXPECT_EQ(j.at(std::string(e.name)).get<std::int64_t>(), e.get(c)) << e.name;
-    EXPECT_NE(e.get(c), e.get(ServerConfig{})) << e.name << ": set did not reach the config";
-    EXPECT_TRUE(e.option().starts_with("--max-") || e.option().ends_with("-timeout-ms"))
-        << e.option();
+  for (const Setting* e : rows_of(SettingKind::kLimit)) {
+    const std::int64_t v = e->get(c).get<std::int64_t>();
+    e->set(c, v == 1 ? 2 : v - 1);
   }
+  const nlohmann::json j = limits_json(c);
+  EXPECT_EQ(j.size(), rows_of(SettingKind::kLimit).size() + rows_of(SettingKind::kFixed).size());
+  for (const Setting* e : rows_of(SettingKind::kLimit)) {
+    EXPECT_EQ(j.at(std::string(e->name)), e->get(c)) << e->name;
+    EXPECT_NE(e->get(c), e->get(ServerConfig{})) << e->name << ": set did not reach the config";
+    EXPECT_TRUE(e->option().starts_with("--max-") || e->option().ends_with("-timeout-ms"))
+        << e->option();
+  }
+  // Fixed rows: reported, never options; the scene format's bounds among them.
+  for (const Setting* e : rows_of(SettingKind::kFixed)) {
+    EXPECT_EQ(j.at(std::string(e->name)), e->get(c)) << e->name;
+    EXPECT_FALSE(e->set) << e->name;
+  }
+  EXPECT_EQ(j.at("max_supersample"), kMaxSupersample);
+  EXPECT_EQ(j.at("max_volume_dimension"), kMaxVolumeDimension);
+  // Options are not limits.
+  EXPECT_FALSE(j.contains("render_workers"));
+}
+
+// stats' settings: every row but the token, whose value never leaves the server.
+TEST(Limits, StatsReportEverySettingButTheToken) {
+  ServerConfig c = server_defaults();
+  c.token = "s3cret";
+  const nlohmann::json j = settings_json(c);
+  EXPECT_EQ(j.size(), settings_table().size() - 1);
+  EXPECT_FALSE(j.contains("token"));
+  EXPECT_EQ(j.dump().find("s3cret"), std::string::npos);
+  EXPECT_EQ(j.at("http_port"), 7879);
+  EXPECT_EQ(j.at("render_workers"), 1);
+  EXPECT_EQ(j.at("png_encoder"), "libdeflate");
+  EXPECT_EQ(j.at("max_width"), 4096);
+}
+
+// What is checked across rows after the command line: the PNG level's
+// default per encoder, libpng-only filters, TLS files in pairs.
+TEST(Limits, CrossChecksAfterTheCommandLine) {
+  ServerConfig c = server_defaults();
+  find_setting("png_encoder")->set(c, "libpng");
+  EXPECT_EQ(finish_settings(c, {}), "");
+  EXPECT_EQ(c.png.level, 2);  // libpng's default level
+  find_setting("png_level")->set(c, 12);
+  EXPECT_NE(finish_settings(c, {{"png_level", true}}).find("0..9"), std::string::npos);
+  ServerConfig d = server_defaults();
+  EXPECT_EQ(finish_settings(d, {}), "");
+  EXPECT_EQ(d.png.level, 1);
+  find_setting("png_filter")->set(d, "paeth");
+  EXPECT_NE(finish_settings(d, {}).find("needs --png-encoder libpng"), std::string::npos);
+  ServerConfig t = server_defaults();
+  find_setting("tls_cert")->set(t, "cert.pem");
+  EXPECT_NE(finish_settings(t, {}).find("--tls-key"), std::string::npos);
+  find_setting("tls_key")->set(t, "key.pem");
+  EXPECT_EQ(finish_settings(t, {}), "");
+  // Flags: given means set.
+  ServerConfig f = server_defaults();
+  find_setting("quiet_requests")->set(f, true);
+  find_setting("no_demo")->set(f, true);
+  EXPECT_FALSE(f.request_log);
+  EXPECT_FALSE(f.preload_demo);
 }
 
 }  // namespace
