@@ -12,6 +12,7 @@
 
 #include "protocol/asset_files.hpp"
 #include "protocol/scene.hpp"
+#include "protocol/scene_json.hpp"
 
 namespace beamcast {
 
@@ -25,9 +26,11 @@ struct MeshTransform {
 };
 
 struct MeshLoadLimits {
-  std::int64_t max_triangles = 2000000;  // for the whole scene (limit max_mesh_triangles)
-  std::int64_t triangles_before = 0;     // already used by earlier meshes of the scene
-  double max_abs_coordinate = 1e12;      // bound on every world-space vertex coordinate
+  // For the whole scene (limit max_mesh_triangles); defaults: the offline
+  // SceneLimits' (protocol/scene_json.hpp), not a copy of their numbers.
+  std::int64_t max_triangles = SceneLimits{}.max_mesh_triangles;
+  std::int64_t triangles_before = 0;  // already used by earlier meshes of the scene
+  double max_abs_coordinate = SceneLimits{}.max_abs_coordinate;  // every world-space vertex coordinate
 };
 
 // Bytes an OBJ file may have per triangle the scene still has room for, plus
