@@ -482,8 +482,16 @@ def test_read_timeout_does_not_count_the_servers_parse_time():
     # socket buffers are full) and its read_timeout_ms passes in wall time.
     # That time is the server's, not the client's (MessageClock,
     # server_core.hpp): both must be answered. Before, the second timed out.
+    # The read timeout is well under one ping's handling, so counting the
+    # server's time would time the second out: over a second in the release
+    # build against 600 ms; 14.3 s under ASan (one ping alone, idle machine)
+    # against 3000 ms. Under ASan the longer timeout leaves room for the
+    # client thread itself to be held off the CPU by the other test running
+    # beside it (CI runs two at a time): with 600 ms it once read "timeout"
+    # for b there while passing alone.
     keys = ",".join(f'"k{i}":{i % 10}' for i in range(900_000))
-    with Server("--no-demo", "--read-timeout-ms", "600", "--network-threads", "1",
+    read_timeout = "600" if os.environ.get("ASAN_OPTIONS") is None else "3000"
+    with Server("--no-demo", "--read-timeout-ms", read_timeout, "--network-threads", "1",
                 "--max-request-memory-bytes", "4000000000") as srv:
         answers = {}
 
