@@ -156,7 +156,21 @@ async function checkTurnAndReset(page, initial, cx, cy, width) {
   await page.screenshot({path: path.join(artifacts, 'turned.png')});
   const tReset = await page.evaluate(() => performance.now());
   await page.locator('#reset').click();
-  const at = await stillAfter(page, tReset);
+  // A still after the click whose camera is the initial one: the turned
+  // pose's own still (a full-accuracy volume frame takes ~0.8 s) may arrive
+  // after the click too, and was once taken for the reset's (a full ctest
+  // run under load); waiting for "any still after the click" raced with it.
+  let at = null;
+  try {
+    const h = await page.waitForFunction(([after, want]) => {
+      const p = window.beamcastPreview;
+      const still = p.frames.find((f) => f.still && f.t > after);
+      return still && p.lastStill && JSON.stringify(p.lastStill.camera) === want ? still.t : null;
+    }, [tReset, JSON.stringify(cam0)], {timeout: 10000});
+    at = await h.jsonValue();
+  } catch {
+    at = null;
+  }
   await page.screenshot({path: path.join(artifacts, 'reset.png')});
   const back = at === null ? null : await stillOf(page);
   check(back !== null && JSON.stringify(back.camera) === JSON.stringify(cam0) &&
