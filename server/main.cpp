@@ -2,7 +2,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <exception>
-#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -27,7 +27,6 @@ int main(int argc, char** argv) {
   const std::vector<Setting>& table = settings_table();
   std::vector<std::int64_t> integers(table.size());
   std::vector<std::string> texts(table.size());
-  std::vector<char> flags(table.size(), 0);
   std::vector<CLI::Option*> options(table.size(), nullptr);
   for (std::size_t i = 0; i < table.size(); ++i) {
     const Setting& s = table[i];
@@ -65,11 +64,11 @@ int main(int argc, char** argv) {
     std::fputs(settings_markdown(server_defaults()).c_str(), stdout);
     return 0;
   }
-  std::map<std::string, bool> given;
+  std::set<std::string> given;  // rows named on the command line (or in the environment)
   for (std::size_t i = 0; i < table.size(); ++i) {
     const Setting& s = table[i];
     if (!options[i]) continue;
-    given[std::string(s.name)] = options[i]->count() > 0;
+    if (options[i]->count() > 0) given.insert(std::string(s.name));
     switch (s.type) {
       case SettingType::kInteger:
         s.set(c, integers[i]);

@@ -335,29 +335,30 @@ const Setting* find_setting(std::string_view name) {
   return nullptr;
 }
 
-json limits_json(const ServerConfig& c) {
+namespace {
+
+// Every row `keep` takes, but never a secret one, with its value in `c`.
+json rows_json(const ServerConfig& c, bool (*keep)(const Setting&)) {
   json j = json::object();
   for (const Setting& s : settings_table()) {
-    if (s.kind != SettingKind::kOption && !s.secret) j[std::string(s.name)] = s.get(c);
+    if (!s.secret && keep(s)) j[std::string(s.name)] = s.get(c);
   }
   return j;
+}
+
+}  // namespace
+
+json limits_json(const ServerConfig& c) {
+  return rows_json(c, [](const Setting& s) { return s.kind != SettingKind::kOption; });
 }
 
 json settings_json(const ServerConfig& c) {
-  json j = json::object();
-  for (const Setting& s : settings_table()) {
-    if (!s.secret) j[std::string(s.name)] = s.get(c);
-  }
-  return j;
+  return rows_json(c, [](const Setting&) { return true; });
 }
 
-std::string finish_settings(ServerConfig& c, const std::map<std::string, bool>& given) {
-  auto was_given = [&](const char* name) {
-    const auto it = given.find(name);
-    return it != given.end() && it->second;
-  };
+std::string finish_settings(ServerConfig& c, const std::set<std::string>& given) {
   const bool libpng = c.png.encoder == PngEncoder::kLibpng;
-  if (!was_given("png_level")) c.png.level = libpng ? 2 : 1;
+  if (!given.contains("png_level")) c.png.level = libpng ? 2 : 1;
   if (libpng && c.png.level > 9) {
     return "--png-level " + std::to_string(c.png.level) + ": libpng (zlib) levels are 0..9";
   }

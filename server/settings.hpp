@@ -12,7 +12,7 @@
 
 #include <cstdint>
 #include <functional>
-#include <map>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -76,6 +76,6 @@ nlohmann::json settings_json(const ServerConfig& c);
 // level's default per encoder (when `given` lacks "png_level") and its
 // range, a filter only libpng has, a TLS certificate without its key.
 // Returns the first problem as a message for the command line, or "".
-std::string finish_settings(ServerConfig& c, const std::map<std::string, bool>& given);
+std::string finish_settings(ServerConfig& c, const std::set<std::string>& given);
 
 }  // namespace beamcast

@@ -170,7 +170,7 @@ TEST(Limits, CrossChecksAfterTheCommandLine) {
   EXPECT_EQ(finish_settings(c, {}), "");
   EXPECT_EQ(c.png.level, 2);  // libpng's default level
   find_setting("png_level")->set(c, 12);
-  EXPECT_NE(finish_settings(c, {{"png_level", true}}).find("0..9"), std::string::npos);
+  EXPECT_NE(finish_settings(c, {"png_level"}).find("0..9"), std::string::npos);
   ServerConfig d = server_defaults();
   EXPECT_EQ(finish_settings(d, {}), "");
   EXPECT_EQ(d.png.level, 1);
