@@ -9,13 +9,16 @@
 // at several bitrates (frames timed at 30 frames/s), are decoded, and each
 // displayed frame is compared with the full-accuracy frame of its pose:
 // PSNR (RGB, 8 bits) and SSIM (luma, 8x8 windows at a stride of 4, the
-// usual constants). Encode and decode are timed per frame in this thread's
-// CPU time (one encoder thread, as the server runs it); decode includes the
-// conversion to RGB.
+// usual constants). Encode is timed per frame in the process's CPU time
+// (the encoder's threads included) and in wall-clock time (what a frame
+// waits); decode in this thread's CPU time, including the conversion to RGB.
+// --threads and --speeds are the encoder's (render/video.hpp); --kbps and
+// --jpeg the bitrates and qualities tried.
 //
 // Not a test: prints a markdown table, and CSV with --csv FILE (for
 // bench/plot_video.py). Usage:
 //   beamcast_bench_video [--scene NAME] [--size WxH] [--level L] [--frames N] [--csv FILE]
+//                        [--threads N] [--speeds S,S..] [--kbps R,R..] [--jpeg Q,Q..]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +26,7 @@
 #include <cstring>
 #include <ctime>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "protocol/data_dir.hpp"
@@ -41,6 +45,20 @@ using namespace beamcast;
 double thread_cpu_ms() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+// CPU time of the whole process, ms: the encoder's own threads included.
+double process_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+// Wall-clock ms: what the frame waits for its encode (added latency).
+double wall_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
   return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
 }
 
@@ -135,15 +153,26 @@ Image to8(const Image& img) {
 struct Result {
   std::string path;
   double setting = 0;  // JPEG quality or kbit/s
-  std::vector<double> psnr, ssim, encode_ms, decode_ms;
+  std::vector<double> psnr{}, ssim{}, encode_ms{}, encode_wall_ms{}, decode_ms{};
   std::size_t bytes = 0, key_bytes = 0;
+  int speed = 0;  // the video encoder's (0 for JPEG)
 };
 
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string name = "paper_10sets", csv_path;
-  int width = 512, height = 512, level_index = 3, frames = 60;
+  int width = 512, height = 512, level_index = 3, frames = 60, threads = 1;
+  std::vector<int> speeds{8}, rates{125, 250, 500, 1000, 2000, 4000}, qualities{50, 75, 85, 92};
+  auto int_list = [](const std::string& v) {
+    std::vector<int> out;
+    for (std::size_t i = 0; i < v.size();) {
+      const std::size_t j = std::min(v.find(',', i), v.size());
+      out.push_back(std::atoi(v.substr(i, j - i).c_str()));
+      i = j + 1;
+    }
+    return out;
+  };
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
     if (a == "--scene") name = v;
@@ -151,6 +180,10 @@ int main(int argc, char** argv) {
     else if (a == "--level") level_index = std::atoi(v.c_str());
     else if (a == "--frames") frames = std::max(2, std::atoi(v.c_str()));
     else if (a == "--csv") csv_path = v;
+    else if (a == "--threads") threads = std::max(1, std::atoi(v.c_str()));
+    else if (a == "--speeds") speeds = int_list(v);
+    else if (a == "--kbps") rates = int_list(v);
+    else if (a == "--jpeg") qualities = int_list(v);
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
       return 2;
@@ -180,19 +213,21 @@ int main(int argc, char** argv) {
     full.push_back(to8(renderer.render(scene, {c})[0].image));
     moving.push_back(to8(renderer.render(reduced, {c}, fo)[0].image));
   }
-  Result raw{"uncompressed", 0};
+  Result raw{.path = "uncompressed"};
   for (int i = 0; i < frames; ++i) {
     raw.psnr.push_back(compare_levels(moving[i], full[i]).psnr_db);
     raw.ssim.push_back(ssim(moving[i], full[i]));
   }
 
   std::vector<Result> results;
-  for (int q : {50, 75, 85, 92}) {
-    Result r{"jpeg", static_cast<double>(q)};
+  for (int q : qualities) {
+    Result r{.path = "jpeg", .setting = static_cast<double>(q)};
     for (int i = 0; i < frames; ++i) {
       double t = thread_cpu_ms();
+      const double w0 = wall_ms();
       const auto bytes = encode_jpeg(moving[i], q);
       r.encode_ms.push_back(thread_cpu_ms() - t);
+      r.encode_wall_ms.push_back(wall_ms() - w0);
       t = thread_cpu_ms();
       const Image shown = decode_jpeg(bytes);
       r.decode_ms.push_back(thread_cpu_ms() - t);
@@ -202,15 +237,22 @@ int main(int argc, char** argv) {
     }
     results.push_back(std::move(r));
   }
+  std::vector<std::pair<VideoCodec, int>> configs;  // codec, speed
   for (VideoCodec codec : {VideoCodec::kVp8, VideoCodec::kVp9}) {
-    for (int kbps : {125, 250, 500, 1000, 2000, 4000}) {
-      Result r{std::string(video_codec_name(codec)), static_cast<double>(kbps)};
-      VideoEncoder enc({codec, width, height, kbps, 1});
+    for (int speed : speeds) configs.emplace_back(codec, speed);
+  }
+  for (const auto& [codec, speed] : configs) {
+    for (int kbps : rates) {
+      Result r{.path = std::string(video_codec_name(codec)), .setting = static_cast<double>(kbps),
+               .speed = speed};
+      VideoEncoder enc({codec, width, height, kbps, threads, speed});
       VideoDecoder dec(codec);
       for (int i = 0; i < frames; ++i) {
-        double t = thread_cpu_ms();
+        double t = process_cpu_ms();
+        const double w0 = wall_ms();
         const EncodedVideoFrame f = enc.encode(moving[i], i * 1000.0 / 30.0);
-        r.encode_ms.push_back(thread_cpu_ms() - t);
+        r.encode_ms.push_back(process_cpu_ms() - t);
+        r.encode_wall_ms.push_back(wall_ms() - w0);
         t = thread_cpu_ms();
         const Image shown = dec.decode(f.data);
         r.decode_ms.push_back(thread_cpu_ms() - t);
@@ -228,19 +270,23 @@ int main(int argc, char** argv) {
               name.c_str(), width, height, level_index, level.label.c_str(), frames);
   std::printf("Without compression the level's frames are %.2f dB PSNR, SSIM %.4f against full accuracy.\n\n",
               mean(raw.psnr), mean(raw.ssim));
-  std::printf("| path | setting | KiB/s | Mbit/s | PSNR dB (mean) | PSNR min | SSIM (mean) | encode CPU ms (median) | decode CPU ms (median) | key frame bytes |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("Video: %d encoder thread(s).\n\n", threads);
+  std::printf("| path | speed | setting | KiB/s | Mbit/s | PSNR dB (mean) | PSNR min | SSIM (mean) | encode CPU ms (median) | encode wall ms (median) | decode CPU ms (median) | key frame bytes |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "a");
   for (const Result& r : results) {
     const double bps = r.bytes / seconds;
-    std::printf("| %s | %s%g | %.1f | %.3f | %.2f | %.2f | %.4f | %.2f | %.2f | %zu |\n", r.path.c_str(),
-                r.path == "jpeg" ? "q" : "", r.setting, bps / 1024, bps * 8 / 1e6, mean(r.psnr),
+    std::printf("| %s | %d | %s%g | %.1f | %.3f | %.2f | %.2f | %.4f | %.2f | %.2f | %.2f | %zu |\n", r.path.c_str(),
+                r.speed, r.path == "jpeg" ? "q" : "", r.setting, bps / 1024, bps * 8 / 1e6, mean(r.psnr),
                 *std::min_element(r.psnr.begin(), r.psnr.end()), mean(r.ssim), median(r.encode_ms),
-                median(r.decode_ms), r.key_bytes);
+                median(r.encode_wall_ms), median(r.decode_ms), r.key_bytes);
     if (csv) {
-      std::fprintf(csv, "%s,%dx%d,%s,%g,%.1f,%.3f,%.4f,%.3f,%.3f,%.3f,%.4f\n", name.c_str(), width,
-                   height, r.path.c_str(), r.setting, bps, mean(r.psnr), mean(r.ssim),
-                   median(r.encode_ms), median(r.decode_ms), mean(raw.psnr), mean(raw.ssim));
+      // The last three columns (wall ms, threads, speed) were added after
+      // docs/data/video_bench_{512,1080}.csv were recorded.
+      std::fprintf(csv, "%s,%dx%d,%s,%g,%.1f,%.3f,%.4f,%.3f,%.3f,%.3f,%.4f,%.3f,%d,%d\n", name.c_str(),
+                   width, height, r.path.c_str(), r.setting, bps, mean(r.psnr), mean(r.ssim),
+                   median(r.encode_ms), median(r.decode_ms), mean(raw.psnr), mean(raw.ssim),
+                   median(r.encode_wall_ms), r.path == "jpeg" ? 1 : threads, r.speed);
     }
   }
   if (csv) std::fclose(csv);

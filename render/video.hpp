@@ -28,8 +28,29 @@ struct VideoEncoderSettings {
   VideoCodec codec = VideoCodec::kVp8;
   int width = 0, height = 0;
   int bitrate_kbps = 1000;  // the rate control's target
-  int threads = 1;          // libvpx's worker threads
+  int threads = 1;          // libvpx's worker threads (VP9: also its tile columns)
+  // libvpx's cpu-used: higher is faster and coarser. The server uses 8 for
+  // both codecs; the bench tries lower ones (docs/performance.md).
+  int speed = 8;
 };
+
+// The encoder's colour conversion: RGB (8-bit, or 16-bit whose high byte is
+// kept) to I420, BT.601 limited range; U and V are (w+1)/2 x (h+1)/2, each
+// from the rounded mean of its 2x2 block (fewer at an odd edge).
+struct I420Planes {
+  std::uint8_t* y;
+  std::uint8_t* u;
+  std::uint8_t* v;
+  int y_stride, u_stride, v_stride;
+};
+void rgb_to_i420(const Image& src, const I420Planes& dst);
+
+// libvpx threads for one stream of width x height on `cores` cores: one per
+// started 2^19 pixels (a 512x512 frame: 1; 1280x720: 2; 1920x1080: 4), at
+// most 4 and at most `cores`. A stream's frames are encoded one at a time, so
+// only threads inside the encoder shorten what one frame waits for
+// (docs/performance.md, "Video preview", at 1080p).
+int video_encoder_threads(int width, int height, int cores);
 
 struct EncodedVideoFrame {
   std::vector<std::uint8_t> data;  // one compressed frame (the codec's bitstream)

@@ -4,6 +4,7 @@
 
 #include "protocol/check.hpp"
 #include "protocol/frame_format.hpp"
+#include "server/threads.hpp"
 
 namespace beamcast {
 
@@ -27,7 +28,8 @@ VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& para
   VideoEncoder* enc = stream.encoder.get();
   if (!enc || enc->settings().codec != codec || enc->settings().width != width ||
       enc->settings().height != height) {
-    stream.encoder = std::make_unique<VideoEncoder>(VideoEncoderSettings{codec, width, height, kbps, 1});
+    const int threads = video_encoder_threads(width, height, usable_cores());
+    stream.encoder = std::make_unique<VideoEncoder>(VideoEncoderSettings{codec, width, height, kbps, threads});
     enc = stream.encoder.get();
   }
   enc->set_bitrate(kbps);

@@ -1,7 +1,10 @@
 // render/video.hpp: the preview's VP8/VP9 stream (issue 42).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 #include <stdexcept>
 
 #include "render/video.hpp"
@@ -78,6 +81,86 @@ TEST(VideoFrames, OddSizesAndBitrateChangesEncode) {
     EXPECT_EQ(out.width, 33);
     EXPECT_EQ(out.height, 17);
   }
+}
+
+// The encoder's colour conversion against the BT.601 limited-range matrix
+// evaluated pixel by pixel from its definition (chroma from the rounded mean
+// of each 2x2 block, or of what an odd edge leaves), exactly: the fast row
+// form must give the same bytes. Odd and even sizes, one-pixel rows and
+// columns, 8- and 16-bit samples (the high byte is kept); noise, so that a
+// swapped channel, plane, row or block edge shows.
+TEST(VideoFrames, ConversionMatchesTheMatrix) {
+  auto clamp8 = [](int v) { return static_cast<int>(static_cast<unsigned char>(v)); };
+  for (const int w : {1, 2, 3, 17, 64}) {
+    for (const int h : {1, 2, 5, 33}) {
+      for (const int depth : {8, 16}) {
+        Image img;
+        img.width = w;
+        img.height = h;
+        img.bit_depth = depth;
+        img.rgb.resize(3 * static_cast<std::size_t>(w) * h);
+        std::uint32_t state = 12345u + static_cast<std::uint32_t>(w * 131 + h * 7 + depth);
+        for (auto& v : img.rgb) {
+          state = state * 1664525u + 1013904223u;
+          v = static_cast<std::uint16_t>(depth == 16 ? state >> 16 : state >> 24);
+        }
+        const int cw = (w + 1) / 2, ch = (h + 1) / 2;
+        std::vector<std::uint8_t> y(static_cast<std::size_t>(w + 3) * h), u(static_cast<std::size_t>(cw + 1) * ch),
+            v(static_cast<std::size_t>(cw + 2) * ch);
+        rgb_to_i420(img, {y.data(), u.data(), v.data(), w + 3, cw + 1, cw + 2});
+        auto sample = [&](int x, int yy, int c) {
+          return img.rgb[3 * (static_cast<std::size_t>(yy) * w + x) + c] >> (depth == 16 ? 8 : 0);
+        };
+        for (int yy = 0; yy < h; ++yy) {
+          for (int x = 0; x < w; ++x) {
+            const int r = sample(x, yy, 0), g = sample(x, yy, 1), b = sample(x, yy, 2);
+            ASSERT_EQ(y[static_cast<std::size_t>(yy) * (w + 3) + x],
+                      clamp8(((66 * r + 129 * g + 25 * b + 128) >> 8) + 16))
+                << w << "x" << h << " depth " << depth << " Y at " << x << "," << yy;
+          }
+        }
+        for (int cy = 0; cy < ch; ++cy) {
+          for (int cx = 0; cx < cw; ++cx) {
+            int r = 0, g = 0, b = 0, n = 0;
+            for (int yy = 2 * cy; yy < std::min(h, 2 * cy + 2); ++yy) {
+              for (int x = 2 * cx; x < std::min(w, 2 * cx + 2); ++x) {
+                r += sample(x, yy, 0);
+                g += sample(x, yy, 1);
+                b += sample(x, yy, 2);
+                ++n;
+              }
+            }
+            r = (r + n / 2) / n;
+            g = (g + n / 2) / n;
+            b = (b + n / 2) / n;
+            ASSERT_EQ(u[static_cast<std::size_t>(cy) * (cw + 1) + cx],
+                      clamp8(((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128))
+                << w << "x" << h << " depth " << depth << " U at " << cx << "," << cy;
+            ASSERT_EQ(v[static_cast<std::size_t>(cy) * (cw + 2) + cx],
+                      clamp8(((112 * r - 94 * g - 18 * b + 128) >> 8) + 128))
+                << w << "x" << h << " depth " << depth << " V at " << cx << "," << cy;
+          }
+        }
+      }
+    }
+  }
+}
+
+// One encoder thread per started 2^19 pixels, at most 4 and at most the
+// cores: the preview's 512x512 stays on one thread, 1080p gets 4 (2 here).
+TEST(VideoFrames, EncoderThreadsFollowThePictureSize) {
+  EXPECT_EQ(video_encoder_threads(512, 512, 16), 1);
+  EXPECT_EQ(video_encoder_threads(1280, 720, 16), 2);
+  EXPECT_EQ(video_encoder_threads(1920, 1080, 16), 4);
+  EXPECT_EQ(video_encoder_threads(1920, 1080, 2), 2);
+  EXPECT_EQ(video_encoder_threads(3840, 2160, 64), 4);
+  EXPECT_EQ(video_encoder_threads(1, 1, 0), 1);
+  // A stream encoded with threads gives the same pictures' sizes back.
+  VideoEncoder enc({VideoCodec::kVp9, 600, 340, 1000, 2});
+  VideoDecoder dec(VideoCodec::kVp9);
+  const Image out = dec.decode(enc.encode(moving_picture(600, 340, 0), 0.0).data);
+  EXPECT_EQ(out.width, 600);
+  EXPECT_EQ(out.height, 340);
 }
 
 TEST(VideoFrames, RejectsWhatIsNotAFrame) {
