@@ -32,8 +32,8 @@ int clamp_byte(int v) { return std::clamp(v, 0, 255); }
 // the rounded mean of its pixels (an odd last row or column averages what
 // there is). Shift keeps the high byte of 16-bit samples. Written for speed
 // (issue 42: at 1920x1080 the per-pixel form took ~15 ms of a frame's encode);
-// the test Video.ConversionMatchesTheMatrix checks it against the matrix
-// pixel by pixel.
+// the test VideoFrames.ConversionMatchesTheMatrix checks it against the
+// matrix pixel by pixel.
 template <int Shift>
 void rgb_to_i420_rows(const Image& src, const I420Planes& dst) {
   const int w = src.width, h = src.height;
@@ -141,7 +141,7 @@ int video_encoder_threads(int width, int height, int cores) {
   const long long pixels = static_cast<long long>(std::max(0, width)) * std::max(0, height);
   const long long per_thread = 1LL << 19;
   const long long wanted = std::max(1LL, (pixels + per_thread - 1) / per_thread);
-  return static_cast<int>(std::clamp(wanted, 1LL, static_cast<long long>(std::clamp(cores, 1, 4))));
+  return static_cast<int>(std::min<long long>(wanted, std::clamp(cores, 1, 4)));
 }
 
 std::string_view video_codec_name(VideoCodec c) { return c == VideoCodec::kVp8 ? "vp8" : "vp9"; }
