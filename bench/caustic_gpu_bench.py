@@ -52,13 +52,15 @@ def main():
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--ref-size", type=int, default=256)
     ap.add_argument("--spp", type=int, default=256)
-    ap.add_argument("--direct", default="photons",
-                    help="gi.direct for every configuration (the GPU tracer covers \"photons\")")
+    ap.add_argument("--direct", default=None,
+                    help="gi.direct for every configuration (default: the scene's own; "
+                         "cornell_caustic's is \"shadow_maps\")")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     with open(a.scene) as f:
         base = json.load(f)
-    base.setdefault("gi", {})["direct"] = a.direct
+    if a.direct:
+        base.setdefault("gi", {})["direct"] = a.direct
     configs = []
     for i, b in enumerate(a.binary):
         tag = "new" if i == 0 else f"old{i}"

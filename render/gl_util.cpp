@@ -48,6 +48,12 @@ GLuint compile_stage(std::string_view program, GLenum stage, const char* stage_n
 }
 }  // namespace
 
+bool software_gl() {
+  const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const std::string s = name != nullptr ? name : "";
+  return s.find("llvmpipe") != std::string::npos || s.find("softpipe") != std::string::npos;
+}
+
 void gl_check(const char* call) {
   // A call issued in another context's namespace finds stale or foreign names
   // (on NVIDIA: errors, wrong images, crashes); say so rather than what it broke.

@@ -22,6 +22,11 @@ class GlError : public std::runtime_error {
 // Throws GlError naming `call` if glGetError reports anything.
 void gl_check(const char* call);
 
+// Whether the current context's GL is a software rasterizer (Mesa's llvmpipe
+// or softpipe): gi.specular_tracer "auto" keeps the CPU tracer there, and the
+// GPU tracer runs in groups of one invocation (shaders/specular_serial_on.glsl).
+bool software_gl();
+
 // Owns one GL object name; `Deleter` frees it.
 template <void (*Deleter)(GLuint)>
 class GlHandle {

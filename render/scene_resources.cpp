@@ -201,19 +201,6 @@ void append_raw(std::string* key, const Vec3& v) {
 
 }  // namespace
 
-namespace {
-
-// Whether the current context's GL is a software rasterizer (Mesa's
-// llvmpipe or softpipe): gi.specular_tracer "auto" keeps the CPU tracer
-// there (docs/performance.md, "Caustics on the GPU").
-bool software_gl() {
-  const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-  const std::string s = name != nullptr ? name : "";
-  return s.find("llvmpipe") != std::string::npos || s.find("softpipe") != std::string::npos;
-}
-
-}  // namespace
-
 SceneResources::SceneResources(const Scene& scene, TableCache& tables, const FramePlan& plan,
                                PhotonCache* photons, VolumeTextureCache* volumes,
                                SceneGpuCache* content)

@@ -13,12 +13,6 @@ namespace beamcast {
 
 bool gpu_traces_specular(const Scene& scene) {
   if (scene.has_medium()) return false;
-  // With gi.direct "shadow_maps" the GPU's frames are darker than the CPU's
-  // over the mirror and glass pixels (cornell_caustic 64^2: 3.4% relative
-  // L1, in bands of rows; 8% without caustic photons), though each part
-  // alone agrees (the direct points without photons, the photons without
-  // direct points: 1.7e-4). Until that is found those scenes stay on the CPU.
-  if (scene.gi.direct != DirectLightMethod::kPhotons) return false;
   return std::none_of(scene.occluders.begin(), scene.occluders.end(), [](const Occluder& o) {
     return std::holds_alternative<SlimOccluder>(o.shape);
   });

@@ -21,10 +21,10 @@
 namespace beamcast {
 
 // Whether the GPU tracer covers `scene`: no SLIM occluders (their surface
-// is sampled by points), no medium (the segments beyond a mirror or glass
-// would be attenuated) and, for now, gi.direct "photons" (see the .cpp:
-// with "shadow_maps" the two tracers disagree). Other scenes are traced on
-// the CPU.
+// is sampled by points) and no medium (the segments beyond a mirror or glass
+// would be attenuated). Other scenes are traced on the CPU. Both gi.direct
+// methods are covered: with "shadow_maps" the diffuse surfaces a ray reaches
+// show the direct points' light with shadow rays, as on the CPU.
 bool gpu_traces_specular(const Scene& scene);
 
 // A BVH over triangles (the GL-free part, for tests): nodes in depth-first

@@ -1,6 +1,7 @@
 #include "render/specular_pass.hpp"
 
 #include <chrono>
+#include <optional>
 #include <vector>
 
 #include "gi/parallel.hpp"
@@ -43,7 +44,11 @@ class SpecularPass final : public Pass {
   // layer (render/specular_gpu.hpp).
   void trace_on_gpu(FrameContext& ctx, const SpecularGpu& gpu) {
     const bool multi = ctx.views > 0;
-    ProgramPair& trace = lazy_.get("specular_trace");
+    // Groups of one invocation on a software rasterizer, where 8 x 8 lanes
+    // share llvmpipe's loop count (shaders/specular_serial_on.glsl).
+    if (!serial_) serial_ = software_gl();
+    const GLuint group = *serial_ ? 1 : 8;
+    ProgramPair& trace = lazy_.get(*serial_ ? "specular_trace_serial" : "specular_trace");
     const GLuint program = trace.get(multi);
     glUseProgram(program);
     gpu.bind(program);
@@ -58,8 +63,8 @@ class SpecularPass final : public Pass {
       const Vec3 e = view_eye(ctx, multi ? v : -1) - gpu.anchor();
       glUniform3f(eye, static_cast<float>(e[0]), static_cast<float>(e[1]), static_cast<float>(e[2]));
       if (multi) glUniform1i(trace.uniform(true, "u_view"), v);
-      dispatch_compute(static_cast<GLuint>((cam.width + 7) / 8),
-                       static_cast<GLuint>((cam.height + 7) / 8), 1);
+      dispatch_compute((static_cast<GLuint>(cam.width) + group - 1) / group,
+                       (static_cast<GLuint>(cam.height) + group - 1) / group, 1);
     }
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
@@ -119,6 +124,7 @@ class SpecularPass final : public Pass {
   }
 
   ProgramPair program_;
+  std::optional<bool> serial_;  // software_gl(), asked once: a pass serves one context
   LazyPrograms lazy_;  // specular_trace, built when a scene is traced on the GPU
 };
 

@@ -11,7 +11,13 @@
 // stack, not recursion) up to 8 specular bounces or a branch weight of
 // 1e-3. The mean goes to the "specular" target, which specular_add adds to
 // hdr. Positions are relative to the scene's anchor (SpecularGpu::anchor).
+// Groups of 8 x 8; of one invocation in "specular_trace_serial", the
+// software rasterizer's program (specular_serial_on.glsl says why).
+#ifdef SPECULAR_SERIAL
+layout(local_size_x = 1, local_size_y = 1) in;
+#else
 layout(local_size_x = 8, local_size_y = 8) in;
+#endif
 
 // a.w: 0 plane (a.xyz a point, b.xyz the unit normal), 1 sphere (a.xyz the
 // centre, b.w the radius), 2 seen light (LightOutline: a.xyz the corner, b.xyz
