@@ -117,6 +117,10 @@ have skull_2.9.inr && skull_args=(--skull "$data/skull_2.9.inr")
 
 step frames 150 "$py" "$root/bench/frame_times.py" --out "$out/frames" --server "$bin/beamcast-server" \
   --sizes 512 2048 --info "$renderer" "${frame_args[@]}"
+# cornell_caustic as shipped, the specular pass on the GPU ("gpu") and on the
+# CPU ("cpu"): frame times and error against the path tracer (issue 39).
+step caustic_512 90 "$py" "$root/bench/caustic_gpu_bench.py" --binary "$bin/beamcast" \
+  --views 3 --rounds 2 --ref-size 128 --spp 64 --out "$out/caustic_512"
 step accuracy_512 150 "$bin/beamcast" bench accuracy --size 512 --out "$out/accuracy_512"
 step views_512 90 "$bin/beamcast" bench views --size 512 --out "$out/views_512"
 step slim_512 90 "$bin/beamcast" bench slim --size 512 --out "$out/slim_512" "${slim_args[@]}"
