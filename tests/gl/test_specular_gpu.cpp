@@ -97,13 +97,32 @@ std::vector<bool> specular_pixels(const Scene& scene) {
   return mask;
 }
 
-json cornell_caustic(int size) {
+// examples/cornell_caustic.json at size x size, its gi settings as shipped.
+json cornell_caustic_as_shipped(int size) {
   std::ifstream in(std::string(BEAMCAST_SOURCE_DIR) + "/examples/cornell_caustic.json");
   json j = json::parse(in);
   j["cameras"][0]["width"] = size;
   j["cameras"][0]["height"] = size;
+  return j;
+}
+
+json cornell_caustic(int size) {
+  json j = cornell_caustic_as_shipped(size);
   j["gi"] = {{"photons", 20000}, {"caustic_photons", 20000}, {"direct", "photons"}};
   return j;
+}
+
+// The two tracers' frames of `j` over its mirror and glass pixels (at least
+// `min_pixels` of them): relative L1 below 0.5%, fewer than 2% of the pixels
+// off by more than 5%.
+void expect_tracers_agree(const char* what, const json& j, std::size_t min_pixels) {
+  const std::vector<bool> mask = specular_pixels(parse_scene(j, {}));
+  const Difference d = compare(j, mask);
+  std::printf("%s: %zu specular pixels, relative L1 %.2e, %.2f%% off by > 5%%\n", what, d.pixels,
+              d.rel_l1, 100.0 * d.far_share);
+  ASSERT_GT(d.pixels, min_pixels);
+  EXPECT_LT(d.rel_l1, 5e-3);
+  EXPECT_LT(d.far_share, 0.02);
 }
 
 // A mirror plane behind a diffuse box and sphere on a floor quad, lit by a
@@ -169,14 +188,7 @@ TEST(SpecularGpu, TheSettingPicksTheTracer) {
 // the BVH), the quad light seen in the mirror and through the glass, the
 // caustic photons gathered through the glass (direct light from photons).
 TEST(SpecularGpu, CornellCausticMatchesTheCpuTracer) {
-  const json j = cornell_caustic(48);
-  const std::vector<bool> mask = specular_pixels(parse_scene(j, {}));
-  const Difference d = compare(j, mask);
-  std::printf("cornell_caustic 48^2: %zu specular pixels, relative L1 %.2e, %.2f%% off by > 5%%\n",
-              d.pixels, d.rel_l1, 100.0 * d.far_share);
-  ASSERT_GT(d.pixels, 200u);
-  EXPECT_LT(d.rel_l1, 5e-3);
-  EXPECT_LT(d.far_share, 0.02);
+  expect_tracers_agree("cornell_caustic 48^2", cornell_caustic(48), 200);
 }
 
 // cornell_caustic as shipped (gi.direct "shadow_maps": the direct points'
@@ -187,29 +199,13 @@ TEST(SpecularGpu, CornellCausticMatchesTheCpuTracer) {
 // the CPU's value, 0.14 where the lost ray saw the light): the test fails
 // that way with the groups of 8 x 8 on llvmpipe (shaders/specular_serial_on.glsl).
 TEST(SpecularGpu, CornellCausticWithShadowMapsMatchesTheCpuTracer) {
-  std::ifstream in(std::string(BEAMCAST_SOURCE_DIR) + "/examples/cornell_caustic.json");
-  json j = json::parse(in);
-  j["cameras"][0]["width"] = 64;
-  j["cameras"][0]["height"] = 64;
+  const json j = cornell_caustic_as_shipped(64);
   ASSERT_FALSE(j.contains("gi"));  // the defaults: "shadow_maps", 100 000 photons, K = 2
-  const std::vector<bool> mask = specular_pixels(parse_scene(j, {}));
-  const Difference d = compare(j, mask);
-  std::printf("cornell_caustic 64^2, shadow maps: %zu specular pixels, relative L1 %.2e, %.2f%% off by > 5%%\n",
-              d.pixels, d.rel_l1, 100.0 * d.far_share);
-  ASSERT_GT(d.pixels, 400u);
-  EXPECT_LT(d.rel_l1, 5e-3);
-  EXPECT_LT(d.far_share, 0.02);
+  expect_tracers_agree("cornell_caustic 64^2, shadow maps", j, 400);
 }
 
 TEST(SpecularGpu, MirrorRoomMatchesTheCpuTracer) {
-  const json j = mirror_room(48);
-  const std::vector<bool> mask = specular_pixels(parse_scene(j, {}));
-  const Difference d = compare(j, mask);
-  std::printf("mirror room 48^2: %zu specular pixels, relative L1 %.2e, %.2f%% off by > 5%%\n",
-              d.pixels, d.rel_l1, 100.0 * d.far_share);
-  ASSERT_GT(d.pixels, 200u);
-  EXPECT_LT(d.rel_l1, 5e-3);
-  EXPECT_LT(d.far_share, 0.02);
+  expect_tracers_agree("mirror room 48^2", mirror_room(48), 200);
 }
 
 }  // namespace
