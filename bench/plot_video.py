@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """Plots beamcast_bench_video's CSV (--csv): bytes a second against PSNR of
-the displayed frames, JPEG at its qualities and VP8/VP9 at their bitrates, one
-panel per scene and size (docs/performance.md, "Video preview").
+the displayed frames, JPEG at its qualities and VP8/VP9/AV1 at their
+bitrates, one panel per scene and size (docs/performance.md, "Video preview").
+Rows of a codec at more than one speed (the CSV's last column) are plotted
+per speed.
 
 Usage: plot_video.py video.csv video.png
 """
@@ -16,7 +18,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 FIELDS = ["scene", "size", "path", "setting", "bytes_per_s", "psnr", "ssim",
-          "encode_ms", "decode_ms", "raw_psnr", "raw_ssim"]
+          "encode_ms", "decode_ms", "raw_psnr", "raw_ssim", "encode_wall_ms", "threads", "speed"]
 
 
 def main():
@@ -25,19 +27,29 @@ def main():
     ceiling = {}
     settings = defaultdict(lambda: defaultdict(list))
     with open(src, newline="") as f:
-        for row in csv.DictReader(f, fieldnames=FIELDS):
-            key = (row["scene"], row["size"])
-            panels[key][row["path"]].append((float(row["bytes_per_s"]), float(row["psnr"])))
-            settings[key][row["path"]].append(float(row["setting"]))
-            ceiling[key] = float(row["raw_psnr"])
+        rows = list(csv.DictReader(f, fieldnames=FIELDS))
+    speeds = defaultdict(set)
+    for row in rows:
+        speeds[row["path"]].add(row["speed"])
+    for row in rows:
+        key = (row["scene"], row["size"])
+        path = row["path"]
+        if len(speeds[path]) > 1 and row["speed"]:
+            path += f" s{row['speed']}"
+        panels[key][path].append((float(row["bytes_per_s"]), float(row["psnr"])))
+        settings[key][path].append(float(row["setting"]))
+        ceiling[key] = float(row["raw_psnr"])
+    codecs = sorted({p for k in panels for p in panels[k] if p != "jpeg"})
     keys = sorted(panels)
     fig, axes = plt.subplots(1, len(keys), figsize=(4.2 * len(keys), 3.6), squeeze=False)
     styles = {"jpeg": ("C0", "o", "JPEG (q50-92)"), "vp8": ("C1", "s", "VP8"),
-              "vp9": ("C2", "^", "VP9")}
+              "vp9": ("C2", "^", "VP9"), "av1": ("C3", "D", "AV1")}
     for ax, key in zip(axes[0], keys):
-        for path, pts in panels[key].items():
+        for i, (path, pts) in enumerate(sorted(panels[key].items())):
             pts.sort()
-            color, marker, label = styles[path]
+            base = path.split(" ")[0]
+            color, marker, label = styles.get(base, (f"C{4 + i}", "x", base))
+            label += path[len(base):]
             ax.plot([b * 8 / 1e6 for b, _ in pts], [p for _, p in pts], marker=marker,
                     color=color, label=label)
         ax.axhline(ceiling[key], color="0.5", ls=":", lw=1, label="level without compression")
@@ -52,15 +64,16 @@ def main():
     # Bytes at equal PSNR: each JPEG point against the video curve,
     # interpolated linearly in PSNR against log(bytes); none where the
     # codec's curve does not reach the JPEG point's PSNR.
-    print("| scene | size | JPEG | JPEG PSNR | JPEG KiB/s | VP8 KiB/s (ratio) | VP9 KiB/s (ratio) |")
-    print("|---|---|---|---|---|---|---|")
+    print("| scene | size | JPEG | JPEG PSNR | JPEG KiB/s | " +
+          " | ".join(f"{c.upper()} KiB/s (ratio)" for c in codecs) + " |")
+    print("|---|---|---|---|---|" + "---|" * len(codecs))
     for key in keys:
         jpeg = sorted(zip(panels[key]["jpeg"], settings[key]["jpeg"]))
         cells = []
         for (jb, jp), q in jpeg:
             row = [key[0], key[1], f"q{q:g}", f"{jp:.2f}", f"{jb / 1024:.0f}"]
-            for codec in ("vp8", "vp9"):
-                pts = sorted(panels[key][codec])
+            for codec in codecs:
+                pts = sorted(panels[key].get(codec, []))
                 found = None
                 for (b0, p0), (b1, p1) in zip(pts, pts[1:]):
                     if p0 <= jp <= p1 and p1 > p0:

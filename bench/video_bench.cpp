@@ -12,13 +12,18 @@
 // usual constants). Encode is timed per frame in the process's CPU time
 // (the encoder's threads included) and in wall-clock time (what a frame
 // waits); decode in this thread's CPU time, including the conversion to RGB.
-// --threads and --speeds are the encoder's (render/video.hpp); --kbps and
-// --jpeg the bitrates and qualities tried.
+// --threads and --speeds are the encoder's (render/video.hpp; speed 0: the
+// codec's default for the size); --codecs the video codecs tried (vp8, vp9,
+// av1); --kbps and --jpeg the bitrates and qualities tried;
+// --max-encode-ms MS lets AV1's speed follow the encode time as the server's
+// does (VideoEncoderSettings::max_encode_ms); --native 1 sends each frame at
+// the size the level renders and shows it upscaled bilinearly.
 //
 // Not a test: prints a markdown table, and CSV with --csv FILE (for
 // bench/plot_video.py). Usage:
 //   beamcast_bench_video [--scene NAME] [--size WxH] [--level L] [--frames N] [--csv FILE]
 //                        [--threads N] [--speeds S,S..] [--kbps R,R..] [--jpeg Q,Q..]
+//                        [--codecs C,C..] [--max-encode-ms MS] [--native 0|1]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -150,12 +155,45 @@ Image to8(const Image& img) {
   return o;
 }
 
+// Bilinear resampling to w x h with pixel centres aligned (what GL's linear
+// blit and a canvas's drawImage do): the display of a frame sent at the
+// level's own resolution.
+Image upscale_bilinear(const Image& src, int w, int h) {
+  if (src.width == w && src.height == h) return src;
+  Image o;
+  o.width = w;
+  o.height = h;
+  o.bit_depth = src.bit_depth;
+  o.rgb.resize(3 * static_cast<std::size_t>(w) * h);
+  const double sx = static_cast<double>(src.width) / w, sy = static_cast<double>(src.height) / h;
+  for (int y = 0; y < h; ++y) {
+    const double fy = std::clamp((y + 0.5) * sy - 0.5, 0.0, src.height - 1.0);
+    const int y0 = static_cast<int>(fy), y1 = std::min(y0 + 1, src.height - 1);
+    const double ty = fy - y0;
+    for (int x = 0; x < w; ++x) {
+      const double fx = std::clamp((x + 0.5) * sx - 0.5, 0.0, src.width - 1.0);
+      const int x0 = static_cast<int>(fx), x1 = std::min(x0 + 1, src.width - 1);
+      const double tx = fx - x0;
+      for (int c = 0; c < 3; ++c) {
+        auto at = [&](int xx, int yy) {
+          return static_cast<double>(src.rgb[3 * (static_cast<std::size_t>(yy) * src.width + xx) + c]);
+        };
+        const double v = (1 - ty) * ((1 - tx) * at(x0, y0) + tx * at(x1, y0)) +
+                         ty * ((1 - tx) * at(x0, y1) + tx * at(x1, y1));
+        o.rgb[3 * (static_cast<std::size_t>(y) * w + x) + c] = static_cast<std::uint16_t>(std::lround(v));
+      }
+    }
+  }
+  return o;
+}
+
 struct Result {
   std::string path;
   double setting = 0;  // JPEG quality or kbit/s
   std::vector<double> psnr{}, ssim{}, encode_ms{}, encode_wall_ms{}, decode_ms{};
   std::size_t bytes = 0, key_bytes = 0;
-  int speed = 0;  // the video encoder's (0 for JPEG)
+  int speed = 0;  // the video encoder's at the start (0 for JPEG)
+  std::vector<double> speeds{};  // per frame (with --max-encode-ms it moves)
 };
 
 }  // namespace
@@ -163,7 +201,10 @@ struct Result {
 int main(int argc, char** argv) {
   std::string name = "paper_10sets", csv_path;
   int width = 512, height = 512, level_index = 3, frames = 60, threads = 1;
-  std::vector<int> speeds{8}, rates{125, 250, 500, 1000, 2000, 4000}, qualities{50, 75, 85, 92};
+  bool native = false;  // send the level at the size it renders; the display upscales
+  double max_encode_ms = 0.0;  // > 0: AV1's speed follows the encode time (VideoEncoderSettings)
+  std::vector<int> speeds{0}, rates{125, 250, 500, 1000, 2000, 4000}, qualities{50, 75, 85, 92};
+  std::vector<VideoCodec> codecs{VideoCodec::kVp8, VideoCodec::kVp9, VideoCodec::kAv1};
   auto int_list = [](const std::string& v) {
     std::vector<int> out;
     for (std::size_t i = 0; i < v.size();) {
@@ -184,6 +225,21 @@ int main(int argc, char** argv) {
     else if (a == "--speeds") speeds = int_list(v);
     else if (a == "--kbps") rates = int_list(v);
     else if (a == "--jpeg") qualities = int_list(v);
+    else if (a == "--native") native = v == "1";
+    else if (a == "--max-encode-ms") max_encode_ms = std::atof(v.c_str());
+    else if (a == "--codecs") {
+      codecs.clear();
+      for (std::size_t i = 0; i < v.size();) {
+        const std::size_t j = std::min(v.find(',', i), v.size());
+        const auto c = parse_video_codec(v.substr(i, j - i));
+        if (!c) {
+          std::fprintf(stderr, "unknown codec in %s\n", v.c_str());
+          return 2;
+        }
+        codecs.push_back(*c);
+        i = j + 1;
+      }
+    }
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
       return 2;
@@ -209,14 +265,25 @@ int main(int argc, char** argv) {
                renderer.description().c_str(), name.c_str(), width, height, level_index,
                level.label.c_str(), frames);
   std::vector<Image> full, moving;
+  const int sw = std::max(1, static_cast<int>(std::lround(width * level.scale)));
+  const int sh = std::max(1, static_cast<int>(std::lround(height * level.scale)));
   for (const Camera& c : drag_path(cam0, frames)) {
     full.push_back(to8(renderer.render(scene, {c})[0].image));
-    moving.push_back(to8(renderer.render(reduced, {c}, fo)[0].image));
+    if (native) {
+      Camera small = c;
+      small.width = sw;
+      small.height = sh;
+      moving.push_back(to8(renderer.render(reduced, {small})[0].image));
+    } else {
+      moving.push_back(to8(renderer.render(reduced, {c}, fo)[0].image));
+    }
   }
+  const int ew = moving[0].width, eh = moving[0].height;
   Result raw{.path = "uncompressed"};
   for (int i = 0; i < frames; ++i) {
-    raw.psnr.push_back(compare_levels(moving[i], full[i]).psnr_db);
-    raw.ssim.push_back(ssim(moving[i], full[i]));
+    const Image shown = upscale_bilinear(moving[i], width, height);
+    raw.psnr.push_back(compare_levels(shown, full[i]).psnr_db);
+    raw.ssim.push_back(ssim(shown, full[i]));
   }
 
   std::vector<Result> results;
@@ -229,7 +296,7 @@ int main(int argc, char** argv) {
       r.encode_ms.push_back(thread_cpu_ms() - t);
       r.encode_wall_ms.push_back(wall_ms() - w0);
       t = thread_cpu_ms();
-      const Image shown = decode_jpeg(bytes);
+      const Image shown = upscale_bilinear(decode_jpeg(bytes), width, height);
       r.decode_ms.push_back(thread_cpu_ms() - t);
       r.bytes += bytes.size();
       r.psnr.push_back(compare_levels(shown, full[i]).psnr_db);
@@ -238,14 +305,14 @@ int main(int argc, char** argv) {
     results.push_back(std::move(r));
   }
   std::vector<std::pair<VideoCodec, int>> configs;  // codec, speed
-  for (VideoCodec codec : {VideoCodec::kVp8, VideoCodec::kVp9}) {
-    for (int speed : speeds) configs.emplace_back(codec, speed);
+  for (VideoCodec codec : codecs) {
+    for (int speed : speeds) configs.emplace_back(codec, speed > 0 ? speed : video_encoder_speed(codec, ew, eh));
   }
   for (const auto& [codec, speed] : configs) {
     for (int kbps : rates) {
       Result r{.path = std::string(video_codec_name(codec)), .setting = static_cast<double>(kbps),
                .speed = speed};
-      VideoEncoder enc({codec, width, height, kbps, threads, speed});
+      VideoEncoder enc({codec, ew, eh, kbps, threads, speed, max_encode_ms});
       VideoDecoder dec(codec);
       for (int i = 0; i < frames; ++i) {
         double t = process_cpu_ms();
@@ -254,10 +321,11 @@ int main(int argc, char** argv) {
         r.encode_ms.push_back(process_cpu_ms() - t);
         r.encode_wall_ms.push_back(wall_ms() - w0);
         t = thread_cpu_ms();
-        const Image shown = dec.decode(f.data);
+        const Image shown = upscale_bilinear(dec.decode(f.data), width, height);
         r.decode_ms.push_back(thread_cpu_ms() - t);
         r.bytes += f.data.size();
         if (f.key) r.key_bytes += f.data.size();
+        r.speeds.push_back(f.speed);
         r.psnr.push_back(compare_levels(shown, full[i]).psnr_db);
         r.ssim.push_back(ssim(shown, full[i]));
       }
@@ -270,7 +338,15 @@ int main(int argc, char** argv) {
               name.c_str(), width, height, level_index, level.label.c_str(), frames);
   std::printf("Without compression the level's frames are %.2f dB PSNR, SSIM %.4f against full accuracy.\n\n",
               mean(raw.psnr), mean(raw.ssim));
-  std::printf("Video: %d encoder thread(s).\n\n", threads);
+  std::printf("Video: %d encoder thread(s). Frames sent at %dx%d%s.\n\n", threads, ew, eh,
+              native ? " (the level's own size; shown upscaled bilinearly)" : "");
+  if (max_encode_ms > 0) {
+    std::printf("AV1's speed follows the encode time against %.1f ms; mean speed over the frames:", max_encode_ms);
+    for (const Result& r : results) {
+      if (!r.speeds.empty() && r.path == "av1") std::printf(" %g kbit/s %.2f;", r.setting, mean(r.speeds));
+    }
+    std::printf("\n\n");
+  }
   std::printf("| path | speed | setting | KiB/s | Mbit/s | PSNR dB (mean) | PSNR min | SSIM (mean) | encode CPU ms (median) | encode wall ms (median) | decode CPU ms (median) | key frame bytes |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "a");

@@ -85,6 +85,7 @@ json to_json(const QualityReport& q) {
   if (q.jpeg_quality) j["jpeg_quality"] = *q.jpeg_quality;
   if (q.bitrate_kbps) j["bitrate_kbps"] = *q.bitrate_kbps;
   if (q.keyframe) j["keyframe"] = *q.keyframe;
+  if (q.encoder_speed) j["encoder_speed"] = *q.encoder_speed;
   return j;
 }
 
@@ -211,6 +212,7 @@ QualityReport read_quality(const Node& n) {
   q.jpeg_quality = read_optional<int>(r, "jpeg_quality", read_int);
   q.bitrate_kbps = read_optional<int>(r, "bitrate_kbps", read_int);
   q.keyframe = read_optional<bool>(r, "keyframe", read_bool);
+  q.encoder_speed = read_optional<int>(r, "encoder_speed", read_int);
   q.budget_ms = read_number(r.required("budget_ms"));
   q.estimate_ms = read_number(r.required("estimate_ms"));
   q.frame_ms = read_number(r.required("frame_ms"));

@@ -96,6 +96,7 @@ struct QualityReport {
   std::optional<int> jpeg_quality;  // JPEG frames only
   std::optional<int> bitrate_kbps;  // video frames only: the stream's target
   std::optional<bool> keyframe;     // video frames only
+  std::optional<int> encoder_speed; // video frames only: the encoder's speed (cpu-used)
   double budget_ms = 0.0, estimate_ms = 0.0, frame_ms = 0.0;
   bool operator==(const QualityReport&) const = default;
 };

@@ -179,13 +179,13 @@ const nlohmann::json& object_at(const json_read::Node& n, std::string_view what)
   return n.json();
 }
 
-// "video": {"codec": "vp8"|"vp9", "bitrate_kbps": N, "keyframe": bool}.
+// "video": {"codec": "vp8"|"vp9"|"av1", "bitrate_kbps": N, "keyframe": bool}.
 VideoParams parse_video_params(const json_read::Node& n) {
   static constexpr std::string_view kKeys[] = {"codec", "bitrate_kbps", "keyframe"};
   const json_read::ObjectReader r(n, "video");
   r.allow_only(kKeys);
   VideoParams v;
-  v.codec = read_choice(r.required("codec"), {"vp8", "vp9"});
+  v.codec = read_choice(r.required("codec"), {"vp8", "vp9", "av1"});
   if (auto b = r.optional("bitrate_kbps")) {
     v.bitrate_kbps = static_cast<int>(json_read::check_closed(
         *b, static_cast<double>(json_read::read_integer(*b)), kMinVideoBitrateKbps,

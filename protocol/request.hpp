@@ -72,7 +72,7 @@ ErrorInfo with_path_prefix(ErrorInfo e, std::string_view prefix);
 // The preview's moving frames as a video stream (PROTOCOL.md, "Video
 // preview"): the connection's encoder, kept from request to request.
 struct VideoParams {
-  std::string codec;                // "vp8" or "vp9"
+  std::string codec;                // "vp8", "vp9" or "av1"
   std::optional<int> bitrate_kbps;  // the target; none: the server's --preview-bitrate
   bool keyframe = false;            // this frame a key frame (a decoder recovering)
 };

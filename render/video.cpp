@@ -1,11 +1,16 @@
 #include "render/video.hpp"
 
+#include <aom/aom_decoder.h>
+#include <aom/aom_encoder.h>
+#include <aom/aomcx.h>
+#include <aom/aomdx.h>
 #include <vpx/vp8cx.h>
 #include <vpx/vp8dx.h>
 #include <vpx/vpx_decoder.h>
 #include <vpx/vpx_encoder.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -17,6 +22,13 @@ namespace beamcast {
 namespace {
 
 constexpr char kMagic[4] = {'B', 'C', 'V', '1'};
+
+[[noreturn]] void aom_fail(aom_codec_ctx_t* ctx, const char* call) {
+  std::string msg = std::string("libaom: ") + call + ": ";
+  msg += ctx ? aom_codec_error(ctx) : "failed";
+  if (ctx && aom_codec_error_detail(ctx)) msg += std::string(" (") + aom_codec_error_detail(ctx) + ")";
+  throw std::runtime_error(msg);
+}
 
 [[noreturn]] void vpx_fail(vpx_codec_ctx_t* ctx, const char* call) {
   std::string msg = std::string("libvpx: ") + call + ": ";
@@ -91,10 +103,18 @@ void rgb_to_i420_rows(const Image& src, const I420Planes& dst) {
   }
 }
 
+// A decoded 8-bit I420 picture, libvpx's or libaom's.
+struct I420View {
+  const unsigned char* planes[3];
+  int stride[3];
+  int w, h;
+};
+
 // The inverse, chroma upsampled bilinearly between sample centres (what a
 // browser's video path does; nearest would add blockiness the stream lacks).
-Image i420_to_rgb(const vpx_image_t& src) {
-  const int w = static_cast<int>(src.d_w), h = static_cast<int>(src.d_h);
+
+Image i420_to_rgb(const I420View& src) {
+  const int w = src.w, h = src.h;
   const int cw = (w + 1) / 2, ch = (h + 1) / 2;
   Image out;
   out.width = w;
@@ -114,10 +134,10 @@ Image i420_to_rgb(const vpx_image_t& src) {
   };
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const int c = src.planes[VPX_PLANE_Y][static_cast<std::size_t>(y) * src.stride[VPX_PLANE_Y] + x] - 16;
+      const int c = src.planes[0][static_cast<std::size_t>(y) * src.stride[0] + x] - 16;
       const double fx = (x - 0.5) / 2.0, fy = (y - 0.5) / 2.0;
-      const int d = static_cast<int>(std::lround(chroma(VPX_PLANE_U, fx, fy))) - 128;
-      const int e = static_cast<int>(std::lround(chroma(VPX_PLANE_V, fx, fy))) - 128;
+      const int d = static_cast<int>(std::lround(chroma(1, fx, fy))) - 128;
+      const int e = static_cast<int>(std::lround(chroma(2, fx, fy))) - 128;
       std::uint16_t* o = &out.rgb[3 * (static_cast<std::size_t>(y) * w + x)];
       o[0] = static_cast<std::uint16_t>(clamp_byte((298 * c + 409 * e + 128) >> 8));
       o[1] = static_cast<std::uint16_t>(clamp_byte((298 * c - 100 * d - 208 * e + 128) >> 8));
@@ -144,28 +164,125 @@ int video_encoder_threads(int width, int height, int cores) {
   return static_cast<int>(std::min<long long>(wanted, std::clamp(cores, 1, 4)));
 }
 
-std::string_view video_codec_name(VideoCodec c) { return c == VideoCodec::kVp8 ? "vp8" : "vp9"; }
+int video_encoder_speed(VideoCodec codec, int width, int height) {
+  if (codec != VideoCodec::kAv1) return 8;
+  const long long pixels = static_cast<long long>(std::max(0, width)) * std::max(0, height);
+  return pixels <= (1LL << 19) ? 5 : pixels <= (1LL << 21) ? 6 : 8;
+}
+
+std::string_view video_codec_name(VideoCodec c) {
+  switch (c) {
+    case VideoCodec::kVp8: return "vp8";
+    case VideoCodec::kVp9: return "vp9";
+    case VideoCodec::kAv1: return "av1";
+  }
+  return "vp8";
+}
 
 std::optional<VideoCodec> parse_video_codec(std::string_view name) {
   if (name == "vp8") return VideoCodec::kVp8;
   if (name == "vp9") return VideoCodec::kVp9;
+  if (name == "av1") return VideoCodec::kAv1;
   return std::nullopt;
 }
 
+// One encoder of either library; the VideoEncoder's settings say which.
 struct VideoEncoder::Impl {
   vpx_codec_ctx_t ctx{};
   vpx_codec_enc_cfg_t cfg{};
   vpx_image_t* img = nullptr;
-  bool open = false;
+  aom_codec_ctx_t actx{};
+  aom_codec_enc_cfg_t acfg{};
+  aom_image_t* aimg = nullptr;
+  bool open = false, aopen = false;
+  void open_av1(const VideoEncoderSettings& settings, int speed);
   ~Impl() {
     if (img) vpx_img_free(img);
     if (open) vpx_codec_destroy(&ctx);
+    if (aimg) aom_img_free(aimg);
+    if (aopen) aom_codec_destroy(&actx);
   }
 };
+
+namespace {
+
+// Tile columns (log2) for `threads` workers: at most 4 columns, each at least
+// 256 pixels wide (VP9's minimum; AV1 gets the same split).
+int log2_tile_columns(int threads, int width) {
+  int log2_tiles = 0;
+  while (log2_tiles < 2 && (2 << log2_tiles) <= threads && (256 << (log2_tiles + 1)) <= width) {
+    ++log2_tiles;
+  }
+  return log2_tiles;
+}
+
+// AV1 (libaom, realtime usage): one pass, no lag, CBR, no dropped frames,
+// key frames at the start and on request only. Unlike the libvpx streams the
+// key frame is not capped and the rate control's buffer is libaom's default
+// (6 s, starting at 4): the first frame is about one JPEG frame's bytes, and
+// its quality carries into every frame predicted from it; no adaptive
+// quantization (cyclic refresh cost 0.3-0.4 dB at equal bytes on the demo
+// drag). Tools that cost time and did not pay on that drag are off, as in
+// libaom's own realtime example: the temporal dependency model, global and
+// warped motion, OBMC, order hints (on: 0.2 dB better, 50% more time).
+// docs/performance.md, "Video preview: AV1".
+}  // namespace
+
+void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int speed) {
+  Impl& impl = *this;
+  aom_codec_iface_t* iface = aom_codec_av1_cx();
+  aom_codec_enc_cfg_t& cfg = impl.acfg;
+  if (aom_codec_enc_config_default(iface, &cfg, AOM_USAGE_REALTIME) != AOM_CODEC_OK) {
+    aom_fail(nullptr, "config_default");
+  }
+  const int threads = std::max(1, settings.threads);
+  cfg.g_w = static_cast<unsigned>(settings.width);
+  cfg.g_h = static_cast<unsigned>(settings.height);
+  cfg.g_timebase = {1, 1000};
+  cfg.g_threads = static_cast<unsigned>(threads);
+  cfg.g_pass = AOM_RC_ONE_PASS;
+  cfg.g_lag_in_frames = 0;
+  cfg.g_error_resilient = 0;
+  cfg.rc_end_usage = AOM_CBR;
+  cfg.rc_target_bitrate = static_cast<unsigned>(settings.bitrate_kbps);
+  cfg.rc_dropframe_thresh = 0;
+  cfg.rc_min_quantizer = 2;
+  cfg.rc_max_quantizer = 56;
+  cfg.rc_undershoot_pct = 50;
+  cfg.rc_overshoot_pct = 50;
+  cfg.rc_buf_initial_sz = 4000;
+  cfg.rc_buf_optimal_sz = 5000;
+  cfg.rc_buf_sz = 6000;
+  cfg.kf_mode = AOM_KF_DISABLED;
+  if (aom_codec_enc_init(&impl.actx, iface, &cfg, 0) != AOM_CODEC_OK) aom_fail(&impl.actx, "enc_init");
+  impl.aopen = true;
+  aom_codec_ctx_t* c = &impl.actx;
+  const bool ok = aom_codec_control(c, AOME_SET_CPUUSED, speed) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_ROW_MT, 1) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_TILE_COLUMNS, log2_tile_columns(threads, settings.width)) ==
+                      AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_AQ_MODE, 0) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AOME_SET_MAX_INTRA_BITRATE_PCT, 0) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_ENABLE_TPL_MODEL, 0) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_ENABLE_GLOBAL_MOTION, 0) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_ENABLE_WARPED_MOTION, 0) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_ENABLE_OBMC, 0) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_ENABLE_ORDER_HINT, 0) == AOM_CODEC_OK;
+  if (!ok) aom_fail(c, "codec_control");
+  impl.aimg = aom_img_alloc(nullptr, AOM_IMG_FMT_I420, cfg.g_w, cfg.g_h, 16);
+  if (!impl.aimg) throw std::runtime_error("libaom: aom_img_alloc failed");
+}
 
 VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
     : impl_(std::make_unique<Impl>()), settings_(settings) {
   BEAMCAST_CHECK(settings.width > 0 && settings.height > 0, "VideoEncoder: empty frame size");
+  if (settings_.speed <= 0) settings_.speed = video_encoder_speed(settings.codec, settings.width, settings.height);
+  if (settings.codec == VideoCodec::kAv1) {
+    settings_.speed = std::clamp(settings_.speed, 5, 9);
+    base_speed_ = settings_.speed;
+    impl_->open_av1(settings_, settings_.speed);
+    return;
+  }
   const bool vp9 = settings.codec == VideoCodec::kVp9;
   vpx_codec_iface_t* iface = vp9 ? vpx_codec_vp9_cx() : vpx_codec_vp8_cx();
   vpx_codec_enc_cfg_t& cfg = impl_->cfg;
@@ -197,17 +314,15 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
   // VP9 splits the picture into tile columns (at least 256 pixels wide each)
   // and rows (row-mt); VP8 threads over macroblock rows and writes as many
   // token partitions so that a decoder may too.
-  const int speed = std::clamp(settings.speed, vp9 ? 5 : 4, vp9 ? 9 : 16);
+  settings_.speed = std::clamp(settings_.speed, vp9 ? 5 : 4, vp9 ? 9 : 16);
+  base_speed_ = settings_.speed;
+  const int speed = settings_.speed;
   const int threads = std::max(1, settings.threads);
   if (vp9) {
-    int log2_tiles = 0;
-    while (log2_tiles < 2 && (2 << log2_tiles) <= threads && (256 << (log2_tiles + 1)) <= settings.width) {
-      ++log2_tiles;
-    }
     vpx_codec_control(c, VP8E_SET_CPUUSED, speed);
     vpx_codec_control(c, VP9E_SET_ROW_MT, 1);
     vpx_codec_control(c, VP9E_SET_AQ_MODE, 3);
-    vpx_codec_control(c, VP9E_SET_TILE_COLUMNS, std::max(1, log2_tiles));
+    vpx_codec_control(c, VP9E_SET_TILE_COLUMNS, std::max(1, log2_tile_columns(threads, settings.width)));
   } else {
     int log2_parts = 0;
     while (log2_parts < 3 && (2 << log2_parts) <= threads) ++log2_parts;
@@ -226,51 +341,116 @@ VideoEncoder::~VideoEncoder() = default;
 
 void VideoEncoder::set_bitrate(int kbps) {
   if (kbps == settings_.bitrate_kbps) return;
-  impl_->cfg.rc_target_bitrate = static_cast<unsigned>(kbps);
-  if (vpx_codec_enc_config_set(&impl_->ctx, &impl_->cfg) != VPX_CODEC_OK) {
-    vpx_fail(&impl_->ctx, "enc_config_set");
+  if (settings_.codec == VideoCodec::kAv1) {
+    impl_->acfg.rc_target_bitrate = static_cast<unsigned>(kbps);
+    if (aom_codec_enc_config_set(&impl_->actx, &impl_->acfg) != AOM_CODEC_OK) {
+      aom_fail(&impl_->actx, "enc_config_set");
+    }
+  } else {
+    impl_->cfg.rc_target_bitrate = static_cast<unsigned>(kbps);
+    if (vpx_codec_enc_config_set(&impl_->ctx, &impl_->cfg) != VPX_CODEC_OK) {
+      vpx_fail(&impl_->ctx, "enc_config_set");
+    }
   }
   settings_.bitrate_kbps = kbps;
+}
+
+void VideoEncoder::adapt_speed(double encode_ms) {
+  constexpr std::size_t kWindow = 3;
+  constexpr int kFastest = 9;
+  recent_.push_back(encode_ms);
+  if (recent_.size() < kWindow) return;
+  double mean = 0.0;
+  for (std::size_t i = recent_.size() - kWindow; i < recent_.size(); ++i) mean += recent_[i];
+  mean /= kWindow;
+  int next = settings_.speed;
+  if (mean > settings_.max_encode_ms && next < kFastest) ++next;
+  if (mean < 0.5 * settings_.max_encode_ms && next > base_speed_) --next;
+  if (next == settings_.speed) return;
+  if (aom_codec_control(&impl_->actx, AOME_SET_CPUUSED, next) != AOM_CODEC_OK) {
+    aom_fail(&impl_->actx, "codec_control (speed)");
+  }
+  settings_.speed = next;
+  recent_.clear();
 }
 
 EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool force_key) {
   BEAMCAST_CHECK(img.width == settings_.width && img.height == settings_.height,
                  "VideoEncoder::encode: frame size differs from the encoder's");
-  const vpx_image_t& yuv = *impl_->img;
-  rgb_to_i420(img, {yuv.planes[VPX_PLANE_Y], yuv.planes[VPX_PLANE_U], yuv.planes[VPX_PLANE_V],
-                    yuv.stride[VPX_PLANE_Y], yuv.stride[VPX_PLANE_U], yuv.stride[VPX_PLANE_V]});
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool av1 = settings_.codec == VideoCodec::kAv1;
+  if (av1) {
+    const aom_image_t& yuv = *impl_->aimg;
+    rgb_to_i420(img, {yuv.planes[AOM_PLANE_Y], yuv.planes[AOM_PLANE_U], yuv.planes[AOM_PLANE_V],
+                      yuv.stride[AOM_PLANE_Y], yuv.stride[AOM_PLANE_U], yuv.stride[AOM_PLANE_V]});
+  } else {
+    const vpx_image_t& yuv = *impl_->img;
+    rgb_to_i420(img, {yuv.planes[VPX_PLANE_Y], yuv.planes[VPX_PLANE_U], yuv.planes[VPX_PLANE_V],
+                      yuv.stride[VPX_PLANE_Y], yuv.stride[VPX_PLANE_U], yuv.stride[VPX_PLANE_V]});
+  }
   // The frame lasts until the next one; the first gets a 30 frames/s share.
   const double gap = frames_ == 0 ? 33.0 : time_ms - last_ms_;
   const auto duration = static_cast<unsigned long>(std::clamp(std::lround(gap), 1L, 1000L));
   last_ms_ = time_ms;
-  const vpx_enc_frame_flags_t flags = force_key || frames_ == 0 ? VPX_EFLAG_FORCE_KF : 0;
-  if (vpx_codec_encode(&impl_->ctx, impl_->img, pts_ms_, duration, flags, VPX_DL_REALTIME) !=
-      VPX_CODEC_OK) {
-    vpx_fail(&impl_->ctx, "encode");
+  const bool key = force_key || frames_ == 0;
+  EncodedVideoFrame out;
+  if (av1) {
+    if (aom_codec_encode(&impl_->actx, impl_->aimg, pts_ms_, duration, key ? AOM_EFLAG_FORCE_KF : 0) !=
+        AOM_CODEC_OK) {
+      aom_fail(&impl_->actx, "encode");
+    }
+    aom_codec_iter_t iter = nullptr;
+    while (const aom_codec_cx_pkt_t* pkt = aom_codec_get_cx_data(&impl_->actx, &iter)) {
+      if (pkt->kind != AOM_CODEC_CX_FRAME_PKT) continue;
+      const auto* p = static_cast<const std::uint8_t*>(pkt->data.frame.buf);
+      out.data.insert(out.data.end(), p, p + pkt->data.frame.sz);
+      out.key = out.key || (pkt->data.frame.flags & AOM_FRAME_IS_KEY) != 0;
+    }
+  } else {
+    if (vpx_codec_encode(&impl_->ctx, impl_->img, pts_ms_, duration, key ? VPX_EFLAG_FORCE_KF : 0,
+                         VPX_DL_REALTIME) != VPX_CODEC_OK) {
+      vpx_fail(&impl_->ctx, "encode");
+    }
+    vpx_codec_iter_t iter = nullptr;
+    while (const vpx_codec_cx_pkt_t* pkt = vpx_codec_get_cx_data(&impl_->ctx, &iter)) {
+      if (pkt->kind != VPX_CODEC_CX_FRAME_PKT) continue;
+      const auto* p = static_cast<const std::uint8_t*>(pkt->data.frame.buf);
+      out.data.insert(out.data.end(), p, p + pkt->data.frame.sz);
+      out.key = out.key || (pkt->data.frame.flags & VPX_FRAME_IS_KEY) != 0;
+    }
   }
   pts_ms_ += static_cast<std::int64_t>(duration);
-  EncodedVideoFrame out;
   out.pts = frames_++;
-  vpx_codec_iter_t iter = nullptr;
-  while (const vpx_codec_cx_pkt_t* pkt = vpx_codec_get_cx_data(&impl_->ctx, &iter)) {
-    if (pkt->kind != VPX_CODEC_CX_FRAME_PKT) continue;
-    const auto* p = static_cast<const std::uint8_t*>(pkt->data.frame.buf);
-    out.data.insert(out.data.end(), p, p + pkt->data.frame.sz);
-    out.key = out.key || (pkt->data.frame.flags & VPX_FRAME_IS_KEY) != 0;
-  }
-  BEAMCAST_CHECK(!out.data.empty(), "libvpx gave no packet for a frame (lag 0, no frame dropping)");
+  BEAMCAST_CHECK(!out.data.empty(), "the encoder gave no packet for a frame (lag 0, no frame dropping)");
+  out.speed = settings_.speed;
+  out.encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (av1 && settings_.max_encode_ms > 0.0 && !out.key) adapt_speed(out.encode_ms);
   return out;
 }
 
 struct VideoDecoder::Impl {
+  VideoCodec codec = VideoCodec::kVp8;
   vpx_codec_ctx_t ctx{};
-  bool open = false;
+  aom_codec_ctx_t actx{};
+  bool open = false, aopen = false;
   ~Impl() {
     if (open) vpx_codec_destroy(&ctx);
+    if (aopen) aom_codec_destroy(&actx);
   }
 };
 
 VideoDecoder::VideoDecoder(VideoCodec codec) : impl_(std::make_unique<Impl>()) {
+  impl_->codec = codec;
+  if (codec == VideoCodec::kAv1) {
+    aom_codec_dec_cfg_t cfg{};
+    cfg.threads = 1;
+    cfg.allow_lowbitdepth = 1;  // 8-bit pictures of an 8-bit stream
+    if (aom_codec_dec_init(&impl_->actx, aom_codec_av1_dx(), &cfg, 0) != AOM_CODEC_OK) {
+      aom_fail(&impl_->actx, "dec_init");
+    }
+    impl_->aopen = true;
+    return;
+  }
   vpx_codec_iface_t* iface = codec == VideoCodec::kVp9 ? vpx_codec_vp9_dx() : vpx_codec_vp8_dx();
   vpx_codec_dec_cfg_t cfg{};
   cfg.threads = 1;
@@ -281,6 +461,19 @@ VideoDecoder::VideoDecoder(VideoCodec codec) : impl_(std::make_unique<Impl>()) {
 VideoDecoder::~VideoDecoder() = default;
 
 Image VideoDecoder::decode(std::span<const std::uint8_t> frame) {
+  if (impl_->codec == VideoCodec::kAv1) {
+    if (aom_codec_decode(&impl_->actx, frame.data(), frame.size(), nullptr) != AOM_CODEC_OK) {
+      aom_fail(&impl_->actx, "decode");
+    }
+    aom_codec_iter_t iter = nullptr;
+    const aom_image_t* img = aom_codec_get_frame(&impl_->actx, &iter);
+    if (!img) throw std::runtime_error("libaom: decode: no picture");
+    if (img->fmt != AOM_IMG_FMT_I420) throw std::runtime_error("libaom: decode: not 8-bit I420");
+    return i420_to_rgb({{img->planes[0], img->planes[1], img->planes[2]},
+                        {img->stride[0], img->stride[1], img->stride[2]},
+                        static_cast<int>(img->d_w),
+                        static_cast<int>(img->d_h)});
+  }
   if (vpx_codec_decode(&impl_->ctx, frame.data(), static_cast<unsigned>(frame.size()), nullptr, 0) !=
       VPX_CODEC_OK) {
     vpx_fail(&impl_->ctx, "decode");
@@ -289,14 +482,21 @@ Image VideoDecoder::decode(std::span<const std::uint8_t> frame) {
   const vpx_image_t* img = vpx_codec_get_frame(&impl_->ctx, &iter);
   if (!img) throw std::runtime_error("libvpx: decode: no picture");
   if (img->fmt != VPX_IMG_FMT_I420) throw std::runtime_error("libvpx: decode: not I420");
-  return i420_to_rgb(*img);
+  return i420_to_rgb({{img->planes[0], img->planes[1], img->planes[2]},
+                      {img->stride[0], img->stride[1], img->stride[2]},
+                      static_cast<int>(img->d_w),
+                      static_cast<int>(img->d_h)});
 }
+
+static_assert(static_cast<int>(VideoCodec::kVp8) == 0 && static_cast<int>(VideoCodec::kVp9) == 1 &&
+                  static_cast<int>(VideoCodec::kAv1) == 2,
+              "the BCV1 header's codec byte is the enum's value");
 
 std::vector<std::uint8_t> pack_video_frame(const EncodedVideoFrame& f, VideoCodec codec) {
   std::vector<std::uint8_t> out(kVideoHeaderBytes + f.data.size());
   std::memcpy(out.data(), kMagic, 4);
   out[4] = f.key ? 1 : 0;
-  out[5] = codec == VideoCodec::kVp8 ? 0 : 1;
+  out[5] = static_cast<std::uint8_t>(codec);  // 0 vp8, 1 vp9, 2 av1 (the enum's order)
   const auto pts = static_cast<std::uint32_t>(f.pts);
   for (int i = 0; i < 4; ++i) out[8 + i] = static_cast<std::uint8_t>(pts >> (8 * i));
   std::copy(f.data.begin(), f.data.end(), out.begin() + kVideoHeaderBytes);
@@ -305,12 +505,12 @@ std::vector<std::uint8_t> pack_video_frame(const EncodedVideoFrame& f, VideoCode
 
 VideoFrameView unpack_video_frame(std::span<const std::uint8_t> bytes) {
   if (bytes.size() < kVideoHeaderBytes || std::memcmp(bytes.data(), kMagic, 4) != 0 ||
-      bytes[4] > 1 || bytes[5] > 1) {
+      bytes[4] > 1 || bytes[5] > 2) {
     throw std::runtime_error("not a video frame: no BCV1 header");
   }
   VideoFrameView v;
   v.key = bytes[4] == 1;
-  v.codec = bytes[5] == 0 ? VideoCodec::kVp8 : VideoCodec::kVp9;
+  v.codec = static_cast<VideoCodec>(bytes[5]);
   for (int i = 0; i < 4; ++i) v.pts |= static_cast<std::uint32_t>(bytes[8 + i]) << (8 * i);
   v.data = bytes.subspan(kVideoHeaderBytes);
   return v;

@@ -1,10 +1,10 @@
 // Video encoding of the preview's moving frames (issue 42): VP8 or VP9 from
-// libvpx with low-latency settings (realtime deadline, no lag, no alt-ref,
-// constant bitrate, a key frame at the start and on request), and a decoder
-// for the tests and the bench. Pure CPU: no GL, no sockets.
+// libvpx, or AV1 from libaom, with low-latency settings (realtime, no lag, no
+// alt-ref, constant bitrate, a key frame at the start and on request), and a
+// decoder for the tests and the bench. Pure CPU: no GL, no sockets.
 //
 // Frames are converted from RGB to I420 with BT.601 limited-range
-// coefficients, what a browser assumes for VP8/VP9 without colour metadata.
+// coefficients, what a browser assumes for VP8/VP9/AV1 without colour metadata.
 #pragma once
 
 #include <cstdint>
@@ -18,9 +18,9 @@
 
 namespace beamcast {
 
-enum class VideoCodec { kVp8, kVp9 };
+enum class VideoCodec { kVp8, kVp9, kAv1 };
 
-// "vp8", "vp9": the wire names.
+// "vp8", "vp9", "av1": the wire names.
 std::string_view video_codec_name(VideoCodec c);
 std::optional<VideoCodec> parse_video_codec(std::string_view name);
 
@@ -28,11 +28,28 @@ struct VideoEncoderSettings {
   VideoCodec codec = VideoCodec::kVp8;
   int width = 0, height = 0;
   int bitrate_kbps = 1000;  // the rate control's target
-  int threads = 1;          // libvpx's worker threads (VP9: also its tile columns)
-  // libvpx's cpu-used: higher is faster and coarser. The server uses 8 for
-  // both codecs; the bench tries lower ones (docs/performance.md).
-  int speed = 8;
+  int threads = 1;          // the encoder's worker threads (VP9, AV1: also tile columns)
+  // The encoder's cpu-used: higher is faster and coarser. 0: the codec's
+  // default, video_encoder_speed(). The bench tries others
+  // (docs/performance.md, "Video preview").
+  int speed = 0;
+  // > 0: AV1's speed follows the encode time, measured per frame (wall clock,
+  // colour conversion included; key frames not counted): one step faster
+  // (up to 9) when the mean of the last 3 delta frames is over this many ms,
+  // one step back (not below `speed`) when it is under half of it. 0: the
+  // speed stays. The server passes the frame budget of the request (the
+  // preview's 33 ms): a frame's encode adds at most about one frame's time.
+  double max_encode_ms = 0.0;
 };
+
+// The speed (cpu-used) a stream gets by default: VP8 and VP9 8 at any size;
+// AV1 5 up to 2^19 pixels (512x512 is 2^18), 6 up to 2^21 (1920x1080), 8
+// above (not measured). On the demo drag at 512x512, AV1 at speed 5 was 0.6
+// dB better than at 6 at the same bitrate and 6 was 0.8 dB better than 7, for
+// 12-18 ms a frame; 1080p frames at 6 with 2 threads take about a frame's
+// time at 30 frames/s on the 2-core machine (docs/performance.md, "Video
+// preview: AV1").
+int video_encoder_speed(VideoCodec codec, int width, int height);
 
 // The encoder's colour conversion: RGB (8-bit, or 16-bit whose high byte is
 // kept) to I420, BT.601 limited range; U and V are (w+1)/2 x (h+1)/2, each
@@ -56,11 +73,13 @@ struct EncodedVideoFrame {
   std::vector<std::uint8_t> data;  // one compressed frame (the codec's bitstream)
   bool key = false;
   std::int64_t pts = 0;
+  int speed = 0;         // the encoder's speed for this frame
+  double encode_ms = 0;  // wall clock, conversion included
 };
 
 class VideoEncoder {
  public:
-  // Throws std::runtime_error if libvpx refuses the settings.
+  // Throws std::runtime_error if libvpx or libaom refuses the settings.
   explicit VideoEncoder(const VideoEncoderSettings& settings);
   ~VideoEncoder();
   VideoEncoder(const VideoEncoder&) = delete;
@@ -72,6 +91,8 @@ class VideoEncoder {
   // `force_key`, is a key frame. Every frame yields one packet (no lag).
   EncodedVideoFrame encode(const Image& img, double time_ms, bool force_key = false);
   void set_bitrate(int kbps);
+  // VideoEncoderSettings::max_encode_ms from the next frame on.
+  void set_max_encode_ms(double ms) { settings_.max_encode_ms = ms; }
 
   const VideoEncoderSettings& settings() const { return settings_; }
   std::int64_t frames() const { return frames_; }
@@ -83,6 +104,9 @@ class VideoEncoder {
   std::int64_t frames_ = 0;
   double last_ms_ = 0.0;
   std::int64_t pts_ms_ = 0;
+  int base_speed_ = 0;          // settings' speed: adaptation does not go below it
+  std::vector<double> recent_;  // encode ms of the delta frames since the last speed change
+  void adapt_speed(double encode_ms);
 };
 
 // Decodes a stream frame by frame into 8-bit RGB (tests and the bench).
@@ -103,7 +127,7 @@ class VideoDecoder {
 
 // The frame header of the protocol's video frames (PROTOCOL.md, "Video
 // preview"): 12 bytes before the codec's frame: "BCV1", a flags byte (bit 0:
-// key frame), the codec (0 vp8, 1 vp9), two zero bytes, and the frame's
+// key frame), the codec (0 vp8, 1 vp9, 2 av1), two zero bytes, and the frame's
 // number on its stream (pts, uint32 little-endian; 0 at each key frame the
 // stream starts with).
 inline constexpr std::size_t kVideoHeaderBytes = 12;

@@ -16,6 +16,7 @@ RUN_PACKAGES=(
   libglm-dev nlohmann-json3-dev libpng-dev libcli11-dev
   libturbojpeg0-dev                                   # JPEG frames of the interactive preview
   libvpx-dev                                          # VP8/VP9 video frames of the preview
+  libaom-dev                                          # AV1 video frames of the preview
   libdeflate-dev                                      # PNG frames (render/image.cpp)
   libzstd-dev python3-zstandard                       # raw_zstd frames (server, C++ and Python clients)
   zlib1g-dev                                          # gzip-compressed volume files (NRRD, .inr.gz)

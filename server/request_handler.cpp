@@ -87,7 +87,7 @@ json hello_result(const ServerCore& core, const json& params, FrameFormat format
                                            ? "libdeflate"
                                            : "libpng"},
                        {"quality", {"full", "auto"}},
-                       {"video", {{"codecs", {"vp8", "vp9"}},
+                       {"video", {{"codecs", {"vp8", "vp9", "av1"}},
                                   {"bitrate_kbps", core.config.preview_bitrate_kbps}}},
                        {"encodings", {"binary", "base64"}},
                        {"batch_window_ms", core.config.batch_window_ms},
@@ -240,7 +240,8 @@ struct RenderReply {
     try {
       VideoFrameReport report =
           encode_video_frame(vs, *video, core.config.preview_bitrate_kbps, ctx.cameras[0].width,
-                             ctx.cameras[0].height, ctx.bit_depth, steady_ms(arrived), out);
+                             ctx.cameras[0].height, ctx.bit_depth, steady_ms(arrived),
+                             frame->budget_ms, out);
       ctx.video_codec = report.codec;
       return report;
     } catch (const std::exception& e) {

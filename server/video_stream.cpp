@@ -14,7 +14,7 @@ void note_video_request(VideoStream& stream, const VideoParams& params) {
 
 VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& params,
                                     int default_kbps, int width, int height, int bit_depth,
-                                    double time_ms, RenderOutcome* out) {
+                                    double time_ms, double budget_ms, RenderOutcome* out) {
   BEAMCAST_CHECK(out->pngs.size() == 1 && out->is_jpeg.size() == 1 && !out->is_jpeg[0],
                  "a video frame is one raw frame");
   const auto t0 = std::chrono::steady_clock::now();
@@ -33,6 +33,7 @@ VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& para
     enc = stream.encoder.get();
   }
   enc->set_bitrate(kbps);
+  enc->set_max_encode_ms(budget_ms);
   const EncodedVideoFrame f = enc->encode(img, time_ms, stream.key_pending);
   stream.key_pending = false;
   out->pngs[0] = pack_video_frame(f, codec);
@@ -41,6 +42,7 @@ VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& para
   r.bitrate_kbps = kbps;
   r.key = f.key;
   r.pts = static_cast<std::uint32_t>(f.pts);
+  r.speed = f.speed;
   r.encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   out->encode_ms[0] += r.encode_ms;
   out->encode_wall_ms += r.encode_ms;
@@ -52,6 +54,7 @@ void set_video_report(const VideoFrameReport& f, QualityReport* q) {
   q->jpeg_quality.reset();
   q->bitrate_kbps = f.bitrate_kbps;
   q->keyframe = f.key;
+  q->encoder_speed = f.speed;
 }
 
 }  // namespace beamcast

@@ -1,6 +1,6 @@
 // A connection's video stream (issue 42; PROTOCOL.md, "Video preview"): the
 // moving frames of `quality: "auto"` renders that ask for "video" are encoded
-// by one VP8/VP9 encoder kept across the connection's requests, so each
+// by one VP8/VP9/AV1 encoder kept across the connection's requests, so each
 // frame is predicted from the previous one. Still frames stay PNG.
 #pragma once
 
@@ -29,6 +29,7 @@ struct VideoFrameReport {
   int bitrate_kbps = 0;
   bool key = false;
   std::uint32_t pts = 0;
+  int speed = 0;  // the encoder's speed (cpu-used) for this frame
   double encode_ms = 0.0;
 };
 
@@ -42,10 +43,12 @@ void note_video_request(VideoStream& stream, const VideoParams& params);
 // encoder, and so a key frame, for the first frame, a new codec and a new
 // frame size; the bitrate is params' or `default_kbps`. The encode time is
 // added to the outcome's encode times (the accuracy controller's frame cost).
-// Call with stream.mu held. Throws std::runtime_error if libvpx fails.
+// An AV1 stream's speed follows its encode time against `budget_ms`, the
+// frame budget of the request (VideoEncoderSettings::max_encode_ms).
+// Call with stream.mu held. Throws std::runtime_error if the encoder fails.
 VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& params,
                                     int default_kbps, int width, int height, int bit_depth,
-                                    double time_ms, RenderOutcome* out);
+                                    double time_ms, double budget_ms, RenderOutcome* out);
 
 // The "quality" block of a video frame: the codec as its format, the
 // stream's bitrate and the key-frame flag in place of a JPEG quality.

@@ -5,8 +5,9 @@
 // URL parameters: scene (stored id, or an example file name), size (canvas
 // pixels, default 512), budget (frame-time budget in ms, default 33), still
 // (ms of rest before the full-accuracy frame, default 300), inflight (requests
-// kept in flight, default 2), video (moving frames as a video stream: vp8,
-// the default, vp9, or off for JPEG), bitrate (the stream's target in kbit/s;
+// kept in flight, default 2), video (moving frames as a video stream: auto,
+// the default, is the first of av1, vp9, vp8 that the browser decodes; or one
+// of them by name; or off for JPEG), bitrate (the stream's target in kbit/s;
 // default: the server's --preview-bitrate).
 //
 // Video (issue 42; PROTOCOL.md, "Video preview"): where WebCodecs has the
@@ -28,7 +29,7 @@ const size = Math.max(16, Math.min(2048, parseInt(params.get('size') || '512', 1
 const budgetMs = parseFloat(params.get('budget') || '33');
 const stillMs = parseFloat(params.get('still') || '300');
 const maxInflight = Math.max(1, parseInt(params.get('inflight') || '2', 10));
-const videoParam = (params.get('video') || 'vp8').toLowerCase();
+const videoParam = (params.get('video') || 'auto').toLowerCase();
 const bitrateKbps = params.get('bitrate') ? parseInt(params.get('bitrate'), 10) : null;
 
 const canvas = document.getElementById('canvas');
@@ -349,10 +350,17 @@ function renderRequest(camera, motion) {
 
 // --- video ------------------------------------------------------------------
 
-const isVideoFormat = (format) => format === 'vp8' || format === 'vp9' || format === preview.video.codec;
-// WebCodecs codec strings (vp9: profile 0, level 4.1, 8 bits); other names
-// are tried as they are, and the server refuses what it does not encode.
-const codecStrings = {vp8: 'vp8', vp9: 'vp09.00.41.08', av1: 'av01.0.08M.08'};
+const isVideoFormat = (format) =>
+  format === 'vp8' || format === 'vp9' || format === 'av1' || format === preview.video.codec;
+// WebCodecs codec strings (vp9: profile 0, level 4.1, 8 bits; av1: main
+// profile, level 4.0, 8 bits; h264: constrained baseline, level 3.1, which the
+// server does not encode: the browser test's refused codec); other names are
+// tried as they are, and the server refuses what it does not encode.
+const codecStrings = {vp8: 'vp8', vp9: 'vp09.00.41.08', av1: 'av01.0.08M.08', h264: 'avc1.42001f'};
+// ?video=auto: the first the browser decodes. AV1 first: about half of VP9's
+// bytes at the same PSNR on the preview's drags (docs/performance.md, "Video
+// preview: AV1"), for more encode time on the server.
+const autoCodecs = ['av1', 'vp9', 'vp8'];
 let decoder = null;
 let decoderConfig = null;
 let needKey = true;        // drop delta frames until a key frame (at start and after an error)
@@ -367,17 +375,28 @@ async function setupVideo() {
     v.reason = 'no WebCodecs in this browser' + (window.isSecureContext ? '' : ' (needs https or localhost)');
     return;
   }
-  const config = {codec: codecStrings[v.want] || v.want, codedWidth: size, codedHeight: size,
-                  optimizeForLatency: true};
-  let ok = false;
-  try {
-    ok = (await VideoDecoder.isConfigSupported(config)).supported;
-  } catch {
-    ok = false;
+  const supported = async (name) => {
+    const config = {codec: codecStrings[name] || name, codedWidth: size, codedHeight: size,
+                    optimizeForLatency: true};
+    try {
+      return (await VideoDecoder.isConfigSupported(config)).supported ? config : null;
+    } catch {
+      return null;
+    }
+  };
+  let chosen = null;
+  let config = null;
+  for (const name of v.want === 'auto' ? autoCodecs : [v.want]) {
+    config = await supported(name);
+    if (config) { chosen = name; break; }
   }
-  if (!ok) { v.reason = `this browser cannot decode ${v.want}`; return; }
+  if (!chosen) {
+    v.reason = v.want === 'auto' ? `this browser decodes none of ${autoCodecs.join(', ')}`
+                                 : `this browser cannot decode ${v.want}`;
+    return;
+  }
   decoderConfig = config;
-  v.codec = v.want;
+  v.codec = chosen;
   v.reason = '';
   openDecoder();
 }

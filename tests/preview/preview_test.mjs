@@ -18,19 +18,20 @@
 //     available, and ?scene=NAME without .json finds NAME.json,
 //  8. the overlay while dragging names the reduced accuracy in words and the
 //     budget, with no beam table for a scene without beams.
-// --video CODEC|off: the page's ?video= (default: the page's own, vp8); the
-// frames while dragging are then that codec's video frames, or JPEG with off.
+// --video CODEC|auto|off: the page's ?video= (default auto, the page's own:
+// av1 in Debian's chromium); the frames while dragging are then that codec's
+// video frames, or JPEG with off.
 // With --video-checks (issue 42), also that
 //  9. the video frames were decoded by WebCodecs into the canvas (the page
 //     counts pictures out of its VideoDecoder) and the overlay says so,
 // 10. a corrupt frame (the page's test hook) makes the decoder fail, the page
 //     asks for a key frame, and decoding resumes,
-// 11. a codec the server refuses (?video=av1) falls back to JPEG, and the
+// 11. a codec the server refuses (?video=h264) falls back to JPEG, and the
 //     overlay says why.
 //
 // node preview_test.mjs --server BIN --cli BIN --artifacts DIR
 //     [--scene demo] [--size 512] [--drag-ms 2000] [--budget 33]
-//     [--still-deadline-ms 1000] [--view-checks] [--video vp8|vp9|off] [--video-checks]
+//     [--still-deadline-ms 1000] [--view-checks] [--video auto|av1|vp9|vp8|off] [--video-checks]
 // --scene names a stored scene or an example file (volume_ml256.json: the
 // page stores it, as its picker does).
 import {execFileSync} from 'node:child_process';
@@ -62,9 +63,11 @@ const stillDeadlineMs = parseInt(opt('still-deadline-ms', '1000'), 10);
 // controller starts from its first measurement and the pipeline fills.
 const warmupMs = 300;
 const viewChecks = argv.includes('--view-checks');
-const video = opt('video', 'vp8');
+const video = opt('video', 'auto');
 const videoChecks = argv.includes('--video-checks');
-const movingFormat = video === 'off' ? 'jpeg' : video;
+// auto: the first of the page's list (av1, vp9, vp8) that chromium decodes;
+// Debian's chromium decodes AV1 (dav1d), so auto streams AV1 there.
+const movingFormat = video === 'off' ? 'jpeg' : video === 'auto' ? 'av1' : video;
 
 const {failures, check} = checkList();
 
@@ -232,7 +235,7 @@ async function checkDecoderRecovery(page, dragFor, cx, cy) {
 // and the page shows JPEG frames, saying why; no error shown.
 async function checkVideoRefused(context) {
   const page = await context.newPage();
-  await page.goto(`${server.url}?scene=demo&size=64&video=av1`);
+  await page.goto(`${server.url}?scene=demo&size=64&video=h264`);
   await page.waitForFunction(() => window.beamcastPreview && window.beamcastPreview.lastStill, null,
                              {timeout: 30000});
   const box = await page.locator('#canvas').boundingBox();
@@ -247,8 +250,8 @@ async function checkVideoRefused(context) {
                                         reason: window.beamcastPreview.video.reason}));
   const moving = p.frames.filter((f) => !f.still);
   check(moving.length > 0 && moving.every((f) => f.format === 'jpeg') && p.errors.length === 0 &&
-            /moving frames: JPEG \(server refused av1: invalid_value/.test(overlay),
-        `video refused by the server (av1): ${moving.length} JPEG moving frames, overlay ` +
+            /moving frames: JPEG \(server refused h264: invalid_value/.test(overlay),
+        `video refused by the server (h264): ${moving.length} JPEG moving frames, overlay ` +
         `${JSON.stringify(overlay.split('\n').pop())}, errors ${JSON.stringify(p.errors)}`);
   await page.close();
 }
@@ -374,10 +377,10 @@ try {
     const videoFrames = dragAll.length;
     check(videoAtRelease.keyframes >= 1 && videoAtRelease.decoded >= videoFrames - 2 &&
               videoAtRelease.errors.length === 0,
-          `the ${video} frames were decoded into the canvas (${videoAtRelease.decoded} pictures ` +
+          `the ${movingFormat} frames were decoded into the canvas (${videoAtRelease.decoded} pictures ` +
           `decoded, ${videoAtRelease.received} video frames received, ${videoFrames} while dragging, ` +
           `${videoAtRelease.keyframes} key frames)`);
-    check(movingOverlay.includes(`moving frames: ${video} video (WebCodecs)`),
+    check(movingOverlay.includes(`moving frames: ${movingFormat} video (WebCodecs)`),
           `the overlay names the video path: ${JSON.stringify(movingOverlay.split('\n').pop())}`);
     await timed('decoder error recovery', () => checkDecoderRecovery(page, dragFor, cx, cy));
     await timed('video refused', () => checkVideoRefused(context));

@@ -235,8 +235,9 @@ TEST(InteractiveQuality, MovingFramesAreReducedAndTheStillFrameIsExact) {
 
 // Video (issue 42): moving frames of a connection that asks for "video" are
 // one VP8 stream (a key frame first, then predicted frames, a key frame on
-// request and on a new frame size), the still frame stays PNG and exact, and
-// bad video params are errors naming the field. Costs ~1 s (llvmpipe, 64x64).
+// request and on a new frame size), the still frame stays PNG and exact,
+// bad video params are errors naming the field, and a change of codec (to
+// AV1) starts a new stream. Costs ~1 s (llvmpipe, 64x64).
 TEST(InteractiveQuality, VideoFramesAreOneStreamAndTheStillFrameStaysExact) {
   HttpTestServer s;
   store_demo(s.core());
@@ -322,6 +323,23 @@ TEST(InteractiveQuality, VideoFramesAreOneStreamAndTheStillFrameStaysExact) {
   r = ws.call(auto_render(40, 0.7, size, video));
   ASSERT_TRUE(r.j["ok"]) << r.j.dump();
   EXPECT_EQ(r.j["result"]["frames"][0]["format"], "vp8");
+
+  // Another codec on the same connection: a new AV1 stream (a key frame
+  // numbered 0, then a predicted frame), decoded by libaom.
+  const json av1 = {{"budget_ms", 10000}, {"still_ms", 60000}, {"video", {{"codec", "av1"}}}};
+  VideoDecoder av1_dec(VideoCodec::kAv1);
+  for (int i = 0; i < 2; ++i) {
+    r = ws.call(auto_render(50 + i, 0.8 + 0.05 * i, size, av1));
+    ASSERT_TRUE(r.j["ok"]) << r.j.dump();
+    EXPECT_EQ(r.j["result"]["frames"][0]["format"], "av1");
+    EXPECT_EQ(r.j["result"]["quality"]["format"], "av1");
+    const std::vector<std::uint8_t> bytes = ws.frame(r);
+    const VideoFrameView v = unpack_video_frame(bytes);
+    EXPECT_EQ(v.codec, VideoCodec::kAv1);
+    EXPECT_EQ(v.key, i == 0) << "frame " << i;
+    EXPECT_EQ(v.pts, static_cast<std::uint32_t>(i));
+    EXPECT_EQ(av1_dec.decode(v.data).width, size);
+  }
 }
 
 TEST(InteractiveQuality, StillTimeElapsesOnTheServerClock) {

@@ -1,4 +1,4 @@
-// render/video.hpp: the preview's VP8/VP9 stream (issue 42).
+// render/video.hpp: the preview's VP8/VP9/AV1 stream (issue 42).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -69,17 +69,21 @@ TEST_P(VideoCodecs, EncodesKeyFramesOnlyAtStartAndOnRequestAndDecodesClose) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Vpx, VideoCodecs, ::testing::Values(VideoCodec::kVp8, VideoCodec::kVp9),
+INSTANTIATE_TEST_SUITE_P(Codecs, VideoCodecs,
+                         ::testing::Values(VideoCodec::kVp8, VideoCodec::kVp9, VideoCodec::kAv1),
                          [](const auto& info) { return std::string(video_codec_name(info.param)); });
 
 TEST(VideoFrames, OddSizesAndBitrateChangesEncode) {
-  VideoEncoder enc({VideoCodec::kVp8, 33, 17, 200, 1});
-  VideoDecoder dec(VideoCodec::kVp8);
-  for (int t = 0; t < 4; ++t) {
-    if (t == 2) enc.set_bitrate(3000);
-    const Image out = dec.decode(enc.encode(moving_picture(33, 17, t), 40.0 * t).data);
-    EXPECT_EQ(out.width, 33);
-    EXPECT_EQ(out.height, 17);
+  for (VideoCodec c : {VideoCodec::kVp8, VideoCodec::kAv1}) {
+    VideoEncoder enc({c, 33, 17, 200, 1});
+    VideoDecoder dec(c);
+    for (int t = 0; t < 4; ++t) {
+      if (t == 2) enc.set_bitrate(3000);
+      const Image out = dec.decode(enc.encode(moving_picture(33, 17, t), 40.0 * t).data);
+      EXPECT_EQ(out.width, 33) << video_codec_name(c);
+      EXPECT_EQ(out.height, 17) << video_codec_name(c);
+    }
+    EXPECT_EQ(enc.settings().bitrate_kbps, 3000);
   }
 }
 
@@ -167,9 +171,60 @@ TEST(VideoFrames, RejectsWhatIsNotAFrame) {
   EXPECT_THROW(unpack_video_frame(std::vector<std::uint8_t>{'B', 'C', 'V'}), std::runtime_error);
   std::vector<std::uint8_t> bad(20, 0);
   EXPECT_THROW(unpack_video_frame(bad), std::runtime_error);
+  // A codec byte past the last codec (av1, 2) is not a frame.
+  std::vector<std::uint8_t> unknown_codec = {'B', 'C', 'V', '1', 0, 3, 0, 0, 0, 0, 0, 0, 1};
+  EXPECT_THROW(unpack_video_frame(unknown_codec), std::runtime_error);
+  unknown_codec[5] = 2;
+  EXPECT_EQ(unpack_video_frame(unknown_codec).codec, VideoCodec::kAv1);
   // A decoder given garbage says so; it does not crash.
-  VideoDecoder dec(VideoCodec::kVp8);
-  EXPECT_THROW(dec.decode(std::vector<std::uint8_t>(5, 0xff)), std::runtime_error);
+  for (VideoCodec c : {VideoCodec::kVp8, VideoCodec::kVp9, VideoCodec::kAv1}) {
+    VideoDecoder dec(c);
+    EXPECT_THROW(dec.decode(std::vector<std::uint8_t>(5, 0xff)), std::runtime_error)
+        << video_codec_name(c);
+  }
+}
+
+// An AV1 stream's speed follows its encode time: with a bound no frame meets
+// (1 ns) it goes one step faster after every 3 delta frames up to 9 and stays
+// there; with a bound every frame meets by far it comes back a step per 3
+// delta frames to the speed it started at, and no lower. Key frames are not
+// counted; VP9 does not adapt. Each frame reports the speed it was encoded at.
+TEST(VideoFrames, Av1SpeedFollowsTheEncodeTime) {
+  VideoEncoder enc({VideoCodec::kAv1, 64, 48, 500, 1, 5, 1e-6});
+  VideoDecoder dec(VideoCodec::kAv1);
+  std::vector<int> speeds;
+  for (int t = 0; t < 16; ++t) {
+    const EncodedVideoFrame f = enc.encode(moving_picture(64, 48, t), 33.0 * t, t == 8);
+    speeds.push_back(f.speed);
+    EXPECT_EQ(dec.decode(f.data).width, 64);
+  }
+  // Frame 0 and 8 are key frames: 1-3 at 5, 4-6 at 6, 7 and 9-10 at 7, ...
+  EXPECT_EQ(speeds, (std::vector<int>{5, 5, 5, 5, 6, 6, 6, 7, 7, 7, 7, 8, 8, 8, 9, 9}));
+  enc.set_max_encode_ms(1e9);
+  speeds.clear();
+  for (int t = 16; t < 32; ++t) speeds.push_back(enc.encode(moving_picture(64, 48, t), 33.0 * t).speed);
+  // Frames 14 and 15 were already timed at 9: the third, frame 16, decides.
+  EXPECT_EQ(speeds, (std::vector<int>{9, 8, 8, 8, 7, 7, 7, 6, 6, 6, 5, 5, 5, 5, 5, 5}));
+  VideoEncoder vp9({VideoCodec::kVp9, 64, 48, 500, 1, 8, 1e-6});
+  for (int t = 0; t < 8; ++t) EXPECT_EQ(vp9.encode(moving_picture(64, 48, t), 33.0 * t).speed, 8);
+}
+
+// The default speed: libvpx's 8; AV1 5 up to 2^19 pixels, 6 up to 1920x1080,
+// 8 above. An encoder with speed 0 takes it, and one given a speed keeps it.
+TEST(VideoFrames, DefaultSpeedFollowsCodecAndPictureSize) {
+  EXPECT_EQ(video_encoder_speed(VideoCodec::kVp8, 1920, 1080), 8);
+  EXPECT_EQ(video_encoder_speed(VideoCodec::kVp9, 512, 512), 8);
+  EXPECT_EQ(video_encoder_speed(VideoCodec::kAv1, 512, 512), 5);
+  EXPECT_EQ(video_encoder_speed(VideoCodec::kAv1, 1024, 512), 5);
+  EXPECT_EQ(video_encoder_speed(VideoCodec::kAv1, 1280, 720), 6);
+  EXPECT_EQ(video_encoder_speed(VideoCodec::kAv1, 1920, 1080), 6);
+  EXPECT_EQ(video_encoder_speed(VideoCodec::kAv1, 2560, 1440), 8);
+  EXPECT_EQ(VideoEncoder({VideoCodec::kAv1, 64, 48, 500, 1}).settings().speed, 5);
+  EXPECT_EQ(VideoEncoder({VideoCodec::kAv1, 64, 48, 500, 1, 7}).settings().speed, 7);
+  EXPECT_EQ(VideoEncoder({VideoCodec::kVp9, 64, 48, 500, 1}).settings().speed, 8);
+  EXPECT_EQ(parse_video_codec("av1"), VideoCodec::kAv1);
+  EXPECT_EQ(video_codec_name(VideoCodec::kAv1), "av1");
+  EXPECT_FALSE(parse_video_codec("h264").has_value());
 }
 
 }  // namespace
