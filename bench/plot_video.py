@@ -2,8 +2,8 @@
 """Plots beamcast_bench_video's CSV (--csv): bytes a second against PSNR of
 the displayed frames, JPEG at its qualities and VP8/VP9/AV1 at their
 bitrates, one panel per scene and size (docs/performance.md, "Video preview").
-Rows of a codec at more than one speed (the CSV's last column) are plotted
-per speed.
+Rows of a codec at more than one speed (the CSV's last column) in one panel
+are plotted per speed.
 
 Usage: plot_video.py video.csv video.png
 """
@@ -30,18 +30,23 @@ def main():
         rows = list(csv.DictReader(f, fieldnames=FIELDS))
     speeds = defaultdict(set)
     for row in rows:
-        speeds[row["path"]].add(row["speed"])
+        speeds[(row["scene"], row["size"], row["path"])].add(row["speed"])
     for row in rows:
         key = (row["scene"], row["size"])
         path = row["path"]
-        if len(speeds[path]) > 1 and row["speed"]:
+        if len(speeds[key + (path,)]) > 1 and row["speed"]:
             path += f" s{row['speed']}"
         panels[key][path].append((float(row["bytes_per_s"]), float(row["psnr"])))
         settings[key][path].append(float(row["setting"]))
         ceiling[key] = float(row["raw_psnr"])
     codecs = sorted({p for k in panels for p in panels[k] if p != "jpeg"})
     keys = sorted(panels)
-    fig, axes = plt.subplots(1, len(keys), figsize=(4.2 * len(keys), 3.6), squeeze=False)
+    cols = min(3, len(keys))
+    rows_n = math.ceil(len(keys) / cols)
+    fig, grid = plt.subplots(rows_n, cols, figsize=(4.2 * cols, 3.6 * rows_n), squeeze=False)
+    axes = [[ax for row in grid for ax in row]]
+    for ax in axes[0][len(keys):]:
+        ax.set_visible(False)
     styles = {"jpeg": ("C0", "o", "JPEG (q50-92)"), "vp8": ("C1", "s", "VP8"),
               "vp9": ("C2", "^", "VP9"), "av1": ("C3", "D", "AV1")}
     for ax, key in zip(axes[0], keys):
@@ -58,7 +63,7 @@ def main():
         ax.set_ylabel("PSNR dB vs full accuracy")
         ax.set_title(f"{key[0]} {key[1]}", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
-    axes[0][0].legend(fontsize=7)
+        ax.legend(fontsize=6)
     fig.tight_layout()
     fig.savefig(dst, dpi=110)
     # Bytes at equal PSNR: each JPEG point against the video curve,
