@@ -112,7 +112,6 @@ struct I420View {
 
 // The inverse, chroma upsampled bilinearly between sample centres (what a
 // browser's video path does; nearest would add blockiness the stream lacks).
-
 Image i420_to_rgb(const I420View& src) {
   const int w = src.w, h = src.h;
   const int cw = (w + 1) / 2, ch = (h + 1) / 2;
@@ -216,18 +215,17 @@ int log2_tile_columns(int threads, int width) {
   return log2_tiles;
 }
 
+}  // namespace
+
 // AV1 (libaom, realtime usage): one pass, no lag, CBR, no dropped frames,
 // key frames at the start and on request only. Unlike the libvpx streams the
 // key frame is not capped and the rate control's buffer is libaom's default
-// (6 s, starting at 4): the first frame is about one JPEG frame's bytes, and
-// its quality carries into every frame predicted from it; no adaptive
-// quantization (cyclic refresh cost 0.3-0.4 dB at equal bytes on the demo
-// drag). Tools that cost time and did not pay on that drag are off, as in
-// libaom's own realtime example: the temporal dependency model, global and
-// warped motion, OBMC, order hints (on: 0.2 dB better, 50% more time).
-// docs/performance.md, "Video preview: AV1".
-}  // namespace
-
+// (6 s, starting at 4): the drag's quality follows its first frame (together
+// 0.6 dB at equal bytes on the demo drag); no adaptive quantization (cyclic
+// refresh cost 0.1-0.4 dB). Tools that cost time and did not pay on that
+// drag are off, as in libaom's own realtime example: the temporal dependency
+// model, global and warped motion, OBMC, order hints (on: 0.2-0.4 dB better,
+// 50% more time). docs/performance.md, "Video preview: AV1".
 void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int speed) {
   Impl& impl = *this;
   aom_codec_iface_t* iface = aom_codec_av1_cx();
@@ -359,9 +357,10 @@ void VideoEncoder::adapt_speed(double encode_ms) {
   constexpr std::size_t kWindow = 3;
   constexpr int kFastest = 9;
   recent_.push_back(encode_ms);
+  if (recent_.size() > kWindow) recent_.erase(recent_.begin());
   if (recent_.size() < kWindow) return;
   double mean = 0.0;
-  for (std::size_t i = recent_.size() - kWindow; i < recent_.size(); ++i) mean += recent_[i];
+  for (double ms : recent_) mean += ms;
   mean /= kWindow;
   int next = settings_.speed;
   if (mean > settings_.max_encode_ms && next < kFastest) ++next;

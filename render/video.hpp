@@ -105,7 +105,7 @@ class VideoEncoder {
   double last_ms_ = 0.0;
   std::int64_t pts_ms_ = 0;
   int base_speed_ = 0;          // settings' speed: adaptation does not go below it
-  std::vector<double> recent_;  // encode ms of the delta frames since the last speed change
+  std::vector<double> recent_;  // encode ms of the last (<= 3) delta frames since the last speed change
   void adapt_speed(double encode_ms);
 };
 
