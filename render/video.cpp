@@ -110,6 +110,15 @@ struct I420View {
   int w, h;
 };
 
+// vpx_image_t and aom_image_t name their planes, strides and size alike.
+template <class CodecImage>
+I420View i420_view(const CodecImage& img) {
+  return {{img.planes[0], img.planes[1], img.planes[2]},
+          {img.stride[0], img.stride[1], img.stride[2]},
+          static_cast<int>(img.d_w),
+          static_cast<int>(img.d_h)};
+}
+
 // The inverse, chroma upsampled bilinearly between sample centres (what a
 // browser's video path does; nearest would add blockiness the stream lacks).
 Image i420_to_rgb(const I420View& src) {
@@ -468,10 +477,7 @@ Image VideoDecoder::decode(std::span<const std::uint8_t> frame) {
     const aom_image_t* img = aom_codec_get_frame(&impl_->actx, &iter);
     if (!img) throw std::runtime_error("libaom: decode: no picture");
     if (img->fmt != AOM_IMG_FMT_I420) throw std::runtime_error("libaom: decode: not 8-bit I420");
-    return i420_to_rgb({{img->planes[0], img->planes[1], img->planes[2]},
-                        {img->stride[0], img->stride[1], img->stride[2]},
-                        static_cast<int>(img->d_w),
-                        static_cast<int>(img->d_h)});
+    return i420_to_rgb(i420_view(*img));
   }
   if (vpx_codec_decode(&impl_->ctx, frame.data(), static_cast<unsigned>(frame.size()), nullptr, 0) !=
       VPX_CODEC_OK) {
@@ -481,10 +487,7 @@ Image VideoDecoder::decode(std::span<const std::uint8_t> frame) {
   const vpx_image_t* img = vpx_codec_get_frame(&impl_->ctx, &iter);
   if (!img) throw std::runtime_error("libvpx: decode: no picture");
   if (img->fmt != VPX_IMG_FMT_I420) throw std::runtime_error("libvpx: decode: not I420");
-  return i420_to_rgb({{img->planes[0], img->planes[1], img->planes[2]},
-                      {img->stride[0], img->stride[1], img->stride[2]},
-                      static_cast<int>(img->d_w),
-                      static_cast<int>(img->d_h)});
+  return i420_to_rgb(i420_view(*img));
 }
 
 static_assert(static_cast<int>(VideoCodec::kVp8) == 0 && static_cast<int>(VideoCodec::kVp9) == 1 &&
