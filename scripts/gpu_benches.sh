@@ -135,6 +135,11 @@ step slim_2048 90 "$bin/beamcast" bench slim --size 2048 --zoom-only --zoom 1 --
 step volumes_2048 90 "$bin/beamcast" bench volumes --size 2048 --reference-spv 2 \
   --out "$out/volumes_2048" "${skull_args[@]}"
 step medium_512 60 "$bin/beamcast" bench medium --size 512 --out "$out/medium_512"
+# The preview's moving frames at 1080p, JPEG against VP9 and AV1 with the
+# encoder threads a 1080p stream gets on a machine of 4 or more cores (issue
+# 42: encode time per frame on the GPU machine's CPU; bytes and PSNR).
+step video_1080 90 "$bin/beamcast_bench_video" --scene paper_10sets --size 1920x1080 --frames 60 \
+  --threads 4 --codecs vp9,av1 --kbps 1000,2000 --jpeg 50 --csv "$out/video_1080.csv"
 echo "done: $((SECONDS)) s" >>"$log"
 pack
 exit 0

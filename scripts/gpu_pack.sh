@@ -22,7 +22,7 @@ dir=$1
 build=${2:-build}
 root=$(cd "$(dirname "$0")/.." && pwd)
 programs=(beamcast beamcast-server beamcast_gl_tests beamcast_stability_tests
-          beamcast_server_tests)
+          beamcast_server_tests beamcast_bench_video)
 rm -rf "$dir"
 mkdir -p "$dir/bin" "$dir/lib"
 for p in "${programs[@]}"; do
