@@ -70,18 +70,18 @@ std::vector<AccuracyLevel> make_accuracy_ladder(const RenderSettings& full, bool
   fast.filter = TableFilter::kHardware;
 
   std::vector<AccuracyLevel> ladder;
-  ladder.push_back({"full", 1.0, full, 92});
+  ladder.push_back({"full", 1.0, full, 92, 1.0, {}, {}});
   const double photons = lit ? kPreviewPhotonFraction : 1.0;
   const std::string fast_name = settings_label(fast) + (lit ? "+photons1/4" : "");
-  if (lit || !same_settings(fast, full)) ladder.push_back({fast_name, 1.0, fast, 90, photons});
+  if (lit || !same_settings(fast, full)) ladder.push_back({fast_name, 1.0, fast, 90, photons, {}, {}});
   // Resolution is the knob that pays on any renderer: cost follows pixel count.
-  ladder.push_back({fast_name + "@3/4", 0.75, fast, 85, photons});
-  ladder.push_back({fast_name + "@1/2", 0.5, fast, 80, photons});
-  ladder.push_back({fast_name + "@1/4", 0.25, fast, 75, photons});
+  ladder.push_back({fast_name + "@3/4", 0.75, fast, 85, photons, {}, {}});
+  ladder.push_back({fast_name + "@1/2", 0.5, fast, 80, photons, {}, {}});
+  ladder.push_back({fast_name + "@1/4", 0.25, fast, 75, photons, {}, {}});
   // Photon LOD last: on the fog stage it costs more error than a step of
   // resolution at equal time (docs/media.md), so it only extends the
   // ladder below its cheapest level.
-  if (lit && lod.groups > 0) ladder.push_back({fast_name + "+lod@1/4", 0.25, fast, 75, photons, lod});
+  if (lit && lod.groups > 0) ladder.push_back({fast_name + "+lod@1/4", 0.25, fast, 75, photons, lod, {}});
   return ladder;
 }
 

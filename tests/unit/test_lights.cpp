@@ -151,7 +151,7 @@ TEST(Lights, BadFieldsAreRefusedWithTheirPath) {
                   "out_of_range", "/gi/cluster");
   // The interleave is 1 or 4 (a 2 x 2 pattern), nothing between; 2^32 + 4
   // must not wrap to 4.
-  for (const json bad : {json(2), json(0), json(4294967300LL)}) {
+  for (const json& bad : {json(2), json(0), json(4294967300LL)}) {
     EXPECT_REJECTED(lit({{{"type", "point"}, {"position", {0, 2, 0}}}}, {{"gi", {{"direct_interleave", bad}}}}),
                     "out_of_range", "/gi/direct_interleave");
   }
