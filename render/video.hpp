@@ -37,8 +37,9 @@ struct VideoEncoderSettings {
   // colour conversion included; key frames not counted): one step faster
   // (up to 9) when the mean of the last 3 delta frames is over this many ms,
   // one step back (not below `speed`) when it is under half of it. 0: the
-  // speed stays. The server passes the frame budget of the request (the
-  // preview's 33 ms): a frame's encode adds at most about one frame's time.
+  // speed stays. The server passes half the frame budget of the request
+  // (the preview's 33 ms): the encode and the browser's decode together add
+  // about one frame's time.
   double max_encode_ms = 0.0;
 };
 

@@ -33,7 +33,9 @@ VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& para
     enc = stream.encoder.get();
   }
   enc->set_bitrate(kbps);
-  enc->set_max_encode_ms(budget_ms);
+  // Half the frame's budget: the encode and the browser's decode together
+  // stay within about one frame (docs/performance.md, "Video preview: AV1").
+  enc->set_max_encode_ms(0.5 * budget_ms);
   const EncodedVideoFrame f = enc->encode(img, time_ms, stream.key_pending);
   stream.key_pending = false;
   out->pngs[0] = pack_video_frame(f, codec);

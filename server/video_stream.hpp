@@ -43,8 +43,8 @@ void note_video_request(VideoStream& stream, const VideoParams& params);
 // encoder, and so a key frame, for the first frame, a new codec and a new
 // frame size; the bitrate is params' or `default_kbps`. The encode time is
 // added to the outcome's encode times (the accuracy controller's frame cost).
-// An AV1 stream's speed follows its encode time against `budget_ms`, the
-// frame budget of the request (VideoEncoderSettings::max_encode_ms).
+// An AV1 stream's speed follows its encode time against half of `budget_ms`,
+// the frame budget of the request (VideoEncoderSettings::max_encode_ms).
 // Call with stream.mu held. Throws std::runtime_error if the encoder fails.
 VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& params,
                                     int default_kbps, int width, int height, int bit_depth,
