@@ -213,13 +213,18 @@ int main(int argc, char** argv) {
   double max_encode_ms = 0.0;  // > 0: AV1's speed follows the encode time (VideoEncoderSettings)
   std::vector<int> speeds{0}, rates{125, 250, 500, 1000, 2000, 4000}, qualities{50, 75, 85, 92};
   std::vector<VideoCodec> codecs{VideoCodec::kVp8, VideoCodec::kVp9, VideoCodec::kAv1};
-  auto int_list = [](const std::string& v) {
-    std::vector<int> out;
+  auto split = [](const std::string& v) {
+    std::vector<std::string> out;
     for (std::size_t i = 0; i < v.size();) {
       const std::size_t j = std::min(v.find(',', i), v.size());
-      out.push_back(std::atoi(v.substr(i, j - i).c_str()));
+      out.push_back(v.substr(i, j - i));
       i = j + 1;
     }
+    return out;
+  };
+  auto int_list = [&](const std::string& v) {
+    std::vector<int> out;
+    for (const std::string& s : split(v)) out.push_back(std::atoi(s.c_str()));
     return out;
   };
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -237,15 +242,13 @@ int main(int argc, char** argv) {
     else if (a == "--max-encode-ms") max_encode_ms = std::atof(v.c_str());
     else if (a == "--codecs") {
       codecs.clear();
-      for (std::size_t i = 0; i < v.size();) {
-        const std::size_t j = std::min(v.find(',', i), v.size());
-        const auto c = parse_video_codec(v.substr(i, j - i));
+      for (const std::string& s : split(v)) {
+        const auto c = parse_video_codec(s);
         if (!c) {
-          std::fprintf(stderr, "unknown codec in %s\n", v.c_str());
+          std::fprintf(stderr, "unknown codec %s\n", s.c_str());
           return 2;
         }
         codecs.push_back(*c);
-        i = j + 1;
       }
     }
     else {
@@ -304,8 +307,9 @@ int main(int argc, char** argv) {
       r.encode_ms.push_back(thread_cpu_ms() - t);
       r.encode_wall_ms.push_back(wall_ms() - w0);
       t = thread_cpu_ms();
-      const Image shown = upscale_bilinear(decode_jpeg(bytes), width, height);
+      const Image decoded = decode_jpeg(bytes);
       r.decode_ms.push_back(thread_cpu_ms() - t);
+      const Image shown = upscale_bilinear(decoded, width, height);
       r.bytes += bytes.size();
       r.psnr.push_back(compare_levels(shown, full[i]).psnr_db);
       r.ssim.push_back(ssim(shown, full[i]));
@@ -329,8 +333,9 @@ int main(int argc, char** argv) {
         r.encode_ms.push_back(process_cpu_ms() - t);
         r.encode_wall_ms.push_back(wall_ms() - w0);
         t = thread_cpu_ms();
-        const Image shown = upscale_bilinear(dec.decode(f.data), width, height);
+        const Image decoded = dec.decode(f.data);
         r.decode_ms.push_back(thread_cpu_ms() - t);
+        const Image shown = upscale_bilinear(decoded, width, height);
         r.bytes += f.data.size();
         if (f.key) r.key_bytes += f.data.size();
         r.speeds.push_back(f.speed);

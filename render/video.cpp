@@ -110,13 +110,32 @@ struct I420View {
   int w, h;
 };
 
-// vpx_image_t and aom_image_t name their planes, strides and size alike.
+// vpx_image_t and aom_image_t name their planes (Y, U, V: 0, 1, 2),
+// strides and size alike.
 template <class CodecImage>
 I420View i420_view(const CodecImage& img) {
   return {{img.planes[0], img.planes[1], img.planes[2]},
           {img.stride[0], img.stride[1], img.stride[2]},
           static_cast<int>(img.d_w),
           static_cast<int>(img.d_h)};
+}
+
+template <class CodecImage>
+I420Planes i420_planes(CodecImage& img) {
+  return {img.planes[0], img.planes[1], img.planes[2], img.stride[0], img.stride[1], img.stride[2]};
+}
+
+// The frame packets libvpx or libaom has for the frame just encoded, appended
+// to `out` (both libraries' packets and iterators have the same layout).
+template <auto GetCxData, auto FramePacket, auto KeyFlag, class Ctx>
+void append_frame_packets(Ctx* ctx, EncodedVideoFrame* out) {
+  const void* iter = nullptr;
+  while (const auto* pkt = GetCxData(ctx, &iter)) {
+    if (pkt->kind != FramePacket) continue;
+    const auto* p = static_cast<const std::uint8_t*>(pkt->data.frame.buf);
+    out->data.insert(out->data.end(), p, p + pkt->data.frame.sz);
+    out->key = out->key || (pkt->data.frame.flags & KeyFlag) != 0;
+  }
 }
 
 // The inverse, chroma upsampled bilinearly between sample centres (what a
@@ -387,15 +406,7 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
                  "VideoEncoder::encode: frame size differs from the encoder's");
   const auto t0 = std::chrono::steady_clock::now();
   const bool av1 = settings_.codec == VideoCodec::kAv1;
-  if (av1) {
-    const aom_image_t& yuv = *impl_->aimg;
-    rgb_to_i420(img, {yuv.planes[AOM_PLANE_Y], yuv.planes[AOM_PLANE_U], yuv.planes[AOM_PLANE_V],
-                      yuv.stride[AOM_PLANE_Y], yuv.stride[AOM_PLANE_U], yuv.stride[AOM_PLANE_V]});
-  } else {
-    const vpx_image_t& yuv = *impl_->img;
-    rgb_to_i420(img, {yuv.planes[VPX_PLANE_Y], yuv.planes[VPX_PLANE_U], yuv.planes[VPX_PLANE_V],
-                      yuv.stride[VPX_PLANE_Y], yuv.stride[VPX_PLANE_U], yuv.stride[VPX_PLANE_V]});
-  }
+  rgb_to_i420(img, av1 ? i420_planes(*impl_->aimg) : i420_planes(*impl_->img));
   // The frame lasts until the next one; the first gets a 30 frames/s share.
   const double gap = frames_ == 0 ? 33.0 : time_ms - last_ms_;
   const auto duration = static_cast<unsigned long>(std::clamp(std::lround(gap), 1L, 1000L));
@@ -407,25 +418,13 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
         AOM_CODEC_OK) {
       aom_fail(&impl_->actx, "encode");
     }
-    aom_codec_iter_t iter = nullptr;
-    while (const aom_codec_cx_pkt_t* pkt = aom_codec_get_cx_data(&impl_->actx, &iter)) {
-      if (pkt->kind != AOM_CODEC_CX_FRAME_PKT) continue;
-      const auto* p = static_cast<const std::uint8_t*>(pkt->data.frame.buf);
-      out.data.insert(out.data.end(), p, p + pkt->data.frame.sz);
-      out.key = out.key || (pkt->data.frame.flags & AOM_FRAME_IS_KEY) != 0;
-    }
+    append_frame_packets<aom_codec_get_cx_data, AOM_CODEC_CX_FRAME_PKT, AOM_FRAME_IS_KEY>(&impl_->actx, &out);
   } else {
     if (vpx_codec_encode(&impl_->ctx, impl_->img, pts_ms_, duration, key ? VPX_EFLAG_FORCE_KF : 0,
                          VPX_DL_REALTIME) != VPX_CODEC_OK) {
       vpx_fail(&impl_->ctx, "encode");
     }
-    vpx_codec_iter_t iter = nullptr;
-    while (const vpx_codec_cx_pkt_t* pkt = vpx_codec_get_cx_data(&impl_->ctx, &iter)) {
-      if (pkt->kind != VPX_CODEC_CX_FRAME_PKT) continue;
-      const auto* p = static_cast<const std::uint8_t*>(pkt->data.frame.buf);
-      out.data.insert(out.data.end(), p, p + pkt->data.frame.sz);
-      out.key = out.key || (pkt->data.frame.flags & VPX_FRAME_IS_KEY) != 0;
-    }
+    append_frame_packets<vpx_codec_get_cx_data, VPX_CODEC_CX_FRAME_PKT, VPX_FRAME_IS_KEY>(&impl_->ctx, &out);
   }
   pts_ms_ += static_cast<std::int64_t>(duration);
   out.pts = frames_++;
