@@ -125,6 +125,32 @@ I420Planes i420_planes(CodecImage& img) {
   return {img.planes[0], img.planes[1], img.planes[2], img.stride[0], img.stride[1], img.stride[2]};
 }
 
+// The settings every stream shares, in libvpx's or libaom's encoder config
+// (same field names): pts in milliseconds of the caller's clock, every frame
+// out as soon as it is in (no lag), a reliable transport (TCP/WebSocket: no
+// error resilience), the bitrate target, no frame dropped (each request gets
+// its picture), the quantizer range and the rate control's slack; a
+// `buffer_ms` long rate-control buffer starting `initial_ms` full.
+template <class Config>
+void set_common_config(Config& cfg, const VideoEncoderSettings& settings, unsigned initial_ms,
+                       unsigned optimal_ms, unsigned buffer_ms) {
+  cfg.g_w = static_cast<unsigned>(settings.width);
+  cfg.g_h = static_cast<unsigned>(settings.height);
+  cfg.g_timebase = {1, 1000};
+  cfg.g_threads = static_cast<unsigned>(std::max(1, settings.threads));
+  cfg.g_lag_in_frames = 0;
+  cfg.g_error_resilient = 0;
+  cfg.rc_target_bitrate = static_cast<unsigned>(settings.bitrate_kbps);
+  cfg.rc_dropframe_thresh = 0;
+  cfg.rc_min_quantizer = 2;
+  cfg.rc_max_quantizer = 56;
+  cfg.rc_undershoot_pct = 50;
+  cfg.rc_overshoot_pct = 50;
+  cfg.rc_buf_initial_sz = initial_ms;
+  cfg.rc_buf_optimal_sz = optimal_ms;
+  cfg.rc_buf_sz = buffer_ms;
+}
+
 // The frame packets libvpx or libaom has for the frame just encoded, appended
 // to `out` (both libraries' packets and iterators have the same layout).
 template <auto GetCxData, auto FramePacket, auto KeyFlag, class Ctx>
@@ -262,23 +288,9 @@ void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int spee
     aom_fail(nullptr, "config_default");
   }
   const int threads = std::max(1, settings.threads);
-  cfg.g_w = static_cast<unsigned>(settings.width);
-  cfg.g_h = static_cast<unsigned>(settings.height);
-  cfg.g_timebase = {1, 1000};
-  cfg.g_threads = static_cast<unsigned>(threads);
+  set_common_config(cfg, settings, 4000, 5000, 6000);
   cfg.g_pass = AOM_RC_ONE_PASS;
-  cfg.g_lag_in_frames = 0;
-  cfg.g_error_resilient = 0;
   cfg.rc_end_usage = AOM_CBR;
-  cfg.rc_target_bitrate = static_cast<unsigned>(settings.bitrate_kbps);
-  cfg.rc_dropframe_thresh = 0;
-  cfg.rc_min_quantizer = 2;
-  cfg.rc_max_quantizer = 56;
-  cfg.rc_undershoot_pct = 50;
-  cfg.rc_overshoot_pct = 50;
-  cfg.rc_buf_initial_sz = 4000;
-  cfg.rc_buf_optimal_sz = 5000;
-  cfg.rc_buf_sz = 6000;
   cfg.kf_mode = AOM_KF_DISABLED;
   if (aom_codec_enc_init(&impl.actx, iface, &cfg, 0) != AOM_CODEC_OK) aom_fail(&impl.actx, "enc_init");
   impl.aopen = true;
@@ -313,23 +325,9 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
   vpx_codec_iface_t* iface = vp9 ? vpx_codec_vp9_cx() : vpx_codec_vp8_cx();
   vpx_codec_enc_cfg_t& cfg = impl_->cfg;
   if (vpx_codec_enc_config_default(iface, &cfg, 0) != VPX_CODEC_OK) vpx_fail(nullptr, "config_default");
-  cfg.g_w = static_cast<unsigned>(settings.width);
-  cfg.g_h = static_cast<unsigned>(settings.height);
-  cfg.g_timebase = {1, 1000};  // pts in milliseconds of the caller's clock
-  cfg.g_threads = static_cast<unsigned>(std::max(1, settings.threads));
+  set_common_config(cfg, settings, 500, 600, 1000);
   cfg.g_pass = VPX_RC_ONE_PASS;
-  cfg.g_lag_in_frames = 0;      // every frame out as soon as it is in
-  cfg.g_error_resilient = 0;    // a reliable transport (TCP/WebSocket)
   cfg.rc_end_usage = VPX_CBR;
-  cfg.rc_target_bitrate = static_cast<unsigned>(settings.bitrate_kbps);
-  cfg.rc_dropframe_thresh = 0;  // never drop a frame: each request gets its picture
-  cfg.rc_min_quantizer = 2;
-  cfg.rc_max_quantizer = 56;
-  cfg.rc_undershoot_pct = 50;
-  cfg.rc_overshoot_pct = 50;
-  cfg.rc_buf_initial_sz = 500;
-  cfg.rc_buf_optimal_sz = 600;
-  cfg.rc_buf_sz = 1000;
   cfg.kf_mode = VPX_KF_DISABLED;  // key frames at the start and on request only
   if (vpx_codec_enc_init(&impl_->ctx, iface, &cfg, 0) != VPX_CODEC_OK) vpx_fail(&impl_->ctx, "enc_init");
   impl_->open = true;
