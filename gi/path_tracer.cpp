@@ -80,7 +80,12 @@ class Tracer {
           beta = (sigma_t > 0.0 ? medium.sigma_s(x) / sigma_t : 0.0) * beta;
           const double k = medium.k(x);
           L = L + mul(beta, in_scattered(x, v, k, rng));
-          v = schlick_sample_direction(k, v, uniform(rng), uniform(rng));
+          // The two numbers drawn one statement each (a call's arguments are
+          // evaluated in an unspecified order: g++ and clang differed), in
+          // the order g++ drew them, so that earlier references stay exact.
+          const double u2 = uniform(rng);
+          const double u1 = uniform(rng);
+          v = schlick_sample_direction(k, v, u1, u2);
           specular = false;
           if (depth >= 2) {
             const double q = std::min(0.95, std::max({beta[0], beta[1], beta[2]}));
@@ -113,7 +118,9 @@ class Tracer {
       switch (occ.material.type) {
         case MaterialType::kDiffuse: {
           L = L + mul(beta, direct(hit->p, n, occ.albedo, rng));
-          v = cosine_hemisphere(n, uniform(rng), uniform(rng));
+          const double u2 = uniform(rng);  // drawn as above
+          const double u1 = uniform(rng);
+          v = cosine_hemisphere(n, u1, u2);
           // f cos / pdf = (albedo / pi) cos / (cos / pi) = albedo.
           beta = mul(beta, occ.albedo);
           specular = false;

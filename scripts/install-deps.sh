@@ -30,7 +30,7 @@ RUN_PACKAGES=(
 TEST_PACKAGES=(
   glslang-tools                                       # shader compile check in the tests
   libgtest-dev libgmock-dev
-  clang-14 libclang-rt-14-dev                         # libFuzzer targets (fuzz/, --preset fuzz)
+  clang-14 libclang-rt-14-dev                         # libFuzzer targets (--preset fuzz) and the sanitizer build (--preset asan)
   clang-tidy-14                                       # the clang-tidy stage of scripts/test.sh
   lld                                                 # linker of the builds (CMakeLists.txt), 5x GNU ld's speed
   python3 python3-numpy python3-matplotlib            # plots and analysis scripts

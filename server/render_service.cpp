@@ -836,7 +836,7 @@ void RenderService::release_when_idle(std::unique_ptr<FrameRenderer>& renderer, 
   malloc_trim(0);
   const std::uint64_t rss = resident_bytes();
   std::uint64_t floor = idle_rss_floor_.load();
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(BEAMCAST_ASAN)
   // Under ASan the resident size holds the allocator's quarantine, not the
   // renderer's memory: it says nothing about what a new context would free.
   const bool over = false;

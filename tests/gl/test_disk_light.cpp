@@ -41,7 +41,7 @@ TEST(DiskLightGl, OutlinesGetTheShareOfEachPixel) {
                   {"lights", {{{"type", "disk"}, {"center", {kCx, kCy, 0}}, {"normal", {0, 0, 2}},
                                {"radius", kR}, {"radiance", {kL, kL, kL}}}}},
                   {"gi", {{"photons", 1000}, {"light_antialias", aa}}},
-                  {"cameras", {cam}}};
+                  {"cameras", json::array({cam})}};
     };
     const Scene probe = parse_scene(scene_json(true), {});
     const std::vector<double> share =

@@ -698,7 +698,7 @@ TEST(Gi, QuadLightOutlinesGetTheShareOfEachPixel) {
                                {"edge_u", {a * c, a * s, 0}}, {"edge_v", {-b * s, b * c, 0}},
                                {"radiance", {L, L, L}}}}},
                   {"gi", {{"photons", 1000}, {"light_antialias", aa}}},
-                  {"cameras", {cam}}};
+                  {"cameras", json::array({cam})}};
     };
     // The covered share of each pixel: 32 x 32 rays a pixel met with the
     // light's plane z = 0.

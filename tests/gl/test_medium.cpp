@@ -376,11 +376,11 @@ TEST(Medium, MeshRegionsAttenuateSurfacesExactly) {
   json dent = test::cube_vertices();
   dent.push_back({0, 0, 0});
   const json cases[] = {
-      {test::mesh_region(moved(test::cube_vertices(), 1.5, {-1.0, 0.5, 0.0}),
-                         test::cube_triangles(), 0.4)},
-      {test::mesh_region(moved(dent, 1.6, {0.8, -0.5, 0.5}), test::dented_triangles(), 0.6)},
-      {test::mesh_region(moved(test::cube_vertices(), 10.0, {0.0, 0.0, 0.0}),
-                         test::cube_triangles(), 0.1)},
+      json::array({test::mesh_region(moved(test::cube_vertices(), 1.5, {-1.0, 0.5, 0.0}),
+                                     test::cube_triangles(), 0.4)}),
+      json::array({test::mesh_region(moved(dent, 1.6, {0.8, -0.5, 0.5}), test::dented_triangles(), 0.6)}),
+      json::array({test::mesh_region(moved(test::cube_vertices(), 10.0, {0.0, 0.0, 0.0}),
+                                     test::cube_triangles(), 0.1)}),
   };
   for (const json& media : cases) {
     json j = beams_in_fog(0.0);

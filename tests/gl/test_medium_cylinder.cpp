@@ -44,7 +44,7 @@ TEST(MediumCylinder, AttenuatesSurfacesAsTheReference) {
         {"occluders",
          {{{"type", "sphere"}, {"center", {1.0, -0.8, 0.3}}, {"radius", 0.7}},
           {{"type", "plane"}, {"point", {0, 0, -3}}, {"normal", {0, 0, 1}}}}},
-        {"media", {view.region}},
+        {"media", json::array({view.region})},
         {"cameras",
          {{{"position", {view.eye[0], view.eye[1], view.eye[2]}},
            {"target", {view.target[0], view.target[1], view.target[2]}},

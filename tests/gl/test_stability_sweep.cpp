@@ -127,8 +127,10 @@ Beam random_beam(Rng& rng, Density d) {
   const Vec3 c{uniform(rng, -0.5, 0.5), uniform(rng, -0.5, 0.5), uniform(rng, -0.5, 0.5)};
   const double r = uniform(rng, 0.3, 1.2);
   if (chance(rng, 0.4)) return sphere_beam(c, r, std::move(d));
-  const Vec3 half = uniform(rng, 0.05, 2.0) * unit_vector(rng);
-  return capsule_beam(c - half, c + half, r, std::move(d), chance(rng, 0.8), chance(rng, 0.8));
+  const Vec3 axis = unit_vector(rng);
+  const Vec3 half = uniform(rng, 0.05, 2.0) * axis;
+  const bool cap1 = chance(rng, 0.8), cap0 = chance(rng, 0.8);
+  return capsule_beam(c - half, c + half, r, std::move(d), cap0, cap1);
 }
 
 // ---------------------------------------------------------------------------
@@ -185,6 +187,12 @@ Occluder plane_occluder(Vec3 p, Vec3 n) {
 // in a frame where the beams have radius ~1 near the origin; place() then
 // rotates, scales (radii 1e-6 .. 1e6) and moves it (up to 1e5 from the
 // origin) as a whole.
+// Each random number is drawn in a statement of its own or in a braced list
+// (both evaluated in order), never two in one call's arguments or one
+// product's operands, whose order C++ leaves to the compiler (g++ and clang
+// differ): so a configuration number names the same scene in every build.
+// The statements keep the order g++ drew them in before, so the numbers of
+// earlier runs (55288 below) still name the same configurations.
 
 constexpr int kCamerasPerScene = 8;
 
@@ -264,7 +272,9 @@ Draw draw_camera_on_beam(Rng& rng) {
         pos = {uniform(rng, -1.2, 1.2), 0, sphere ? 0.0 : h};
         break;
     }
-    d.scene.cameras.push_back(camera_towards(rng, pos, unit_vector(rng), uniform(rng, 20.0, 120.0)));
+    const double fov = uniform(rng, 20.0, 120.0);
+    const Vec3 dir = unit_vector(rng);
+    d.scene.cameras.push_back(camera_towards(rng, pos, dir, fov));
   }
   return d;
 }
@@ -298,7 +308,8 @@ Draw draw_grazing(Rng& rng) {
   for (int k = 0; k < kCamerasPerScene; ++k) {
     // A view direction across the axis (capsule) and a central ray passing at
     // d' = 1 -+ eps from the centre or the axis.
-    const double eps = log_uniform(rng, 1e-7, 1e-1) * (chance(rng, 0.8) ? 1.0 : -1.0);
+    const double eps_size = log_uniform(rng, 1e-7, 1e-1);
+    const double eps = eps_size * (chance(rng, 0.8) ? 1.0 : -1.0);
     const Vec3 v = sphere ? unit_vector(rng) : at_angle(rng, {0, 0, 1}, uniform(rng, 0.3, kPi / 2));
     Vec3 side = cross(v, sphere ? unit_vector(rng) : Vec3{0, 0, 1});
     side = normalize(side);
@@ -323,9 +334,11 @@ Draw draw_jumps(Rng& rng) {
   d.what = dens.name();
   for (int k = 0; k < kCamerasPerScene; ++k) {
     // Rays through the centre (the abe core at x <= 0.01) or across the jump.
-    const Vec3 pos = uniform(rng, 1.5, 10.0) * unit_vector(rng);
-    const Vec3 aim = chance(rng, 0.5) ? log_uniform(rng, 1e-4, 0.02) * unit_vector(rng)
-                                      : uniform(rng, 0.6, 0.9) * unit_vector(rng);
+    const Vec3 pos_dir = unit_vector(rng);
+    const Vec3 pos = uniform(rng, 1.5, 10.0) * pos_dir;
+    const bool core = chance(rng, 0.5);
+    const Vec3 aim_dir = unit_vector(rng);
+    const Vec3 aim = (core ? log_uniform(rng, 1e-4, 0.02) : uniform(rng, 0.6, 0.9)) * aim_dir;
     d.scene.cameras.push_back(camera_towards(rng, pos, normalize(aim - pos), log_uniform(rng, 0.05, 30.0)));
   }
   return d;
@@ -350,7 +363,8 @@ Draw draw_coincident(Rng& rng) {
   }
   d.what = std::to_string(n) + " beams " + base.density.name() + " jitter " + fmt("%.2g", jitter);
   for (int k = 0; k < kCamerasPerScene; ++k) {
-    const Vec3 pos = uniform(rng, 0.2, 6.0) * unit_vector(rng);
+    const Vec3 dir = unit_vector(rng);
+    const Vec3 pos = uniform(rng, 0.2, 6.0) * dir;
     d.scene.cameras.push_back(camera_seeing(rng, pos, {0, 0, 0}, 2.0));
   }
   return d;
@@ -360,13 +374,15 @@ Draw draw_occluders(Rng& rng) {
   Draw d;
   const Beam b = random_beam(rng, random_density(rng));
   d.scene.beams = {b};
-  const Vec3 in = uniform(rng, 0.0, 0.6) * unit_vector(rng);  // a point inside the beam
+  const Vec3 in_dir = unit_vector(rng);
+  const Vec3 in = uniform(rng, 0.0, 0.6) * in_dir;  // a point inside the beam
   std::vector<Camera> cams;
   for (int k = 0; k < kCamerasPerScene; ++k) {
-    const Vec3 pos = (chance(rng, 0.3) ? uniform(rng, 0.0, 0.8) : uniform(rng, 2.0, 6.0)) *
-                     unit_vector(rng);
-    cams.push_back(camera_towards(rng, pos, normalize(in - pos + 0.3 * unit_vector(rng)),
-                                  uniform(rng, 20.0, 100.0)));
+    const Vec3 pos_dir = unit_vector(rng);
+    const Vec3 pos = (chance(rng, 0.3) ? uniform(rng, 0.0, 0.8) : uniform(rng, 2.0, 6.0)) * pos_dir;
+    const double fov = uniform(rng, 20.0, 100.0);
+    const Vec3 wobble = unit_vector(rng);
+    cams.push_back(camera_towards(rng, pos, normalize(in - pos + 0.3 * wobble), fov));
   }
   switch (pick(rng, 4)) {
     case 0:
@@ -402,26 +418,35 @@ Draw draw_extreme_cameras(Rng& rng) {
     Camera cam;
     switch (pick(rng, 4)) {
       case 0: {  // tiny fov
-        const Vec3 pos = uniform(rng, 2.0, 20.0) * unit_vector(rng);
-        cam = camera_towards(rng, pos, normalize(0.5 * unit_vector(rng) - pos),
-                             log_uniform(rng, 0.01, 0.5), wh[0], wh[1]);
+        const Vec3 pos_dir = unit_vector(rng);
+        const Vec3 pos = uniform(rng, 2.0, 20.0) * pos_dir;
+        const double fov = log_uniform(rng, 0.01, 0.5);
+        const Vec3 aim = 0.5 * unit_vector(rng);
+        cam = camera_towards(rng, pos, normalize(aim - pos), fov, wh[0], wh[1]);
         break;
       }
       case 1: {  // huge fov, from inside or next to a beam
-        const Vec3 pos = uniform(rng, 0.0, 1.5) * unit_vector(rng);
-        cam = camera_towards(rng, pos, unit_vector(rng), uniform(rng, 150.0, 179.0), wh[0], wh[1]);
+        const Vec3 pos_dir = unit_vector(rng);
+        const Vec3 pos = uniform(rng, 0.0, 1.5) * pos_dir;
+        const double fov = uniform(rng, 150.0, 179.0);
+        const Vec3 dir = unit_vector(rng);
+        cam = camera_towards(rng, pos, dir, fov, wh[0], wh[1]);
         break;
       }
       case 2: {  // orthographic, any height
         const Vec3 v = unit_vector(rng);
-        cam = ortho_towards(rng, uniform(rng, -0.5, 0.5) * unit_vector(rng) - uniform(rng, 0.0, 8.0) * v,
-                            v, log_uniform(rng, 1e-3, 10.0));
+        const double height = log_uniform(rng, 1e-3, 10.0);
+        const double back = uniform(rng, 0.0, 8.0);
+        const Vec3 side_dir = unit_vector(rng);
+        const Vec3 side = uniform(rng, -0.5, 0.5) * side_dir;
+        cam = ortho_towards(rng, side - back * v, v, height);
         cam.width = wh[0];
         cam.height = wh[1];
         break;
       }
       default: {  // near 1e-6, far 1e9 (the largest ratio validation accepts is 1e15)
-        const Vec3 pos = uniform(rng, 0.5, 6.0) * unit_vector(rng);
+        const Vec3 pos_dir = unit_vector(rng);
+        const Vec3 pos = uniform(rng, 0.5, 6.0) * pos_dir;
         cam = camera_seeing(rng, pos, {0, 0, 0}, 1.5);
         cam.width = wh[0];
         cam.height = wh[1];

@@ -57,7 +57,7 @@ namespace {
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(BEAMCAST_ASAN)
 constexpr bool kSanitized = true;
 #else
 constexpr bool kSanitized = false;

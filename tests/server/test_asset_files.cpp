@@ -155,7 +155,7 @@ void expect_quick_bounded_refusal(const Refusal& r, const std::string& words) {
   EXPECT_EQ(r.reply["error"]["path"], "/params/scene/occluders/0/file") << r.reply;
   EXPECT_NE(r.reply["error"]["message"].get<std::string>().find(words), std::string::npos)
       << r.reply;
-#if !defined(__SANITIZE_ADDRESS__)
+#if !defined(BEAMCAST_ASAN)
   // Not in the Debug + sanitizer build: its JSON parsing runs some 10x
   // slower (the SLIM refusal took 948 ms there, about what the old reader
   // took in the optimized build), so time tells nothing; and ASan's
@@ -171,7 +171,7 @@ void expect_quick_bounded_refusal(const Refusal& r, const std::string& words) {
 
 json scene_with(const json& occluder) {
   json s = test::tiny_scene(8);
-  s["occluders"] = {occluder};
+  s["occluders"] = json::array({occluder});
   return s;
 }
 
@@ -235,7 +235,7 @@ TEST(AssetFiles, PingIsAnsweredWhileALegalMeshFileIsParsed) {
       timed_scene_put(s.port(), scene_with({{"type", "mesh"}, {"file", "grid.obj"}}));
   EXPECT_TRUE(r.reply.value("ok", false)) << r.reply.dump().substr(0, 300);
   std::printf("scene.put of the mesh %.1f ms, ping beside it %.1f ms\n", r.ms, r.ping_ms);
-#if !defined(__SANITIZE_ADDRESS__)
+#if !defined(BEAMCAST_ASAN)
   // The parse must be long enough to tell (measured 250-400 ms here), and
   // the ping at most a quarter of it: on the network thread the ping waited
   // for nearly all of it; beside it, it waits for a scheduler turn of the

@@ -167,7 +167,7 @@ TEST(HostileRenders, FogPhotonEventsAreBounded) {
   // 50 MiB: the budget for RSS after a burst; the cap alone holds
   // the events to 21 MB, and they are freed when tracing stops. Not under
   // AddressSanitizer: its quarantine keeps freed memory (up to 256 MB).
-#if !defined(__SANITIZE_ADDRESS__)
+#if !defined(BEAMCAST_ASAN)
   EXPECT_LT(after - before, 50.0) << "RSS " << before << " MiB -> " << after << " MiB";
 #endif
   std::printf("fog request: RSS %.1f MiB before, %.1f MiB after\n", before, after);
@@ -210,7 +210,7 @@ TEST(HostileRenders, CachedPhotonMapsAreGivenBackOnceIdle) {
   std::printf("lit render (%.2f s): RSS %.1f MiB before, %.1f right after, %.1f once idle\n",
               std::chrono::duration<double>(Clock::now() - t0).count(), before, held, after);
   EXPECT_GE(server.core().renders->idle_releases(), 2u);
-#if !defined(__SANITIZE_ADDRESS__)
+#if !defined(BEAMCAST_ASAN)
   // Right after the render the cache holds the maps (measured +35 MiB here,
   // +54 in CI, and still +35 after 4 s without the release); once idle the
   // cache keeps at most 16 MiB of maps (these are larger: evicted), so the
@@ -383,7 +383,7 @@ TEST(ServerProcess, SigtermEndsACostlyRender) {
     EXPECT_EQ(done, pid) << "still running " << s << " s after SIGTERM";
     // The drain deadline (1 s), then the cancelled render's answer and the
     // teardown; the watchdog would end it at 3 s with status 2.
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(BEAMCAST_ASAN)
     // Debug + sanitizers: the teardown (and LeakSanitizer's pass at exit) can
     // outlast the watchdog's 2 s, which then ends the process with status 2:
     // SIGTERM obeyed either way.

@@ -84,7 +84,7 @@ json camera(double x, int size) {
 }
 
 json auto_render(int id, double x, int size, json extra = json::object()) {
-  json params = {{"scene_id", "demo"}, {"cameras", {camera(x, size)}}, {"quality", "auto"}};
+  json params = {{"scene_id", "demo"}, {"cameras", json::array({camera(x, size)})}, {"quality", "auto"}};
   params.update(extra);
   return {{"id", id}, {"method", "render"}, {"params", params}};
 }
@@ -141,7 +141,7 @@ TEST(HttpServer, WebSocketCarriesTheProtocolWithBinaryFrames) {
   EXPECT_EQ(r.j["error"]["path"], "/params/quality");
   // A full render: JSON text, then the PNG in one binary message.
   r = ws.call({{"id", 3}, {"method", "render"},
-               {"params", {{"scene_id", "demo"}, {"cameras", {camera(0.5, 64)}}}}});
+               {"params", {{"scene_id", "demo"}, {"cameras", json::array({camera(0.5, 64)})}}}});
   ASSERT_TRUE(r.j["ok"]) << r.j.dump();
   EXPECT_EQ(r.j["result"]["frames"][0]["format"], "png");
   const Image img = decode_png(ws.frame(r));
@@ -227,7 +227,7 @@ TEST(InteractiveQuality, MovingFramesAreReducedAndTheStillFrameIsExact) {
   EXPECT_EQ(r.j["result"]["frames"][0]["format"], "png");
   const Image still = decode_png(ws.frame(r));
   auto full = ws.call({{"id", 101}, {"method", "render"},
-                       {"params", {{"scene_id", "demo"}, {"cameras", {camera(x, size)}}}}});
+                       {"params", {{"scene_id", "demo"}, {"cameras", json::array({camera(x, size)})}}}});
   const Image reference = decode_png(ws.frame(full));
   // Same renderer, same settings, same device: exactly equal.
   EXPECT_EQ(still.rgb, reference.rgb);
@@ -287,7 +287,7 @@ TEST(InteractiveQuality, VideoFramesAreOneStreamAndTheStillFrameStaysExact) {
   EXPECT_EQ(r.j["result"]["frames"][0]["format"], "png");
   const Image still = decode_png(ws.frame(r));
   auto full = ws.call({{"id", 21}, {"method", "render"},
-                       {"params", {{"scene_id", "demo"}, {"cameras", {camera(0.4, size)}}}}});
+                       {"params", {{"scene_id", "demo"}, {"cameras", json::array({camera(0.4, size)})}}}});
   EXPECT_EQ(still.rgb, decode_png(ws.frame(full)).rgb);
 
   // Bad video params: code, message, path; the connection carries on.

@@ -81,7 +81,7 @@ TEST(HttpRender, SeveralCamerasOrAcceptJsonGiveTheResultWithBase64Frames) {
   }
   EXPECT_EQ(result["frames"][1]["camera"], "right");
   // One camera, but JSON asked for first.
-  params["cameras"] = {small_camera("one", 0)};
+  params["cameras"] = json::array({small_camera("one", 0)});
   r = post(s.http_port(), params.dump(), {{"Accept", "application/json, image/png;q=0.5"}});
   ASSERT_EQ(r.result_int(), 200) << r.body();
   EXPECT_EQ(json::parse(r.body())["frames"][0]["camera"], "one");
@@ -129,7 +129,7 @@ TEST(HttpRender, OverTheLimitsIs413Or422) {
   ServerConfig c;
   c.max_message_bytes = 64 * 1024;
   HttpTestServer s(c);
-  json params = {{"scene_id", "demo"}, {"cameras", {small_camera("big", 0)}}};
+  json params = {{"scene_id", "demo"}, {"cameras", json::array({small_camera("big", 0)})}};
   params["cameras"][0]["width"] = 5000;
   auto r = post(s.http_port(), params.dump());
   EXPECT_EQ(r.result_int(), 422);
@@ -150,7 +150,7 @@ TEST(HttpRender, WithATokenTheBearerHeaderIsNeeded) {
   c.token = "s3cret-token";
   HttpTestServer s(c);
   const std::string body = json{{"scene", json::parse(read_text("examples/paper_1set.json"))},
-                                {"cameras", {small_camera("v", 0)}}}
+                                {"cameras", json::array({small_camera("v", 0)})}}
                                .dump();
   auto r = post(s.http_port(), body);
   EXPECT_EQ(r.result_int(), 401);

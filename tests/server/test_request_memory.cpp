@@ -31,7 +31,7 @@ std::string repeated(const std::string& open, const std::string& element, const 
 }
 
 TEST(RequestMemory, ParseCostFactorBoundsTheCostliestShapes) {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(BEAMCAST_ASAN)
   // ASan replaces glibc's malloc, whose mallinfo2 this measures (it reads 0
   // there); the default build measures it.
   GTEST_SKIP() << "measures glibc's allocator, which AddressSanitizer replaces";

@@ -115,6 +115,15 @@ TEST(Scheduling, BatchWorkSubmittedWhileAPreviewIsActiveRendersOneCameraPerSlice
 }
 
 TEST(Scheduling, FourPipelinedConnectionsTakeTurns) {
+#if defined(BEAMCAST_ASAN)
+  // Turns go by measured render time, equal within 5 ms (kTurnQuantumMs):
+  // one fake render preempted for longer puts its connection a turn behind.
+  // In the Debug + ASan build beside a compile that happened in 5 of 10 runs
+  // (clang-14) and 1 of 10 (g++), never on an idle machine or in the release
+  // build; the scheduler's code runs under the sanitizers in this file's
+  // other tests.
+  GTEST_SKIP() << "turn order by measured time: the release build checks it";
+#endif
   auto control = std::make_shared<test::FakeRendererControl>();
   ServerConfig cfg;  // defaults: 16 in flight per connection
   cfg.max_inflight_total = 65;  // the four connections' 64 and the blocker's

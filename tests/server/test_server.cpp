@@ -172,7 +172,7 @@ TEST(Server, SlimSurfacesRenderAndBadOnesAreRefusedWithPaths) {
   TestServer s(config);
   Conn c(s.port());
   json sphere = {{"center", {0, 0, 0}}, {"radius", 1.0}, {"coefficients", {-0.3, 0, -0.3, 0, 0, 0.5}}};
-  json scene = {{"occluders", {{{"type", "slim"}, {"spheres", {sphere}}}}},
+  json scene = {{"occluders", {{{"type", "slim"}, {"spheres", json::array({sphere})}}}},
                 {"cameras", {{{"position", {0, 3, 0.5}}, {"target", {0, 0, 0}}, {"width", 32}, {"height", 32}}}}};
   Reply r = c.call(render_req(1, scene));
   ASSERT_TRUE(r.json["ok"]) << r.json;
@@ -187,10 +187,10 @@ TEST(Server, SlimSurfacesRenderAndBadOnesAreRefusedWithPaths) {
   };
   json negative = sphere;
   negative["radius"] = -1;
-  refused({{"type", "slim"}, {"spheres", {negative}}}, "out_of_range", "/params/scene/occluders/0/spheres/0/radius");
+  refused({{"type", "slim"}, {"spheres", json::array({negative})}}, "out_of_range", "/params/scene/occluders/0/spheres/0/radius");
   json rotation = sphere;
   rotation["rotation"] = {0, 0, 0, 0};
-  refused({{"type", "slim"}, {"spheres", {rotation}}}, "invalid_value",
+  refused({{"type", "slim"}, {"spheres", json::array({rotation})}}, "invalid_value",
           "/params/scene/occluders/0/spheres/0/rotation");
   refused({{"type", "slim"}, {"file", "../outside.bslm"}}, "forbidden_path", "/params/scene/occluders/0/file");
   refused({{"type", "slim"}, {"file", "cut.bslm"}}, "bad_slim", "/params/scene/occluders/0/file");
@@ -270,7 +270,7 @@ TEST(Server, StoredScenesPutUpdateRenderDeleteAndEvict) {
   ASSERT_TRUE(r.json["ok"]) << r.json;
   // A preview client sends only a camera pose.
   json pose = {{"position", {3, 1, 3}}, {"target", {0, 0, 0}}, {"width", 48}, {"height", 40}};
-  r = c.call({{"id", 2}, {"method", "render"}, {"params", {{"scene_id", "a"}, {"cameras", {pose}}}}});
+  r = c.call({{"id", 2}, {"method", "render"}, {"params", {{"scene_id", "a"}, {"cameras", json::array({pose})}}}});
   ASSERT_TRUE(r.json["ok"]) << r.json;
   EXPECT_EQ(frame_png(r, 0).width, 48);
   const Image before = frame_png(r, 0);
@@ -278,7 +278,7 @@ TEST(Server, StoredScenesPutUpdateRenderDeleteAndEvict) {
   r = c.call({{"id", 3}, {"method", "scene.update"},
               {"params", {{"scene_id", "a"}, {"patch", {{"output", {{"exposure", 4.0}}}}}}}});
   ASSERT_TRUE(r.json["ok"]) << r.json;
-  r = c.call({{"id", 4}, {"method", "render"}, {"params", {{"scene_id", "a"}, {"cameras", {pose}}}}});
+  r = c.call({{"id", 4}, {"method", "render"}, {"params", {{"scene_id", "a"}, {"cameras", json::array({pose})}}}});
   EXPECT_GT(compare_levels(frame_png(r, 0), before).max_abs, 10);
   // A patch that breaks the scene is refused with the path, the scene stays.
   r = c.call({{"id", 5}, {"method", "scene.update"},
@@ -602,7 +602,7 @@ TEST(Server, BatchWindowMergesViewersOfOneStoredScene) {
   for (int i = 0; i < 3; ++i) {
     viewers[i]->send({{"id", i},
                       {"method", "render"},
-                      {"params", {{"scene_id", "shared"}, {"cameras", {poses[i]}}}}});
+                      {"params", {{"scene_id", "shared"}, {"cameras", json::array({poses[i]})}}}});
   }
   Renderer offline;
   Scene scene = parse_scene(small_scene(48), SceneLoadOptions{});

@@ -114,7 +114,7 @@ TEST(Soak, MixedLoadWithFaultsLeavesNoErrorsNoLeaksAndCorrectFrames) {
                     .json.value("ok", false));
     for (int i = 0; i < kPoses; ++i) {
       ASSERT_TRUE(warm.call({{"id", 2}, {"method", "render"},
-                             {"params", {{"scene_id", "soak"}, {"cameras", {pose(i)}}}}})
+                             {"params", {{"scene_id", "soak"}, {"cameras", json::array({pose(i)})}}}})
                       .json.value("ok", false));
     }
     // The largest frames of the run too (the two-camera renders and the slow
@@ -152,7 +152,7 @@ TEST(Soak, MixedLoadWithFaultsLeavesNoErrorsNoLeaksAndCorrectFrames) {
         for (long n = 0; Clock::now() < end; ++n) {
           const int a = static_cast<int>((n + k) % kPoses), b = static_cast<int>((n * 5 + 1) % kPoses);
           const bool two = n % 3 == 2;
-          json cams = two ? json{pose(a), pose(b)} : json{pose(a)};
+          json cams = two ? json::array({pose(a), pose(b)}) : json::array({pose(a)});
           const json id = "g" + std::to_string(k) + "-" + std::to_string(n);
           const json req = {{"id", id}, {"method", "render"},
                             {"params", {{"scene_id", "soak"}, {"cameras", cams}}}};
@@ -206,7 +206,7 @@ TEST(Soak, MixedLoadWithFaultsLeavesNoErrorsNoLeaksAndCorrectFrames) {
     });
   };
   const json render = {{"id", 1}, {"method", "render"},
-                       {"params", {{"scene_id", "soak"}, {"cameras", {pose(0)}}}}};
+                       {"params", {{"scene_id", "soak"}, {"cameras", json::array({pose(0)})}}}};
   // Disconnect mid-request: half a frame, then gone.
   injector([&](std::mt19937& rng) {
     Conn c(s.port(), 5);
@@ -289,14 +289,14 @@ TEST(Soak, MixedLoadWithFaultsLeavesNoErrorsNoLeaksAndCorrectFrames) {
   // Still serving, and with the right frames.
   Conn c(s.port(), 30);
   const auto r = c.call({{"id", "after"}, {"method", "render"},
-                         {"params", {{"scene_id", "soak"}, {"cameras", {pose(2)}}}}});
+                         {"params", {{"scene_id", "soak"}, {"cameras", json::array({pose(2)})}}}});
   ASSERT_TRUE(r.json.value("ok", false)) << r.json;
   EXPECT_TRUE(same_image(frame_image(r, 0), reference[2]));
   c.close();
 
   const double rss_end = settled_rss_mib();
   std::printf("soak: RSS baseline %.1f MiB, after %.1f MiB\n", rss_base, rss_end);
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(BEAMCAST_ASAN)
   // ASan keeps freed blocks in its quarantine (256 MiB by default): RSS says
   // nothing about leaks there; LeakSanitizer checks them at exit instead.
 #else

@@ -54,7 +54,7 @@ LightRandom draw(std::mt19937_64& rng) {
 TEST(BeamLights, AnEmittingBeamBecomesALightWithTheFluxOfItsDensity) {
   // Linear f = 1 - x: S2 = 1/12, M = 4 pi r^3 / 12; flux = 4 pi c I M / r.
   const double r = 2.0, intensity = 3.0;
-  const Scene s = parse_scene(beam_scene({sphere_beam(r, "linear", intensity, true)}), {});
+  const Scene s = parse_scene(beam_scene(json::array({sphere_beam(r, "linear", intensity, true)})), {});
   ASSERT_EQ(s.lights.size(), 1u);
   ASSERT_TRUE(std::holds_alternative<BeamEmitter>(s.lights[0].shape));
   EXPECT_TRUE(s.has_gi());
@@ -70,14 +70,14 @@ TEST(BeamLights, AnEmittingBeamBecomesALightWithTheFluxOfItsDensity) {
   const json capsule = {{"type", "capsule"}, {"p0", {0, 0, 0}}, {"p1", {3, 0, 0}},
                         {"radius", 1.0},     {"caps", {true, false}}, {"density", "quadratic"},
                         {"emit", true}};
-  const Scene c = parse_scene(beam_scene({capsule}), {});
+  const Scene c = parse_scene(beam_scene(json::array({capsule})), {});
   ASSERT_EQ(c.lights.size(), 1u);
   const double mc = 2.0 * kPi * 3.0 * 0.25 + 2.0 * kPi * 2.0 / 15.0;
   EXPECT_NEAR(std::get<BeamEmitter>(c.lights[0].shape).volume_mass(), mc, 1e-9 * mc);
   EXPECT_NEAR(c.lights[0].flux[0], 4.0 * kPi * mc, 1e-9 * mc);
 
   // Not emitting: no light, no GI passes.
-  const Scene quiet = parse_scene(beam_scene({sphere_beam(r, "linear", intensity, false)}), {});
+  const Scene quiet = parse_scene(beam_scene(json::array({sphere_beam(r, "linear", intensity, false)})), {});
   EXPECT_TRUE(quiet.lights.empty());
   EXPECT_FALSE(quiet.has_gi());
 }
@@ -91,13 +91,13 @@ TEST(BeamLights, TheBeamLightIsNotATypeClientsWrite) {
   EXPECT_NE(bad_type.message.find("\"quad\""), std::string::npos) << bad_type.message;
   json b = sphere_beam(1.0, "linear", 1.0, true);
   b["emit"] = 1;
-  const ErrorInfo bad_emit = error_of(beam_scene({b}));
+  const ErrorInfo bad_emit = error_of(beam_scene(json::array({b})));
   EXPECT_EQ(bad_emit.path, "/beams/0/emit");
   EXPECT_FALSE(bad_emit.message.empty());
 }
 
 TEST(BeamLights, PhotonsLeaveWithTheDensityInUniformDirections) {
-  const Scene s = parse_scene(beam_scene({sphere_beam(2.0, "linear", 1.0, true)}), {});
+  const Scene s = parse_scene(beam_scene(json::array({sphere_beam(2.0, "linear", 1.0, true)})), {});
   const auto& e = std::get<BeamEmitter>(s.lights[0].shape);
   std::mt19937_64 rng(7);
   constexpr int kN = 200000;
@@ -121,7 +121,7 @@ TEST(BeamLights, PhotonsLeaveWithTheDensityInUniformDirections) {
   // and none lies outside the body.
   const json capsule = {{"type", "capsule"}, {"p0", {0, 0, 0}}, {"p1", {3, 0, 0}},
                         {"radius", 1.0},     {"density", "quadratic"}, {"emit", true}};
-  const Scene c = parse_scene(beam_scene({capsule}), {});
+  const Scene c = parse_scene(beam_scene(json::array({capsule})), {});
   const auto& ce = std::get<BeamEmitter>(c.lights[0].shape);
   const double cyl = 2.0 * kPi * 3.0 * 0.25, cap = 2.0 * kPi * 2.0 / 15.0;
   int in_cylinder = 0;
@@ -137,14 +137,14 @@ TEST(BeamLights, PhotonsLeaveWithTheDensityInUniformDirections) {
 }
 
 TEST(BeamLights, DirectPointsCarryTheWholeFlux) {
-  const Scene s = parse_scene(beam_scene({sphere_beam(2.0, "linear", 1.0, true)}), {});
+  const Scene s = parse_scene(beam_scene(json::array({sphere_beam(2.0, "linear", 1.0, true)})), {});
   const auto sp = std::get<BeamEmitter>(s.lights[0].shape).direct_points(16);
   ASSERT_EQ(sp.size(), 1u);
   EXPECT_EQ(sp[0].position, (Vec3{0.0, 1.0, 0.0}));
   EXPECT_NEAR(sp[0].scale, 1.0 / (4.0 * kPi), 1e-15);
   const json capsule = {{"type", "capsule"}, {"p0", {0, 0, 0}}, {"p1", {3, 0, 0}},
                         {"radius", 1.0},     {"density", "quadratic"}, {"emit", true}};
-  const Scene c = parse_scene(beam_scene({capsule}), {});
+  const Scene c = parse_scene(beam_scene(json::array({capsule})), {});
   const auto cp = std::get<BeamEmitter>(c.lights[0].shape).direct_points(16);
   ASSERT_EQ(cp.size(), 16u);
   double total = 0.0;
@@ -162,7 +162,7 @@ TEST(BeamLights, DirectPointsCarryTheWholeFlux) {
 // Every photon from a beam inside a closed sphere hits its wall once straight
 // from the beam: their powers sum to the beam's flux.
 TEST(BeamLights, PhotonsCarryTheBeamsFlux) {
-  json scene = {{"beams", {sphere_beam(1.5, "quadratic", 2.0, true)}},
+  json scene = {{"beams", json::array({sphere_beam(1.5, "quadratic", 2.0, true)})},
                 {"occluders", {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 6.0},
                                 {"albedo", {0.0, 0.0, 0.0}}}}},
                 {"gi", {{"photons", 20000}, {"caustic_photons", 0}}},

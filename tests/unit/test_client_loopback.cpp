@@ -246,7 +246,7 @@ TEST(ClientLoopback, AttachmentOutsideTheBinaryPartThrows) {
            {"ok", true},
            {"result",
             {{"passes", json::array()},
-             {"frames", {frame}},
+             {"frames", json::array({frame})},
              {"batched", false},
              {"batch", {{"requests", 1}, {"views", 1}}},
              {"timings", timings}}}},

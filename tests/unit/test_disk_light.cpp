@@ -31,7 +31,7 @@ json disk_scene(double h, double R, const json& normal, double rho, json light_e
   if (light_extra.is_object()) light.update(light_extra);
   return {{"occluders", {{{"type", "plane"}, {"point", {0, 0, 0}}, {"normal", {0, 1, 0}},
                           {"albedo", {rho, rho, rho}}}}},
-          {"lights", {light}},
+          {"lights", json::array({light})},
           {"cameras", {{{"position", {2, 1, 0.3}}, {"target", {0, 0, 0}}}}}};
 }
 

@@ -219,7 +219,7 @@ TEST(Lights, PhotonCountsAreLimited) {
 TEST(Lights, DirectLightSettingsAndTheShadowBudget) {
   const json quad = {{"type", "quad"}, {"corner", {0, 2, 0}}, {"edge_u", {1, 0, 0}},
                      {"edge_v", {0, 0, 1}}};
-  auto gi = [&](json g) { return lit({quad}, {{"gi", g}}); };
+  auto gi = [&](json g) { return lit(json::array({quad}), {{"gi", g}}); };
   const Scene s = parse_scene(gi({{"direct", "photons"}, {"direct_samples", 9}, {"shadow_size", 64}}),
                               {});
   EXPECT_EQ(s.gi.direct, DirectLightMethod::kPhotons);
@@ -238,13 +238,13 @@ TEST(Lights, DirectLightSettingsAndTheShadowBudget) {
   // Without a gi object the error points at the lights; with direct light
   // from photons there are no shadow maps to limit.
   limits.max_shadow_texels = 1000;
-  EXPECT_EQ(error_of(lit({quad}), limits).path, "/lights");
+  EXPECT_EQ(error_of(lit(json::array({quad})), limits).path, "/lights");
   SceneLoadOptions o;
   o.limits = limits;
   EXPECT_NO_THROW(parse_scene(gi({{"direct", "photons"}}), o));
   // Each light kind's points: a point light is one isotropic point of
   // 1 / (4 pi) per unit flux, a quad's points share its flux evenly.
-  const Scene q = parse_scene(lit({quad}), {});
+  const Scene q = parse_scene(lit(json::array({quad})), {});
   const auto points = std::get<QuadLight>(q.lights[0].shape).direct_points(16);
   ASSERT_EQ(points.size(), 16u);
   double total = 0.0;

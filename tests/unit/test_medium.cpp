@@ -213,7 +213,7 @@ TEST(Medium, BadFieldsAreRefusedWithTheirPath) {
   };
   for (const RegionCase& c : region_cases) {
     json j = fogged(json::object());
-    j["media"] = {c.region};
+    j["media"] = json::array({c.region});
     const ErrorInfo e = error_of(j);
     EXPECT_EQ(e.code, c.code) << c.region.dump() << ": " << e.message;
     EXPECT_EQ(e.path, c.path) << c.region.dump() << ": " << e.message;

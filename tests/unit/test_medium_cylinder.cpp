@@ -19,7 +19,7 @@ using nlohmann::json;
 
 json with_region(json region) {
   return {{"beams", {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1.0}}}},
-          {"media", {std::move(region)}},
+          {"media", json::array({std::move(region)})},
           {"cameras", {{{"position", {0, 0, 5}}, {"target", {0, 0, 0}}}}}};
 }
 

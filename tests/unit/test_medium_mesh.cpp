@@ -27,7 +27,7 @@ using test::mesh_region;
 
 json scene_with(json region) {
   return {{"beams", {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1.0}}}},
-          {"media", {std::move(region)}},
+          {"media", json::array({std::move(region)})},
           {"cameras", {{{"position", {0, 0, 5}}, {"target", {0, 0, 0}}}}}};
 }
 

@@ -257,7 +257,7 @@ TEST(CameraPathTest, ErrorsCarryPaths) {
     const char* path;
   };
   const Case cases[] = {
-      {{{"keyframes", {key0}}}, "/keyframes"},
+      {{{"keyframes", json::array({key0})}}, "/keyframes"},
       {{{"keyframes", {key0, {{"position", {0, 0, 5}}}}}}, "/keyframes/1/target"},
       {{{"keyframes", {key0, {{"position", {1, 0, 0}}, {"target", {1, 0, 0}}}}}},
        "/keyframes/1/target"},

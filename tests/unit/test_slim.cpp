@@ -217,7 +217,7 @@ TEST(SlimFormat, InlineSpheresParseAndArePlaced) {
 }
 
 TEST(SlimFormat, BadFieldsAreRefusedWithTheirPath) {
-  auto with = [](json sphere) { return slim_scene({{"type", "slim"}, {"spheres", {std::move(sphere)}}}); };
+  auto with = [](json sphere) { return slim_scene({{"type", "slim"}, {"spheres", json::array({std::move(sphere)})}}); };
   EXPECT_REJECTED(with(one_sphere({{"radius", -1}})), "out_of_range", "/occluders/0/spheres/0/radius");
   EXPECT_REJECTED(with(one_sphere({{"coefficients", {0, 0, 0, 0, 0, 1e13}}})), "out_of_range",
                   "/occluders/0/spheres/0/coefficients");
@@ -232,11 +232,11 @@ TEST(SlimFormat, BadFieldsAreRefusedWithTheirPath) {
   EXPECT_REJECTED(slim_scene({{"type", "slim"}, {"spheres", json::array()}}), "invalid_value",
                   "/occluders/0/spheres");
   EXPECT_REJECTED(slim_scene({{"type", "slim"}}), "missing_field", "/occluders/0/spheres");
-  EXPECT_REJECTED(slim_scene({{"type", "slim"}, {"spheres", {one_sphere()}}, {"file", "a.slim"}}),
+  EXPECT_REJECTED(slim_scene({{"type", "slim"}, {"spheres", json::array({one_sphere()})}, {"file", "a.slim"}}),
                   "invalid_value", "/occluders/0/spheres");
-  EXPECT_REJECTED(slim_scene({{"type", "slim"}, {"spheres", {one_sphere()}}, {"scale", 0}}),
+  EXPECT_REJECTED(slim_scene({{"type", "slim"}, {"spheres", json::array({one_sphere()})}, {"scale", 0}}),
                   "out_of_range", "/occluders/0/scale");
-  json settings = slim_scene({{"type", "slim"}, {"spheres", {one_sphere()}}});
+  json settings = slim_scene({{"type", "slim"}, {"spheres", json::array({one_sphere()})}});
   settings["slim"] = {{"sampling", 0.1}};
   EXPECT_REJECTED(settings, "out_of_range", "/slim/sampling");
   settings["slim"] = {{"cull_backfaces", 1}};
@@ -251,7 +251,7 @@ TEST(SlimFormat, HelloListsTheKindAndTheSettings) {
   const json caps = scene_capabilities();
   const auto& types = caps.at("occluder_types");
   EXPECT_NE(std::find(types.begin(), types.end(), "slim"), types.end());
-  json scene = slim_scene({{"type", "slim"}, {"spheres", {one_sphere()}}});
+  json scene = slim_scene({{"type", "slim"}, {"spheres", json::array({one_sphere()})}});
   scene["slim"] = json::object();
   for (const auto& field : caps.at("slim_settings")) {
     const std::string name = field.get<std::string>();
@@ -268,7 +268,7 @@ TEST(SlimFormat, HelloListsTheKindAndTheSettings) {
   EXPECT_FALSE(parsed.slim.cull_backfaces);
   EXPECT_EQ(parsed.slim.evaluation, SlimEvaluation::kBlend);
   EXPECT_EQ(
-      parse_scene(slim_scene({{"type", "slim"}, {"spheres", {one_sphere()}}}), {}).slim.evaluation,
+      parse_scene(slim_scene({{"type", "slim"}, {"spheres", json::array({one_sphere()})}}), {}).slim.evaluation,
       SlimEvaluation::kPatch);
   scene["slim"]["evaluation"] = "field";
   EXPECT_EQ(parse_scene(scene, {}).slim.evaluation, SlimEvaluation::kField);

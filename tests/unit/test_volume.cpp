@@ -332,7 +332,7 @@ TEST(VolumeSettingsJson, DefaultsAndEveryField) {
   j["volume"] = {{"integration", "point"}, {"opacity_correction", false}};
   EXPECT_EQ(parse_scene(j, {}).volume.integration, VolumeIntegration::kPoint);
   // Settings without volumes are fine (a scene that adds them later by update).
-  EXPECT_NO_THROW(parse_scene({{"volume", {{"level", 1}}}, {"cameras", {json::object()}}}, {}));
+  EXPECT_NO_THROW(parse_scene({{"volume", {{"level", 1}}}, {"cameras", json::array({json::object()})}}, {}));
 }
 
 TEST(VolumeSettingsJson, Refusals) {

@@ -12,7 +12,7 @@
 namespace beamcast::test {
 
 inline nlohmann::json volume_scene(nlohmann::json volume) {
-  return {{"volumes", {std::move(volume)}},
+  return {{"volumes", nlohmann::json::array({std::move(volume)})},
           {"cameras", {{{"position", {0, 0, 5}}, {"target", {0, 0, 0}}}}}};
 }
 
