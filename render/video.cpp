@@ -271,7 +271,7 @@ int log2_tile_columns(int threads, int width) {
 
 // libaom's speed (cpu-used) and, from speed 6 on, no re-estimation of the
 // coefficient, mode and motion-vector costs within a frame: on the bench's
-// drags at speeds 6 and 7 that is 15-40% less encode time for equal or
+// drags at speeds 6 and 7 that was 6-35% less encode time for equal or
 // fewer bytes; at speed 5 it cost the demo 3-5% more bytes, so there the
 // costs follow libaom's default (per superblock).
 void set_av1_speed(aom_codec_ctx_t* c, int speed) {
