@@ -271,9 +271,10 @@ int log2_tile_columns(int threads, int width) {
 
 // libaom's speed (cpu-used) and, from speed 6 on, no re-estimation of the
 // coefficient, mode and motion-vector costs within a frame: on the bench's
-// drags at speeds 6 and 7 that was 6-35% less encode time for equal or
-// fewer bytes; at speed 5 it cost the demo 3-5% more bytes, so there the
-// costs follow libaom's default (per superblock).
+// demo drag, together with the golden-frame boost, 7-17% less encode time
+// at speed 6 (old and new alternated; at 7 no consistent difference) and
+// fewer bytes at 7, within 3% at 6; at speed 5 it cost the demo 3-5% more
+// bytes, so there the costs follow libaom's default (per superblock).
 void set_av1_speed(aom_codec_ctx_t* c, int speed) {
   const int cost_updates = speed >= 6 ? 3 : 0;  // 3: off, 0: every superblock
   const bool ok = aom_codec_control(c, AOME_SET_CPUUSED, speed) == AOM_CODEC_OK &&

@@ -40,7 +40,7 @@ ctest --test-dir build-fuzz --output-on-failure -j"$(nproc)" -L fuzz
 
 if [ "${BEAMCAST_SKIP_ASAN:-0}" != 1 ]; then
   stage "ASan + UBSan"
-  # Compiled by clang-14 (CMakePresets.json): about 2/3 of g++'s CPU time
+  # Compiled by clang-14 (CMakePresets.json): about half of g++'s CPU time
   # for the same build (docs/performance.md, "The test command's time").
   if [ ! -f build-asan/build.ninja ]; then cmake --preset asan "${launcher[@]}" >/dev/null; fi
   cmake --build build-asan -j"$(nproc)"
