@@ -39,21 +39,36 @@ constexpr char kMagic[4] = {'B', 'C', 'V', '1'};
 
 int clamp_byte(int v) { return std::clamp(v, 0, 255); }
 
-// BT.601 limited range (studio swing), the integer form of the matrix. One
-// pass over row pairs: Y of both rows, then U and V of each 2x2 block from
-// the rounded mean of its pixels (an odd last row or column averages what
-// there is). Shift keeps the high byte of 16-bit samples. Written for speed
-// (issue 42: at 1920x1080 the per-pixel form took ~15 ms of a frame's encode);
-// the test VideoFrames.ConversionMatchesTheMatrix checks it against the
-// matrix pixel by pixel.
-template <int Shift>
+// The BT.601 matrix in integers. Limited range (studio swing): the usual
+// form with 8-bit coefficients. Full range (JPEG's YCbCr): 16-bit
+// coefficients, 0.299 / 0.587 / 0.114 for Y, and U and V clamped to 0-255
+// (pure blue or red rounds to 256).
+struct LimitedRange {
+  static unsigned char y(int r, int g, int b) { return static_cast<unsigned char>(((66 * r + 129 * g + 25 * b + 128) >> 8) + 16); }
+  static unsigned char u(int r, int g, int b) { return static_cast<unsigned char>(((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128); }
+  static unsigned char v(int r, int g, int b) { return static_cast<unsigned char>(((112 * r - 94 * g - 18 * b + 128) >> 8) + 128); }
+};
+struct FullRange {
+  static unsigned char y(int r, int g, int b) { return static_cast<unsigned char>((19595 * r + 38470 * g + 7471 * b + 32768) >> 16); }
+  static unsigned char u(int r, int g, int b) {
+    return static_cast<unsigned char>(clamp_byte(((-11059 * r - 21709 * g + 32768 * b + 32768) >> 16) + 128));
+  }
+  static unsigned char v(int r, int g, int b) {
+    return static_cast<unsigned char>(clamp_byte(((32768 * r - 27439 * g - 5329 * b + 32768) >> 16) + 128));
+  }
+};
+
+// One pass over row pairs: Y of both rows, then U and V of each 2x2 block
+// from the rounded mean of its pixels (an odd last row or column averages
+// what there is). Shift keeps the high byte of 16-bit samples. Written for
+// speed (issue 42: at 1920x1080 the per-pixel form took ~15 ms of a frame's
+// encode); the test VideoFrames.ConversionMatchesTheMatrix checks it against
+// the matrix pixel by pixel.
+template <int Shift, class Range>
 void rgb_to_i420_rows(const Image& src, const I420Planes& dst) {
   const int w = src.width, h = src.height;
   const int ys = dst.y_stride, us = dst.u_stride, vs = dst.v_stride;
-  auto luma = [](const std::uint16_t* p) {
-    const int r = p[0] >> Shift, g = p[1] >> Shift, b = p[2] >> Shift;
-    return static_cast<unsigned char>(((66 * r + 129 * g + 25 * b + 128) >> 8) + 16);
-  };
+  auto luma = [](const std::uint16_t* p) { return Range::y(p[0] >> Shift, p[1] >> Shift, p[2] >> Shift); };
   for (int y0 = 0; y0 < h; y0 += 2) {
     const bool two_rows = y0 + 1 < h;
     const std::uint16_t* r0 = src.rgb.data() + 3 * static_cast<std::size_t>(y0) * w;
@@ -97,8 +112,8 @@ void rgb_to_i420_rows(const Image& src, const I420Planes& dst) {
         g = (g + n / 2) / n;
         b = (b + n / 2) / n;
       }
-      u[cx] = static_cast<unsigned char>(((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128);
-      v[cx] = static_cast<unsigned char>(((112 * r - 94 * g - 18 * b + 128) >> 8) + 128);
+      u[cx] = Range::u(r, g, b);
+      v[cx] = Range::v(r, g, b);
     }
   }
 }
@@ -108,16 +123,19 @@ struct I420View {
   const unsigned char* planes[3];
   int stride[3];
   int w, h;
+  ColorRange range = ColorRange::kLimited;
 };
 
 // vpx_image_t and aom_image_t name their planes (Y, U, V: 0, 1, 2),
-// strides and size alike.
+// strides, size and range alike (full range is 1 in both).
 template <class CodecImage>
 I420View i420_view(const CodecImage& img) {
+  static_assert(static_cast<int>(AOM_CR_FULL_RANGE) == 1 && static_cast<int>(VPX_CR_FULL_RANGE) == 1);
   return {{img.planes[0], img.planes[1], img.planes[2]},
           {img.stride[0], img.stride[1], img.stride[2]},
           static_cast<int>(img.d_w),
-          static_cast<int>(img.d_h)};
+          static_cast<int>(img.d_h),
+          static_cast<int>(img.range) == 1 ? ColorRange::kFull : ColorRange::kLimited};
 }
 
 template <class CodecImage>
@@ -166,6 +184,9 @@ void append_frame_packets(Ctx* ctx, EncodedVideoFrame* out) {
 
 // The inverse, chroma upsampled bilinearly between sample centres (what a
 // browser's video path does; nearest would add blockiness the stream lacks).
+// Limited range in integers (what the VP8/VP9 rows of docs/performance.md
+// were measured with); full range in floating point with one rounding at the
+// end, as a browser's GPU converts.
 Image i420_to_rgb(const I420View& src) {
   const int w = src.w, h = src.h;
   const int cw = (w + 1) / 2, ch = (h + 1) / 2;
@@ -187,8 +208,18 @@ Image i420_to_rgb(const I420View& src) {
   };
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const int c = src.planes[0][static_cast<std::size_t>(y) * src.stride[0] + x] - 16;
       const double fx = (x - 0.5) / 2.0, fy = (y - 0.5) / 2.0;
+      if (src.range == ColorRange::kFull) {
+        const double l = src.planes[0][static_cast<std::size_t>(y) * src.stride[0] + x];
+        const double cb = chroma(1, fx, fy) - 128.0, cr = chroma(2, fx, fy) - 128.0;
+        std::uint16_t* o = &out.rgb[3 * (static_cast<std::size_t>(y) * w + x)];
+        o[0] = static_cast<std::uint16_t>(clamp_byte(static_cast<int>(std::lround(l + 1.402 * cr))));
+        o[1] = static_cast<std::uint16_t>(
+            clamp_byte(static_cast<int>(std::lround(l - 0.344136 * cb - 0.714136 * cr))));
+        o[2] = static_cast<std::uint16_t>(clamp_byte(static_cast<int>(std::lround(l + 1.772 * cb))));
+        continue;
+      }
+      const int c = src.planes[0][static_cast<std::size_t>(y) * src.stride[0] + x] - 16;
       const int d = static_cast<int>(std::lround(chroma(1, fx, fy))) - 128;
       const int e = static_cast<int>(std::lround(chroma(2, fx, fy))) - 128;
       std::uint16_t* o = &out.rgb[3 * (static_cast<std::size_t>(y) * w + x)];
@@ -202,11 +233,12 @@ Image i420_to_rgb(const I420View& src) {
 
 }  // namespace
 
-void rgb_to_i420(const Image& src, const I420Planes& dst) {
-  if (src.bit_depth == 16) {
-    rgb_to_i420_rows<8>(src, dst);
+void rgb_to_i420(const Image& src, const I420Planes& dst, ColorRange range) {
+  const bool wide = src.bit_depth == 16;
+  if (range == ColorRange::kFull) {
+    wide ? rgb_to_i420_rows<8, FullRange>(src, dst) : rgb_to_i420_rows<0, FullRange>(src, dst);
   } else {
-    rgb_to_i420_rows<0>(src, dst);
+    wide ? rgb_to_i420_rows<8, LimitedRange>(src, dst) : rgb_to_i420_rows<0, LimitedRange>(src, dst);
   }
 }
 
@@ -248,6 +280,7 @@ struct VideoEncoder::Impl {
   aom_codec_enc_cfg_t acfg{};
   aom_image_t* aimg = nullptr;
   bool open = false, aopen = false;
+  bool widen_quantizer = false;  // AV1: the starting cap on the quantizer is still on
   void open_av1(const VideoEncoderSettings& settings, int speed);
   ~Impl() {
     if (img) vpx_img_free(img);
@@ -286,6 +319,19 @@ void set_av1_speed(aom_codec_ctx_t* c, int speed) {
 
 }  // namespace
 
+// AV1's quantizer range (0-63): libaom's CBR rate control starts its
+// average quantizer at the worst one allowed (av1_primary_rc_init), so a
+// stream that allowed 56 from the start spent its first second climbing
+// down from ~40 at most 1/8 a frame, at a fraction of its bitrate (the demo
+// drag at 1 000 kbit/s: 600-900 bytes a frame for 10 frames after the key
+// frame, 4 000 once settled). Opening the encoder with 24 as the worst and
+// widening to 56 after the first frame starts that average at 24; from there
+// it rises as fast as a scene needs (20 quantizer-index steps a frame).
+// Starting at 8, 16 or 24 gave the same bytes at equal PSNR on the demo drag
+// (docs/performance.md, "The rate control's start").
+constexpr unsigned kAv1StartMaxQuantizer = 24;
+constexpr unsigned kAv1MaxQuantizer = 56;
+
 // AV1 (libaom, realtime usage): one pass, no lag, CBR, no dropped frames,
 // key frames at the start and on request only. Unlike the libvpx streams the
 // key frame is not capped and the rate control's buffer is libaom's default
@@ -306,6 +352,8 @@ void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int spee
   }
   const int threads = std::max(1, settings.threads);
   set_common_config(cfg, settings, 4000, 5000, 6000);
+  cfg.rc_max_quantizer = kAv1StartMaxQuantizer;
+  impl.widen_quantizer = true;
   cfg.g_pass = AOM_RC_ONE_PASS;
   cfg.rc_end_usage = AOM_CBR;
   cfg.kf_mode = AOM_KF_DISABLED;
@@ -322,11 +370,22 @@ void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int spee
                   aom_codec_control(c, AV1E_SET_ENABLE_WARPED_MOTION, 0) == AOM_CODEC_OK &&
                   aom_codec_control(c, AV1E_SET_ENABLE_OBMC, 0) == AOM_CODEC_OK &&
                   aom_codec_control(c, AV1E_SET_ENABLE_ORDER_HINT, 0) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_GF_CBR_BOOST_PCT, 100) == AOM_CODEC_OK;
+                  aom_codec_control(c, AV1E_SET_GF_CBR_BOOST_PCT, 100) == AOM_CODEC_OK &&
+                  // Full-range BT.601 YUV of sRGB pixels, said in the sequence
+                  // header: WebCodecs hands the browser a VideoFrame with this
+                  // colour space and the canvas converts back with it.
+                  aom_codec_control(c, AV1E_SET_COLOR_RANGE, AOM_CR_FULL_RANGE) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_MATRIX_COEFFICIENTS, AOM_CICP_MC_BT_601) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_COLOR_PRIMARIES, AOM_CICP_CP_BT_709) == AOM_CODEC_OK &&
+                  aom_codec_control(c, AV1E_SET_TRANSFER_CHARACTERISTICS, AOM_CICP_TC_SRGB) == AOM_CODEC_OK;
   if (!ok) aom_fail(c, "codec_control");
   set_av1_speed(c, speed);
   impl.aimg = aom_img_alloc(nullptr, AOM_IMG_FMT_I420, cfg.g_w, cfg.g_h, 16);
   if (!impl.aimg) throw std::runtime_error("libaom: aom_img_alloc failed");
+  impl.aimg->range = AOM_CR_FULL_RANGE;
+  impl.aimg->mc = AOM_CICP_MC_BT_601;
+  impl.aimg->cp = AOM_CICP_CP_BT_709;
+  impl.aimg->tc = AOM_CICP_TC_SRGB;
 }
 
 VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
@@ -420,7 +479,11 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
                  "VideoEncoder::encode: frame size differs from the encoder's");
   const auto t0 = std::chrono::steady_clock::now();
   const bool av1 = settings_.codec == VideoCodec::kAv1;
-  rgb_to_i420(img, av1 ? i420_planes(*impl_->aimg) : i420_planes(*impl_->img));
+  if (av1) {
+    rgb_to_i420(img, i420_planes(*impl_->aimg), ColorRange::kFull);
+  } else {
+    rgb_to_i420(img, i420_planes(*impl_->img), ColorRange::kLimited);
+  }
   // The frame lasts until the next one; the first gets a 30 frames/s share.
   const double gap = frames_ == 0 ? 33.0 : time_ms - last_ms_;
   const auto duration = static_cast<unsigned long>(std::clamp(std::lround(gap), 1L, 1000L));
@@ -433,6 +496,16 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
       aom_fail(&impl_->actx, "encode");
     }
     append_frame_packets<aom_codec_get_cx_data, AOM_CODEC_CX_FRAME_PKT, AOM_FRAME_IS_KEY>(&impl_->actx, &out);
+    if (aom_codec_control(&impl_->actx, AOME_GET_LAST_QUANTIZER_64, &out.quantizer) != AOM_CODEC_OK) {
+      aom_fail(&impl_->actx, "codec_control (last quantizer)");
+    }
+    if (impl_->widen_quantizer) {
+      impl_->widen_quantizer = false;
+      impl_->acfg.rc_max_quantizer = kAv1MaxQuantizer;
+      if (aom_codec_enc_config_set(&impl_->actx, &impl_->acfg) != AOM_CODEC_OK) {
+        aom_fail(&impl_->actx, "enc_config_set (quantizer range)");
+      }
+    }
   } else {
     if (vpx_codec_encode(&impl_->ctx, impl_->img, pts_ms_, duration, key ? VPX_EFLAG_FORCE_KF : 0,
                          VPX_DL_REALTIME) != VPX_CODEC_OK) {

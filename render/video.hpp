@@ -53,15 +53,24 @@ struct VideoEncoderSettings {
 int video_encoder_speed(VideoCodec codec, int width, int height);
 
 // The encoder's colour conversion: RGB (8-bit, or 16-bit whose high byte is
-// kept) to I420, BT.601 limited range; U and V are (w+1)/2 x (h+1)/2, each
+// kept) to I420 with the BT.601 matrix; U and V are (w+1)/2 x (h+1)/2, each
 // from the rounded mean of its 2x2 block (fewer at an odd edge).
+// - Limited range (studio swing: Y 16-235, U and V 16-240), the integer form
+//   with 8-bit coefficients: VP8 and VP9, whose streams carry no range.
+// - Full range (Y, U and V 0-255, as JPEG's YCbCr), 16-bit coefficients:
+//   AV1, whose sequence header says so (and the matrix, the primaries and the
+//   sRGB transfer), so that the browser converts back with the same matrix.
+//   Its steps are finer: on the volume's drag a frame through RGB -> I420 ->
+//   RGB alone is 48.6 dB from full accuracy against 47.3 for limited range
+//   (the frame itself 49.7; docs/performance.md, "The colour range").
+enum class ColorRange { kLimited, kFull };
 struct I420Planes {
   std::uint8_t* y;
   std::uint8_t* u;
   std::uint8_t* v;
   int y_stride, u_stride, v_stride;
 };
-void rgb_to_i420(const Image& src, const I420Planes& dst);
+void rgb_to_i420(const Image& src, const I420Planes& dst, ColorRange range = ColorRange::kLimited);
 
 // libvpx threads for one stream of width x height on `cores` cores: one per
 // started 2^19 pixels (a 512x512 frame: 1; 1280x720: 2; 1920x1080: 4), at
@@ -75,6 +84,8 @@ struct EncodedVideoFrame {
   bool key = false;
   std::int64_t pts = 0;
   int speed = 0;         // the encoder's speed for this frame
+  int quantizer = -1;    // AV1: the frame's base quantizer, 0-63 (the scale of
+                         // rc_max_quantizer); -1 for VP8/VP9
   double encode_ms = 0;  // wall clock, conversion included
 };
 

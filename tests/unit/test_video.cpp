@@ -7,6 +7,10 @@
 #include <vector>
 #include <stdexcept>
 
+#include <aom/aom_decoder.h>
+#include <aom/aom_image.h>
+#include <aom/aomdx.h>
+
 #include "render/video.hpp"
 
 namespace beamcast {
@@ -148,6 +152,139 @@ TEST(VideoFrames, ConversionMatchesTheMatrix) {
       }
     }
   }
+}
+
+// The full-range conversion (AV1's) against the BT.601 matrix in floating
+// point, JPEG's YCbCr: every Y, U and V sample is the matrix's value rounded
+// (within 0.51: the 16-bit coefficients move a value by at most 0.002, which
+// can tip a rounding at .5), chroma from the rounded mean of each 2x2 block;
+// U and V clamped to 0-255. Saturated primaries, black, white and noise, odd
+// and even sizes, 8- and 16-bit samples.
+TEST(VideoFrames, FullRangeConversionMatchesTheMatrix) {
+  for (const int w : {1, 3, 16}) {
+    for (const int h : {1, 4, 7}) {
+      for (const int depth : {8, 16}) {
+        Image img;
+        img.width = w;
+        img.height = h;
+        img.bit_depth = depth;
+        img.rgb.resize(3 * static_cast<std::size_t>(w) * h);
+        std::uint32_t state = 777u + static_cast<std::uint32_t>(w * 31 + h * 3 + depth);
+        const int extremes[][3] = {{0, 0, 0}, {255, 255, 255}, {255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 0}};
+        for (std::size_t i = 0; i < img.rgb.size() / 3; ++i) {
+          for (int c = 0; c < 3; ++c) {
+            state = state * 1664525u + 1013904223u;
+            int v8 = static_cast<int>(state >> 24);
+            if (i < 6) v8 = extremes[i][c];
+            img.rgb[3 * i + c] = static_cast<std::uint16_t>(depth == 16 ? v8 * 257 : v8);
+          }
+        }
+        const int cw = (w + 1) / 2, ch = (h + 1) / 2;
+        std::vector<std::uint8_t> y(static_cast<std::size_t>(w) * h), u(static_cast<std::size_t>(cw) * ch),
+            v(static_cast<std::size_t>(cw) * ch);
+        rgb_to_i420(img, {y.data(), u.data(), v.data(), w, cw, cw}, ColorRange::kFull);
+        auto sample = [&](int x, int yy, int c) {
+          return img.rgb[3 * (static_cast<std::size_t>(yy) * w + x) + c] >> (depth == 16 ? 8 : 0);
+        };
+        for (int yy = 0; yy < h; ++yy) {
+          for (int x = 0; x < w; ++x) {
+            const double want = 0.299 * sample(x, yy, 0) + 0.587 * sample(x, yy, 1) + 0.114 * sample(x, yy, 2);
+            ASSERT_NEAR(y[static_cast<std::size_t>(yy) * w + x], want, 0.51)
+                << w << "x" << h << " depth " << depth << " Y at " << x << "," << yy;
+          }
+        }
+        for (int cy = 0; cy < ch; ++cy) {
+          for (int cx = 0; cx < cw; ++cx) {
+            int r = 0, g = 0, b = 0, n = 0;
+            for (int yy = 2 * cy; yy < std::min(h, 2 * cy + 2); ++yy) {
+              for (int x = 2 * cx; x < std::min(w, 2 * cx + 2); ++x) {
+                r += sample(x, yy, 0);
+                g += sample(x, yy, 1);
+                b += sample(x, yy, 2);
+                ++n;
+              }
+            }
+            r = (r + n / 2) / n;
+            g = (g + n / 2) / n;
+            b = (b + n / 2) / n;
+            const double cb = std::clamp(128.0 - 0.168736 * r - 0.331264 * g + 0.5 * b, 0.0, 255.0);
+            const double cr = std::clamp(128.0 + 0.5 * r - 0.418688 * g - 0.081312 * b, 0.0, 255.0);
+            ASSERT_NEAR(u[static_cast<std::size_t>(cy) * cw + cx], cb, 0.51)
+                << w << "x" << h << " depth " << depth << " U at " << cx << "," << cy;
+            ASSERT_NEAR(v[static_cast<std::size_t>(cy) * cw + cx], cr, 0.51)
+                << w << "x" << h << " depth " << depth << " V at " << cx << "," << cy;
+          }
+        }
+      }
+    }
+  }
+}
+
+// An AV1 stream says what its samples are: full range, the BT.601 matrix,
+// BT.709 (sRGB) primaries and the sRGB transfer, so that a browser's
+// VideoFrame converts back with the matrix the encoder used. The decoder
+// turns full-range pictures back to RGB close to the source (near-lossless
+// bitrate: within 1.5 levels RMS on black, white and grey; a range read
+// as limited would stretch black to -19 and white to 278).
+TEST(VideoFrames, Av1StreamIsFullRangeBt601AndSaysSo) {
+  VideoEncoder enc({VideoCodec::kAv1, 64, 48, 8000, 1});
+  const EncodedVideoFrame f = enc.encode(moving_picture(64, 48, 0), 0.0);
+  aom_codec_ctx_t ctx{};
+  aom_codec_dec_cfg_t cfg{};
+  cfg.threads = 1;
+  ASSERT_EQ(aom_codec_dec_init(&ctx, aom_codec_av1_dx(), &cfg, 0), AOM_CODEC_OK);
+  ASSERT_EQ(aom_codec_decode(&ctx, f.data.data(), f.data.size(), nullptr), AOM_CODEC_OK);
+  aom_codec_iter_t iter = nullptr;
+  const aom_image_t* img = aom_codec_get_frame(&ctx, &iter);
+  ASSERT_NE(img, nullptr);
+  EXPECT_EQ(img->range, AOM_CR_FULL_RANGE);
+  EXPECT_EQ(img->mc, AOM_CICP_MC_BT_601);
+  EXPECT_EQ(img->cp, AOM_CICP_CP_BT_709);
+  EXPECT_EQ(img->tc, AOM_CICP_TC_SRGB);
+  aom_codec_destroy(&ctx);
+
+  for (const int level : {0, 128, 255}) {
+    VideoEncoder flat_enc({VideoCodec::kAv1, 64, 48, 8000, 1});
+    VideoDecoder dec(VideoCodec::kAv1);
+    Image flat;
+    flat.width = 64;
+    flat.height = 48;
+    flat.bit_depth = 8;
+    flat.rgb.assign(3 * 64 * 48, static_cast<std::uint16_t>(level));
+    const Image out = dec.decode(flat_enc.encode(flat, 0.0).data);
+    double sq = 0.0;
+    for (std::size_t i = 0; i < out.rgb.size(); ++i) sq += std::pow(out.rgb[i] - level, 2);
+    EXPECT_LT(std::sqrt(sq / static_cast<double>(out.rgb.size())), 1.5) << "grey level " << level;
+  }
+}
+
+// AV1's rate control starts near the quantizer its bitrate affords: with a
+// bitrate that lets the key frame take the finest quantizer, the delta
+// frames after it stay at or under 24 (the starting cap, widened to 56 after
+// the first frame) instead of jumping to the worst allowed and climbing down
+// 1/8 a frame (with 56 from the start: 30-40 here). A low bitrate still gets
+// coarse quantizers (the cap does not hold it to 24), and the cap is gone
+// after the first frame.
+TEST(VideoFrames, Av1RateControlStartsAtAQuantizerItsBitrateAffords) {
+  VideoEncoder rich({VideoCodec::kAv1, 128, 96, 3000, 1, 5});
+  std::vector<int> q;
+  for (int t = 0; t < 8; ++t) q.push_back(rich.encode(moving_picture(128, 96, t), 33.0 * t).quantizer);
+  for (int t = 1; t < 8; ++t) EXPECT_LE(q[static_cast<std::size_t>(t)], 24) << "frame " << t;
+  // Noise over the picture, new every frame: what no bitrate of 20 kbit/s
+  // codes finely.
+  VideoEncoder poor({VideoCodec::kAv1, 128, 96, 20, 1, 5});
+  std::uint32_t state = 99u;
+  int last = -1;
+  for (int t = 0; t < 20; ++t) {
+    Image img = moving_picture(128, 96, t);
+    for (auto& s : img.rgb) {
+      state = state * 1664525u + 1013904223u;
+      s = static_cast<std::uint16_t>(std::clamp(static_cast<int>(s) + static_cast<int>(state >> 27) - 16, 0, 255));
+    }
+    last = poor.encode(img, 33.0 * t).quantizer;
+  }
+  EXPECT_GT(last, 24);
+  EXPECT_LE(last, 56);
 }
 
 // One encoder thread per started 2^19 pixels, at most 4 and at most the
