@@ -68,7 +68,10 @@ const preview = {
     errors: [],      // decoder errors (messages)
     recoveries: 0,   // key frames decoded after a decoder error
     decode_ms: [],   // decode() to the picture, per frame (the latest 200)
+    colorSpace: null,    // the latest picture's VideoColorSpace, as the browser read it from the stream
+    lastShown: null,     // {seq, camera} of the latest video response shown
     corruptNext: false,  // test hook: the next delta frame is fed as garbage
+    keepLast: false,     // test hook: keep the latest picture for lastVideoPicture()
   },
 };
 window.beamcastPreview = preview;
@@ -452,11 +455,18 @@ function feedVideo(f, bytes, seq) {
   }
 }
 
+let lastFrame = null;  // with video.keepLast: {seq, frame} (a clone, closed when replaced)
+
 function onVideoFrame(frame) {
   const v = preview.video;
   const seq = frame.timestamp;
   // A PNG or JPEG that arrived later is already on the canvas.
   if (seq > lastImageSeq) ctx2d.drawImage(frame, 0, 0, canvas.width, canvas.height);
+  v.colorSpace = frame.colorSpace ? frame.colorSpace.toJSON() : null;
+  if (v.keepLast) {
+    if (lastFrame) lastFrame.frame.close();
+    lastFrame = {seq, frame: frame.clone()};
+  }
   frame.close();
   ++v.decoded;
   const started = decodeStarted.get(seq);
@@ -468,11 +478,23 @@ function onVideoFrame(frame) {
   }
 }
 
+// Test hook (video.keepLast): the latest decoded picture as the canvas
+// draws it, {seq, width, height, rgba: [...]}, or null.
+preview.lastVideoPicture = () => {
+  if (!lastFrame) return null;
+  const c = new OffscreenCanvas(canvas.width, canvas.height);
+  const g = c.getContext('2d');
+  g.drawImage(lastFrame.frame, 0, 0, c.width, c.height);
+  return {seq: lastFrame.seq, width: c.width, height: c.height,
+          rgba: Array.from(g.getImageData(0, 0, c.width, c.height).data)};
+};
+
 async function show(res, camera, socket) {
   const {msg, bytes, sent, received, seq} = res;
   const r = msg.result;
   const f = r.frames[0];
   const data = bytes.subarray(f.attachment.offset, f.attachment.offset + f.attachment.length);
+  if (isVideoFormat(f.format)) preview.video.lastShown = {seq, camera};
   if (!isVideoFormat(f.format)) {
     // Video frames went to the decoder as they came (feedVideo).
     const type = f.format === 'jpeg' ? 'image/jpeg' : 'image/png';
