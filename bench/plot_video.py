@@ -48,7 +48,8 @@ def main():
     for ax in axes[0][len(keys):]:
         ax.set_visible(False)
     styles = {"jpeg": ("C0", "o", "JPEG (q50-92)"), "vp8": ("C1", "s", "VP8"),
-              "vp9": ("C2", "^", "VP9"), "av1": ("C3", "D", "AV1")}
+              "vp9": ("C2", "^", "VP9"), "av1": ("C3", "D", "AV1"),
+              "av1-before": ("0.6", "d", "AV1, stop 52's encoder")}
     for ax, key in zip(axes[0], keys):
         for i, (path, pts) in enumerate(sorted(panels[key].items())):
             pts.sort()

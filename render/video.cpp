@@ -44,17 +44,27 @@ int clamp_byte(int v) { return std::clamp(v, 0, 255); }
 // coefficients, 0.299 / 0.587 / 0.114 for Y, and U and V clamped to 0-255
 // (pure blue or red rounds to 256).
 struct LimitedRange {
-  static unsigned char y(int r, int g, int b) { return static_cast<unsigned char>(((66 * r + 129 * g + 25 * b + 128) >> 8) + 16); }
-  static unsigned char u(int r, int g, int b) { return static_cast<unsigned char>(((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128); }
-  static unsigned char v(int r, int g, int b) { return static_cast<unsigned char>(((112 * r - 94 * g - 18 * b + 128) >> 8) + 128); }
-};
-struct FullRange {
-  static unsigned char y(int r, int g, int b) { return static_cast<unsigned char>((19595 * r + 38470 * g + 7471 * b + 32768) >> 16); }
+  static unsigned char y(int r, int g, int b) {
+    return static_cast<unsigned char>(((66 * r + 129 * g + 25 * b + 128) >> 8) + 16);
+  }
   static unsigned char u(int r, int g, int b) {
-    return static_cast<unsigned char>(clamp_byte(((-11059 * r - 21709 * g + 32768 * b + 32768) >> 16) + 128));
+    return static_cast<unsigned char>(((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128);
   }
   static unsigned char v(int r, int g, int b) {
-    return static_cast<unsigned char>(clamp_byte(((32768 * r - 27439 * g - 5329 * b + 32768) >> 16) + 128));
+    return static_cast<unsigned char>(((112 * r - 94 * g - 18 * b + 128) >> 8) + 128);
+  }
+};
+struct FullRange {
+  static unsigned char y(int r, int g, int b) {
+    return static_cast<unsigned char>((19595 * r + 38470 * g + 7471 * b + 32768) >> 16);
+  }
+  static unsigned char u(int r, int g, int b) {
+    return static_cast<unsigned char>(
+        clamp_byte(((-11059 * r - 21709 * g + 32768 * b + 32768) >> 16) + 128));
+  }
+  static unsigned char v(int r, int g, int b) {
+    return static_cast<unsigned char>(
+        clamp_byte(((32768 * r - 27439 * g - 5329 * b + 32768) >> 16) + 128));
   }
 };
 
@@ -62,8 +72,9 @@ struct FullRange {
 // from the rounded mean of its pixels (an odd last row or column averages
 // what there is). Shift keeps the high byte of 16-bit samples. Written for
 // speed (issue 42: at 1920x1080 the per-pixel form took ~15 ms of a frame's
-// encode); the test VideoFrames.ConversionMatchesTheMatrix checks it against
-// the matrix pixel by pixel.
+// encode); the tests VideoFrames.ConversionMatchesTheMatrix and
+// FullRangeConversionMatchesTheMatrix check it against the matrix pixel by
+// pixel.
 template <int Shift, class Range>
 void rgb_to_i420_rows(const Image& src, const I420Planes& dst) {
   const int w = src.width, h = src.height;
@@ -202,7 +213,9 @@ Image i420_to_rgb(const I420View& src) {
     const double ax = std::clamp(fx - x0, 0.0, 1.0), ay = std::clamp(fy - y0, 0.0, 1.0);
     const unsigned char* p = src.planes[plane];
     const int s = src.stride[plane];
-    auto at = [&](int x, int y) { return static_cast<double>(p[static_cast<std::size_t>(y) * s + x]); };
+    auto at = [&](int x, int y) {
+      return static_cast<double>(p[static_cast<std::size_t>(y) * s + x]);
+    };
     return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x1, y0)) +
            ay * ((1 - ax) * at(x0, y1) + ax * at(x1, y1));
   };
@@ -213,10 +226,12 @@ Image i420_to_rgb(const I420View& src) {
         const double l = src.planes[0][static_cast<std::size_t>(y) * src.stride[0] + x];
         const double cb = chroma(1, fx, fy) - 128.0, cr = chroma(2, fx, fy) - 128.0;
         std::uint16_t* o = &out.rgb[3 * (static_cast<std::size_t>(y) * w + x)];
-        o[0] = static_cast<std::uint16_t>(clamp_byte(static_cast<int>(std::lround(l + 1.402 * cr))));
+        o[0] =
+            static_cast<std::uint16_t>(clamp_byte(static_cast<int>(std::lround(l + 1.402 * cr))));
         o[1] = static_cast<std::uint16_t>(
             clamp_byte(static_cast<int>(std::lround(l - 0.344136 * cb - 0.714136 * cr))));
-        o[2] = static_cast<std::uint16_t>(clamp_byte(static_cast<int>(std::lround(l + 1.772 * cb))));
+        o[2] =
+            static_cast<std::uint16_t>(clamp_byte(static_cast<int>(std::lround(l + 1.772 * cb))));
         continue;
       }
       const int c = src.planes[0][static_cast<std::size_t>(y) * src.stride[0] + x] - 16;
@@ -328,7 +343,7 @@ void set_av1_speed(aom_codec_ctx_t* c, int speed) {
 // widening to 56 after the first frame starts that average at 24; from there
 // it rises as fast as a scene needs (20 quantizer-index steps a frame).
 // Starting at 8, 16 or 24 gave the same bytes at equal PSNR on the demo drag
-// (docs/performance.md, "The rate control's start").
+// (docs/performance.md, "The rate control's start and the colour range").
 constexpr unsigned kAv1StartMaxQuantizer = 24;
 constexpr unsigned kAv1MaxQuantizer = 56;
 
@@ -360,24 +375,25 @@ void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int spee
   if (aom_codec_enc_init(&impl.actx, iface, &cfg, 0) != AOM_CODEC_OK) aom_fail(&impl.actx, "enc_init");
   impl.aopen = true;
   aom_codec_ctx_t* c = &impl.actx;
-  const bool ok = aom_codec_control(c, AV1E_SET_ROW_MT, 1) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_TILE_COLUMNS, log2_tile_columns(threads, settings.width)) ==
-                      AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_AQ_MODE, 0) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AOME_SET_MAX_INTRA_BITRATE_PCT, 0) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_ENABLE_TPL_MODEL, 0) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_ENABLE_GLOBAL_MOTION, 0) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_ENABLE_WARPED_MOTION, 0) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_ENABLE_OBMC, 0) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_ENABLE_ORDER_HINT, 0) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_GF_CBR_BOOST_PCT, 100) == AOM_CODEC_OK &&
-                  // Full-range BT.601 YUV of sRGB pixels, said in the sequence
-                  // header: WebCodecs hands the browser a VideoFrame with this
-                  // colour space and the canvas converts back with it.
-                  aom_codec_control(c, AV1E_SET_COLOR_RANGE, AOM_CR_FULL_RANGE) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_MATRIX_COEFFICIENTS, AOM_CICP_MC_BT_601) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_COLOR_PRIMARIES, AOM_CICP_CP_BT_709) == AOM_CODEC_OK &&
-                  aom_codec_control(c, AV1E_SET_TRANSFER_CHARACTERISTICS, AOM_CICP_TC_SRGB) == AOM_CODEC_OK;
+  const bool ok =
+      aom_codec_control(c, AV1E_SET_ROW_MT, 1) == AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_TILE_COLUMNS, log2_tile_columns(threads, settings.width)) ==
+          AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_AQ_MODE, 0) == AOM_CODEC_OK &&
+      aom_codec_control(c, AOME_SET_MAX_INTRA_BITRATE_PCT, 0) == AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_ENABLE_TPL_MODEL, 0) == AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_ENABLE_GLOBAL_MOTION, 0) == AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_ENABLE_WARPED_MOTION, 0) == AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_ENABLE_OBMC, 0) == AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_ENABLE_ORDER_HINT, 0) == AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_GF_CBR_BOOST_PCT, 100) == AOM_CODEC_OK &&
+      // Full-range BT.601 YUV of sRGB pixels, said in the sequence
+      // header: WebCodecs hands the browser a VideoFrame with this
+      // colour space and the canvas converts back with it.
+      aom_codec_control(c, AV1E_SET_COLOR_RANGE, AOM_CR_FULL_RANGE) == AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_MATRIX_COEFFICIENTS, AOM_CICP_MC_BT_601) == AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_COLOR_PRIMARIES, AOM_CICP_CP_BT_709) == AOM_CODEC_OK &&
+      aom_codec_control(c, AV1E_SET_TRANSFER_CHARACTERISTICS, AOM_CICP_TC_SRGB) == AOM_CODEC_OK;
   if (!ok) aom_fail(c, "codec_control");
   set_av1_speed(c, speed);
   impl.aimg = aom_img_alloc(nullptr, AOM_IMG_FMT_I420, cfg.g_w, cfg.g_h, 16);
@@ -491,12 +507,14 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
   const bool key = force_key || frames_ == 0;
   EncodedVideoFrame out;
   if (av1) {
-    if (aom_codec_encode(&impl_->actx, impl_->aimg, pts_ms_, duration, key ? AOM_EFLAG_FORCE_KF : 0) !=
-        AOM_CODEC_OK) {
+    if (aom_codec_encode(&impl_->actx, impl_->aimg, pts_ms_, duration,
+                         key ? AOM_EFLAG_FORCE_KF : 0) != AOM_CODEC_OK) {
       aom_fail(&impl_->actx, "encode");
     }
-    append_frame_packets<aom_codec_get_cx_data, AOM_CODEC_CX_FRAME_PKT, AOM_FRAME_IS_KEY>(&impl_->actx, &out);
-    if (aom_codec_control(&impl_->actx, AOME_GET_LAST_QUANTIZER_64, &out.quantizer) != AOM_CODEC_OK) {
+    append_frame_packets<aom_codec_get_cx_data, AOM_CODEC_CX_FRAME_PKT, AOM_FRAME_IS_KEY>(
+        &impl_->actx, &out);
+    if (aom_codec_control(&impl_->actx, AOME_GET_LAST_QUANTIZER_64, &out.quantizer) !=
+        AOM_CODEC_OK) {
       aom_fail(&impl_->actx, "codec_control (last quantizer)");
     }
     if (impl_->widen_quantizer) {

@@ -62,7 +62,8 @@ int video_encoder_speed(VideoCodec codec, int width, int height);
 //   sRGB transfer), so that the browser converts back with the same matrix.
 //   Its steps are finer: on the volume's drag a frame through RGB -> I420 ->
 //   RGB alone is 48.6 dB from full accuracy against 47.3 for limited range
-//   (the frame itself 49.7; docs/performance.md, "The colour range").
+//   (the frame itself 49.7; docs/performance.md, "The rate control's start
+//   and the colour range").
 enum class ColorRange { kLimited, kFull };
 struct I420Planes {
   std::uint8_t* y;

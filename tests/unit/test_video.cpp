@@ -170,7 +170,8 @@ TEST(VideoFrames, FullRangeConversionMatchesTheMatrix) {
         img.bit_depth = depth;
         img.rgb.resize(3 * static_cast<std::size_t>(w) * h);
         std::uint32_t state = 777u + static_cast<std::uint32_t>(w * 31 + h * 3 + depth);
-        const int extremes[][3] = {{0, 0, 0}, {255, 255, 255}, {255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 0}};
+        const int extremes[][3] = {{0, 0, 0},   {255, 255, 255}, {255, 0, 0},
+                                   {0, 255, 0}, {0, 0, 255},     {255, 255, 0}};
         for (std::size_t i = 0; i < img.rgb.size() / 3; ++i) {
           for (int c = 0; c < 3; ++c) {
             state = state * 1664525u + 1013904223u;
@@ -180,15 +181,16 @@ TEST(VideoFrames, FullRangeConversionMatchesTheMatrix) {
           }
         }
         const int cw = (w + 1) / 2, ch = (h + 1) / 2;
-        std::vector<std::uint8_t> y(static_cast<std::size_t>(w) * h), u(static_cast<std::size_t>(cw) * ch),
-            v(static_cast<std::size_t>(cw) * ch);
+        std::vector<std::uint8_t> y(static_cast<std::size_t>(w) * h),
+            u(static_cast<std::size_t>(cw) * ch), v(static_cast<std::size_t>(cw) * ch);
         rgb_to_i420(img, {y.data(), u.data(), v.data(), w, cw, cw}, ColorRange::kFull);
         auto sample = [&](int x, int yy, int c) {
           return img.rgb[3 * (static_cast<std::size_t>(yy) * w + x) + c] >> (depth == 16 ? 8 : 0);
         };
         for (int yy = 0; yy < h; ++yy) {
           for (int x = 0; x < w; ++x) {
-            const double want = 0.299 * sample(x, yy, 0) + 0.587 * sample(x, yy, 1) + 0.114 * sample(x, yy, 2);
+            const double want =
+                0.299 * sample(x, yy, 0) + 0.587 * sample(x, yy, 1) + 0.114 * sample(x, yy, 2);
             ASSERT_NEAR(y[static_cast<std::size_t>(yy) * w + x], want, 0.51)
                 << w << "x" << h << " depth " << depth << " Y at " << x << "," << yy;
           }
@@ -268,7 +270,8 @@ TEST(VideoFrames, Av1StreamIsFullRangeBt601AndSaysSo) {
 TEST(VideoFrames, Av1RateControlStartsAtAQuantizerItsBitrateAffords) {
   VideoEncoder rich({VideoCodec::kAv1, 128, 96, 3000, 1, 5});
   std::vector<int> q;
-  for (int t = 0; t < 8; ++t) q.push_back(rich.encode(moving_picture(128, 96, t), 33.0 * t).quantizer);
+  for (int t = 0; t < 8; ++t)
+    q.push_back(rich.encode(moving_picture(128, 96, t), 33.0 * t).quantizer);
   for (int t = 1; t < 8; ++t) EXPECT_LE(q[static_cast<std::size_t>(t)], 24) << "frame " << t;
   // Noise over the picture, new every frame: what no bitrate of 20 kbit/s
   // codes finely.
@@ -279,7 +282,8 @@ TEST(VideoFrames, Av1RateControlStartsAtAQuantizerItsBitrateAffords) {
     Image img = moving_picture(128, 96, t);
     for (auto& s : img.rgb) {
       state = state * 1664525u + 1013904223u;
-      s = static_cast<std::uint16_t>(std::clamp(static_cast<int>(s) + static_cast<int>(state >> 27) - 16, 0, 255));
+      s = static_cast<std::uint16_t>(
+          std::clamp(static_cast<int>(s) + static_cast<int>(state >> 27) - 16, 0, 255));
     }
     last = poor.encode(img, 33.0 * t).quantizer;
   }
