@@ -295,7 +295,7 @@ struct VideoEncoder::Impl {
   aom_codec_enc_cfg_t acfg{};
   aom_image_t* aimg = nullptr;
   bool open = false, aopen = false;
-  bool widen_quantizer = false;  // AV1: the starting cap on the quantizer is still on
+  bool widen_quantizer = false;  // AV1, VP9: the starting cap on the quantizer is still on
   void open_av1(const VideoEncoderSettings& settings, int speed);
   ~Impl() {
     if (img) vpx_img_free(img);
@@ -334,18 +334,19 @@ void set_av1_speed(aom_codec_ctx_t* c, int speed) {
 
 }  // namespace
 
-// AV1's quantizer range (0-63): libaom's CBR rate control starts its
-// average quantizer at the worst one allowed (av1_primary_rc_init), so a
-// stream that allowed 56 from the start spent its first second climbing
-// down from ~40 at most 1/8 a frame, at a fraction of its bitrate (the demo
-// drag at 1 000 kbit/s: 600-900 bytes a frame for 10 frames after the key
-// frame, 4 000 once settled). Opening the encoder with 24 as the worst and
-// widening to 56 after the first frame starts that average at 24; from there
-// it rises as fast as a scene needs (20 quantizer-index steps a frame).
-// Starting at 8, 16 or 24 gave the same bytes at equal PSNR on the demo drag
+// The quantizer range (0-63) of AV1 and VP9 streams: the CBR rate control
+// of libaom and of libvpx's VP9 starts its average quantizer at the worst
+// one allowed (av1_primary_rc_init, vp9_rc_init), so a stream that allowed
+// 56 from the start spent its first second climbing down from ~40 at most
+// 1/8 a frame, at a fraction of its bitrate (AV1, the demo drag at 1 000
+// kbit/s: 600-900 bytes a frame for 10 frames after the key frame, 4 000
+// once settled). Opening the encoder with 24 as the worst and widening to
+// 56 after the first frame starts that average at 24; from there it rises
+// as fast as a scene needs (20 quantizer-index steps a frame). Starting at
+// 8, 16 or 24 gave the same bytes at equal PSNR on the demo drag
 // (docs/performance.md, "The rate control's start and the colour range").
-constexpr unsigned kAv1StartMaxQuantizer = 24;
-constexpr unsigned kAv1MaxQuantizer = 56;
+constexpr unsigned kStartMaxQuantizer = 24;
+constexpr unsigned kMaxQuantizer = 56;
 
 // AV1 (libaom, realtime usage): one pass, no lag, CBR, no dropped frames,
 // key frames at the start and on request only. Unlike the libvpx streams the
@@ -367,7 +368,7 @@ void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int spee
   }
   const int threads = std::max(1, settings.threads);
   set_common_config(cfg, settings, 4000, 5000, 6000);
-  cfg.rc_max_quantizer = kAv1StartMaxQuantizer;
+  cfg.rc_max_quantizer = kStartMaxQuantizer;
   impl.widen_quantizer = true;
   cfg.g_pass = AOM_RC_ONE_PASS;
   cfg.rc_end_usage = AOM_CBR;
@@ -422,6 +423,10 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
   cfg.g_pass = VPX_RC_ONE_PASS;
   cfg.rc_end_usage = VPX_CBR;
   cfg.kf_mode = VPX_KF_DISABLED;  // key frames at the start and on request only
+  if (vp9) {
+    cfg.rc_max_quantizer = kStartMaxQuantizer;
+    impl_->widen_quantizer = true;
+  }
   if (vpx_codec_enc_init(&impl_->ctx, iface, &cfg, 0) != VPX_CODEC_OK) vpx_fail(&impl_->ctx, "enc_init");
   impl_->open = true;
   vpx_codec_ctx_t* c = &impl_->ctx;
@@ -452,6 +457,16 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
   vpx_codec_control(c, VP8E_SET_MAX_INTRA_BITRATE_PCT, 300);
   impl_->img = vpx_img_alloc(nullptr, VPX_IMG_FMT_I420, cfg.g_w, cfg.g_h, 16);
   if (!impl_->img) throw std::runtime_error("libvpx: vpx_img_alloc failed");
+  if (vp9) {
+    // Full-range BT.601, said in the frame headers, as for AV1 (VP8 has no
+    // way to say it and stays limited range).
+    if (vpx_codec_control(c, VP9E_SET_COLOR_SPACE, VPX_CS_BT_601) != VPX_CODEC_OK ||
+        vpx_codec_control(c, VP9E_SET_COLOR_RANGE, VPX_CR_FULL_RANGE) != VPX_CODEC_OK) {
+      vpx_fail(c, "codec_control (colour)");
+    }
+    impl_->img->cs = VPX_CS_BT_601;
+    impl_->img->range = VPX_CR_FULL_RANGE;
+  }
 }
 
 VideoEncoder::~VideoEncoder() = default;
@@ -498,7 +513,8 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
   if (av1) {
     rgb_to_i420(img, i420_planes(*impl_->aimg), ColorRange::kFull);
   } else {
-    rgb_to_i420(img, i420_planes(*impl_->img), ColorRange::kLimited);
+    rgb_to_i420(img, i420_planes(*impl_->img),
+                impl_->img->range == VPX_CR_FULL_RANGE ? ColorRange::kFull : ColorRange::kLimited);
   }
   // The frame lasts until the next one; the first gets a 30 frames/s share.
   const double gap = frames_ == 0 ? 33.0 : time_ms - last_ms_;
@@ -519,7 +535,7 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
     }
     if (impl_->widen_quantizer) {
       impl_->widen_quantizer = false;
-      impl_->acfg.rc_max_quantizer = kAv1MaxQuantizer;
+      impl_->acfg.rc_max_quantizer = kMaxQuantizer;
       if (aom_codec_enc_config_set(&impl_->actx, &impl_->acfg) != AOM_CODEC_OK) {
         aom_fail(&impl_->actx, "enc_config_set (quantizer range)");
       }
@@ -530,6 +546,16 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
       vpx_fail(&impl_->ctx, "encode");
     }
     append_frame_packets<vpx_codec_get_cx_data, VPX_CODEC_CX_FRAME_PKT, VPX_FRAME_IS_KEY>(&impl_->ctx, &out);
+    if (vpx_codec_control(&impl_->ctx, VP8E_GET_LAST_QUANTIZER_64, &out.quantizer) != VPX_CODEC_OK) {
+      vpx_fail(&impl_->ctx, "codec_control (last quantizer)");
+    }
+    if (impl_->widen_quantizer) {
+      impl_->widen_quantizer = false;
+      impl_->cfg.rc_max_quantizer = kMaxQuantizer;
+      if (vpx_codec_enc_config_set(&impl_->ctx, &impl_->cfg) != VPX_CODEC_OK) {
+        vpx_fail(&impl_->ctx, "enc_config_set (quantizer range)");
+      }
+    }
   }
   pts_ms_ += static_cast<std::int64_t>(duration);
   out.pts = frames_++;

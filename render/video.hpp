@@ -56,10 +56,11 @@ int video_encoder_speed(VideoCodec codec, int width, int height);
 // kept) to I420 with the BT.601 matrix; U and V are (w+1)/2 x (h+1)/2, each
 // from the rounded mean of its 2x2 block (fewer at an odd edge).
 // - Limited range (studio swing: Y 16-235, U and V 16-240), the integer form
-//   with 8-bit coefficients: VP8 and VP9, whose streams carry no range.
+//   with 8-bit coefficients: VP8, whose stream cannot say otherwise.
 // - Full range (Y, U and V 0-255, as JPEG's YCbCr), 16-bit coefficients:
 //   AV1, whose sequence header says so (and the matrix, the primaries and the
-//   sRGB transfer), so that the browser converts back with the same matrix.
+//   sRGB transfer), and VP9, whose frame headers say range and matrix; the
+//   browser converts back with the same matrix.
 //   Its steps are finer: on the volume's drag a frame through RGB -> I420 ->
 //   RGB alone is 48.6 dB from full accuracy against 47.3 for limited range
 //   (the frame itself 49.7; docs/performance.md, "The rate control's start
@@ -85,8 +86,8 @@ struct EncodedVideoFrame {
   bool key = false;
   std::int64_t pts = 0;
   int speed = 0;         // the encoder's speed for this frame
-  int quantizer = -1;    // AV1: the frame's base quantizer, 0-63 (the scale of
-                         // rc_max_quantizer); -1 for VP8/VP9
+  int quantizer = -1;    // the frame's base quantizer, 0-63 (the scale of
+                         // rc_max_quantizer)
   double encode_ms = 0;  // wall clock, conversion included
 };
 

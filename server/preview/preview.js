@@ -360,6 +360,13 @@ const isVideoFormat = (format) =>
 // server does not encode: the browser test's refused codec); other names are
 // tried as they are, and the server refuses what it does not encode.
 const codecStrings = {vp8: 'vp8', vp9: 'vp09.00.41.08', av1: 'av01.0.08M.08', h264: 'avc1.42001f'};
+// What the server's streams carry (render/video.hpp): BT.601 YUV of sRGB
+// pixels, full range for AV1 and VP9, limited for VP8. Given to the decoder
+// as its colour space: chromium takes AV1's from the stream but not VP8's or
+// VP9's, and drew those as limited-range BT.709 (a colour shift the browser
+// test measured: 33 dB from the still frame for VP9 against AV1's 40).
+const streamColor = (name) => ({primaries: 'bt709', transfer: 'iec61966-2-1', matrix: 'smpte170m',
+                                 fullRange: name !== 'vp8'});
 // ?video=auto: the first the browser decodes. AV1 first: about half of VP9's
 // bytes at the same PSNR on the preview's drags (docs/performance.md, "Video
 // preview: AV1"), for more encode time on the server.
@@ -380,7 +387,7 @@ async function setupVideo() {
   }
   const supported = async (name) => {
     const config = {codec: codecStrings[name] || name, codedWidth: size, codedHeight: size,
-                    optimizeForLatency: true};
+                    optimizeForLatency: true, colorSpace: streamColor(name)};
     try {
       return (await VideoDecoder.isConfigSupported(config)).supported ? config : null;
     } catch {

@@ -24,9 +24,9 @@
 // With --video-checks (issue 42), also that
 //  9. the video frames were decoded by WebCodecs into the canvas (the page
 //     counts pictures out of its VideoDecoder) and the overlay says so,
-//  9b. the browser reads AV1's colour description (full-range BT.601 of
-//     sRGB) and the last moving picture, as drawn, is within 35 dB of the
-//     still frame of its pose,
+//  9b. the pictures' colour space is the stream's (BT.601 of sRGB; full
+//     range for AV1 and VP9) and the last moving picture, as drawn, is
+//     within 35 dB of the still frame of its pose,
 // 10. a corrupt frame (the page's test hook) makes the decoder fail, the page
 //     asks for a key frame, and decoding resumes,
 // 11. a codec the server refuses (?video=h264) falls back to JPEG, and the
@@ -119,25 +119,27 @@ function checkIdentical(livePng, offlinePng, what) {
   return same;
 }
 
-// 9b. The colours of the video path: the stream says what its samples are
-// (AV1: full-range BT.601 of sRGB pixels; the browser reads it into the
-// picture's VideoColorSpace), and the last moving picture, drawn as the
+// 9b. The colours of the video path: the pictures' VideoColorSpace is what
+// the stream carries (BT.601 of sRGB pixels, full range for AV1 and VP9,
+// limited for VP8: AV1 says so in the stream, the page tells the decoder
+// for all three), and the last moving picture, drawn as the
 // canvas draws it, is close to the still frame of the same pose. The two
 // differ by the moving level's accuracy (the demo's quarter-resolution level
 // is ~40 dB from full accuracy at 512^2) and the stream's loss: measured
-// 39.7 dB (result.json, video.last_picture_psnr_db). The floor is 35: a
-// picture converted with the wrong range measured 34.0 (a stream that said
-// limited range over full-range samples), and a wrong matrix or swapped
-// planes land lower still.
+// 39.7 dB for AV1 (result.json, video.last_picture_psnr_db). The floor is
+// 35: pictures converted with the wrong range or matrix measured 33.1-34.0
+// (AV1 saying limited range over full-range samples; VP9 drawn as
+// limited-range BT.709 before the page gave the decoder its colour space),
+// and swapped planes land lower still.
 async function checkVideoPicture(page, still, result) {
   const v = await page.evaluate(() => window.beamcastPreview.video);
   const cs = v.colorSpace || {};
   result.video.color_space = cs;
-  if (movingFormat === 'av1') {
-    check(cs.fullRange === true && cs.matrix === 'smpte170m' && cs.primaries === 'bt709' &&
-              cs.transfer === 'iec61966-2-1',
-          `the AV1 pictures are full-range BT.601 sRGB to the browser (${JSON.stringify(cs)})`);
-  }
+  const full = movingFormat !== 'vp8';
+  check(cs.fullRange === full && cs.matrix === 'smpte170m' && cs.primaries === 'bt709' &&
+            cs.transfer === 'iec61966-2-1',
+        `the ${movingFormat} pictures are ${full ? 'full' : 'limited'}-range BT.601 sRGB to the ` +
+        `browser (${JSON.stringify(cs)})`);
   const pic = await page.evaluate(() => window.beamcastPreview.lastVideoPicture());
   const shown = v.lastShown;
   const samePose = pic && shown && pic.seq === shown.seq &&

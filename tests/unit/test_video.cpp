@@ -10,6 +10,8 @@
 #include <aom/aom_decoder.h>
 #include <aom/aom_image.h>
 #include <aom/aomdx.h>
+#include <vpx/vp8dx.h>
+#include <vpx/vpx_decoder.h>
 
 #include "render/video.hpp"
 
@@ -224,11 +226,13 @@ TEST(VideoFrames, FullRangeConversionMatchesTheMatrix) {
 
 // An AV1 stream says what its samples are: full range, the BT.601 matrix,
 // BT.709 (sRGB) primaries and the sRGB transfer, so that a browser's
-// VideoFrame converts back with the matrix the encoder used. The decoder
-// turns full-range pictures back to RGB close to the source (near-lossless
-// bitrate: within 1.5 levels RMS on black, white and grey; a range read
-// as limited would stretch black to -19 and white to 278).
-TEST(VideoFrames, Av1StreamIsFullRangeBt601AndSaysSo) {
+// VideoFrame converts back with the matrix the encoder used; a VP9 stream
+// says full range and BT.601 (all its headers can say). The decoder turns
+// full-range pictures back to RGB close to the source (near-lossless
+// bitrate: within 1.5 levels RMS on black, white and grey; a range read as
+// limited would stretch black to -19 and white to 278), and VP8's
+// limited-range ones too.
+TEST(VideoFrames, StreamsAreFullRangeBt601AndSaySo) {
   VideoEncoder enc({VideoCodec::kAv1, 64, 48, 8000, 1});
   const EncodedVideoFrame f = enc.encode(moving_picture(64, 48, 0), 0.0);
   aom_codec_ctx_t ctx{};
@@ -245,37 +249,58 @@ TEST(VideoFrames, Av1StreamIsFullRangeBt601AndSaysSo) {
   EXPECT_EQ(img->tc, AOM_CICP_TC_SRGB);
   aom_codec_destroy(&ctx);
 
-  for (const int level : {0, 128, 255}) {
-    VideoEncoder flat_enc({VideoCodec::kAv1, 64, 48, 8000, 1});
-    VideoDecoder dec(VideoCodec::kAv1);
-    Image flat;
-    flat.width = 64;
-    flat.height = 48;
-    flat.bit_depth = 8;
-    flat.rgb.assign(3 * 64 * 48, static_cast<std::uint16_t>(level));
-    const Image out = dec.decode(flat_enc.encode(flat, 0.0).data);
-    double sq = 0.0;
-    for (std::size_t i = 0; i < out.rgb.size(); ++i) sq += std::pow(out.rgb[i] - level, 2);
-    EXPECT_LT(std::sqrt(sq / static_cast<double>(out.rgb.size())), 1.5) << "grey level " << level;
+  VideoEncoder vp9_enc({VideoCodec::kVp9, 64, 48, 8000, 1});
+  const EncodedVideoFrame f9 = vp9_enc.encode(moving_picture(64, 48, 0), 0.0);
+  vpx_codec_ctx_t vctx{};
+  vpx_codec_dec_cfg_t vcfg{};
+  vcfg.threads = 1;
+  ASSERT_EQ(vpx_codec_dec_init(&vctx, vpx_codec_vp9_dx(), &vcfg, 0), VPX_CODEC_OK);
+  ASSERT_EQ(vpx_codec_decode(&vctx, f9.data.data(), static_cast<unsigned>(f9.data.size()), nullptr, 0),
+            VPX_CODEC_OK);
+  vpx_codec_iter_t viter = nullptr;
+  const vpx_image_t* vimg = vpx_codec_get_frame(&vctx, &viter);
+  ASSERT_NE(vimg, nullptr);
+  EXPECT_EQ(vimg->range, VPX_CR_FULL_RANGE);
+  EXPECT_EQ(vimg->cs, VPX_CS_BT_601);
+  vpx_codec_destroy(&vctx);
+
+  for (VideoCodec c : {VideoCodec::kAv1, VideoCodec::kVp9, VideoCodec::kVp8}) {
+    for (const int level : {0, 128, 255}) {
+      VideoEncoder flat_enc({c, 64, 48, 8000, 1});
+      VideoDecoder dec(c);
+      Image flat;
+      flat.width = 64;
+      flat.height = 48;
+      flat.bit_depth = 8;
+      flat.rgb.assign(3 * 64 * 48, static_cast<std::uint16_t>(level));
+      const Image out = dec.decode(flat_enc.encode(flat, 0.0).data);
+      double sq = 0.0;
+      for (std::size_t i = 0; i < out.rgb.size(); ++i) sq += std::pow(out.rgb[i] - level, 2);
+      EXPECT_LT(std::sqrt(sq / static_cast<double>(out.rgb.size())), 1.5)
+          << video_codec_name(c) << ", grey level " << level;
+    }
   }
 }
 
-// AV1's rate control starts near the quantizer its bitrate affords: with a
+// AV1's and VP9's rate control starts near the quantizer its bitrate affords: with a
 // bitrate that lets the key frame take the finest quantizer, the delta
 // frames after it stay at or under 24 (the starting cap, widened to 56 after
 // the first frame) instead of jumping to the worst allowed and climbing down
 // 1/8 a frame (with 56 from the start: 30-40 here). A low bitrate still gets
 // coarse quantizers (the cap does not hold it to 24), and the cap is gone
 // after the first frame.
-TEST(VideoFrames, Av1RateControlStartsAtAQuantizerItsBitrateAffords) {
-  VideoEncoder rich({VideoCodec::kAv1, 128, 96, 3000, 1, 5});
+class RateControlStart : public ::testing::TestWithParam<VideoCodec> {};
+
+TEST_P(RateControlStart, StartsAtAQuantizerItsBitrateAffords) {
+  const VideoCodec codec = GetParam();
+  VideoEncoder rich({codec, 128, 96, 3000, 1, codec == VideoCodec::kAv1 ? 5 : 8});
   std::vector<int> q;
   for (int t = 0; t < 8; ++t)
     q.push_back(rich.encode(moving_picture(128, 96, t), 33.0 * t).quantizer);
   for (int t = 1; t < 8; ++t) EXPECT_LE(q[static_cast<std::size_t>(t)], 24) << "frame " << t;
   // Noise over the picture, new every frame: what no bitrate of 20 kbit/s
   // codes finely.
-  VideoEncoder poor({VideoCodec::kAv1, 128, 96, 20, 1, 5});
+  VideoEncoder poor({codec, 128, 96, 20, 1, codec == VideoCodec::kAv1 ? 5 : 8});
   std::uint32_t state = 99u;
   int last = -1;
   for (int t = 0; t < 20; ++t) {
@@ -290,6 +315,10 @@ TEST(VideoFrames, Av1RateControlStartsAtAQuantizerItsBitrateAffords) {
   EXPECT_GT(last, 24);
   EXPECT_LE(last, 56);
 }
+
+INSTANTIATE_TEST_SUITE_P(Codecs, RateControlStart,
+                         ::testing::Values(VideoCodec::kAv1, VideoCodec::kVp9),
+                         [](const auto& info) { return std::string(video_codec_name(info.param)); });
 
 // One encoder thread per started 2^19 pixels, at most 4 and at most the
 // cores: the preview's 512x512 stays on one thread, 1080p gets 4 (2 here).
