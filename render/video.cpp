@@ -295,7 +295,6 @@ struct VideoEncoder::Impl {
   aom_codec_enc_cfg_t acfg{};
   aom_image_t* aimg = nullptr;
   bool open = false, aopen = false;
-  bool widen_quantizer = false;  // AV1, VP9: the starting cap on the quantizer is still on
   void open_av1(const VideoEncoderSettings& settings, int speed);
   ~Impl() {
     if (img) vpx_img_free(img);
@@ -341,10 +340,12 @@ void set_av1_speed(aom_codec_ctx_t* c, int speed) {
 // 1/8 a frame, at a fraction of its bitrate (AV1, the demo drag at 1 000
 // kbit/s: 600-900 bytes a frame for 10 frames after the key frame, 4 000
 // once settled). Opening the encoder with 24 as the worst and widening to
-// 56 after the first frame starts that average at 24; from there it rises
-// as fast as a scene needs (20 quantizer-index steps a frame). Starting at
-// 8, 16 or 24 gave the same bytes at equal PSNR on the demo drag
-// (docs/performance.md, "The rate control's start and the colour range").
+// 56 before the first frame starts that average at 24 and leaves the key
+// frame's quantizer free (a low bitrate's key frame is not held to 24);
+// from there it rises as fast as a scene needs (20 quantizer-index steps a
+// frame). Starting at 8, 16 or 24 gave the same bytes at equal PSNR on the
+// demo drag (docs/performance.md, "The rate control's start and the colour
+// range").
 constexpr unsigned kStartMaxQuantizer = 24;
 constexpr unsigned kMaxQuantizer = 56;
 
@@ -369,7 +370,6 @@ void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int spee
   const int threads = std::max(1, settings.threads);
   set_common_config(cfg, settings, 4000, 5000, 6000);
   cfg.rc_max_quantizer = kStartMaxQuantizer;
-  impl.widen_quantizer = true;
   cfg.g_pass = AOM_RC_ONE_PASS;
   cfg.rc_end_usage = AOM_CBR;
   cfg.kf_mode = AOM_KF_DISABLED;
@@ -397,6 +397,8 @@ void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int spee
       aom_codec_control(c, AV1E_SET_TRANSFER_CHARACTERISTICS, AOM_CICP_TC_SRGB) == AOM_CODEC_OK;
   if (!ok) aom_fail(c, "codec_control");
   set_av1_speed(c, speed);
+  cfg.rc_max_quantizer = kMaxQuantizer;  // the rate control's average starts at the start cap
+  if (aom_codec_enc_config_set(c, &cfg) != AOM_CODEC_OK) aom_fail(c, "enc_config_set (quantizer range)");
   impl.aimg = aom_img_alloc(nullptr, AOM_IMG_FMT_I420, cfg.g_w, cfg.g_h, 16);
   if (!impl.aimg) throw std::runtime_error("libaom: aom_img_alloc failed");
   impl.aimg->range = AOM_CR_FULL_RANGE;
@@ -423,11 +425,14 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
   cfg.g_pass = VPX_RC_ONE_PASS;
   cfg.rc_end_usage = VPX_CBR;
   cfg.kf_mode = VPX_KF_DISABLED;  // key frames at the start and on request only
-  if (vp9) {
-    cfg.rc_max_quantizer = kStartMaxQuantizer;
-    impl_->widen_quantizer = true;
-  }
+  if (vp9) cfg.rc_max_quantizer = kStartMaxQuantizer;
   if (vpx_codec_enc_init(&impl_->ctx, iface, &cfg, 0) != VPX_CODEC_OK) vpx_fail(&impl_->ctx, "enc_init");
+  if (vp9) {
+    cfg.rc_max_quantizer = kMaxQuantizer;  // the rate control's average starts at the start cap
+    if (vpx_codec_enc_config_set(&impl_->ctx, &cfg) != VPX_CODEC_OK) {
+      vpx_fail(&impl_->ctx, "enc_config_set (quantizer range)");
+    }
+  }
   impl_->open = true;
   vpx_codec_ctx_t* c = &impl_->ctx;
   // Realtime speed settings (libvpx's own realtime examples use these
@@ -533,13 +538,6 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
         AOM_CODEC_OK) {
       aom_fail(&impl_->actx, "codec_control (last quantizer)");
     }
-    if (impl_->widen_quantizer) {
-      impl_->widen_quantizer = false;
-      impl_->acfg.rc_max_quantizer = kMaxQuantizer;
-      if (aom_codec_enc_config_set(&impl_->actx, &impl_->acfg) != AOM_CODEC_OK) {
-        aom_fail(&impl_->actx, "enc_config_set (quantizer range)");
-      }
-    }
   } else {
     if (vpx_codec_encode(&impl_->ctx, impl_->img, pts_ms_, duration, key ? VPX_EFLAG_FORCE_KF : 0,
                          VPX_DL_REALTIME) != VPX_CODEC_OK) {
@@ -548,13 +546,6 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
     append_frame_packets<vpx_codec_get_cx_data, VPX_CODEC_CX_FRAME_PKT, VPX_FRAME_IS_KEY>(&impl_->ctx, &out);
     if (vpx_codec_control(&impl_->ctx, VP8E_GET_LAST_QUANTIZER_64, &out.quantizer) != VPX_CODEC_OK) {
       vpx_fail(&impl_->ctx, "codec_control (last quantizer)");
-    }
-    if (impl_->widen_quantizer) {
-      impl_->widen_quantizer = false;
-      impl_->cfg.rc_max_quantizer = kMaxQuantizer;
-      if (vpx_codec_enc_config_set(&impl_->ctx, &impl_->cfg) != VPX_CODEC_OK) {
-        vpx_fail(&impl_->ctx, "enc_config_set (quantizer range)");
-      }
     }
   }
   pts_ms_ += static_cast<std::int64_t>(duration);

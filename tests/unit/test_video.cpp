@@ -282,13 +282,14 @@ TEST(VideoFrames, StreamsAreFullRangeBt601AndSaySo) {
   }
 }
 
-// AV1's and VP9's rate control starts near the quantizer its bitrate affords: with a
-// bitrate that lets the key frame take the finest quantizer, the delta
-// frames after it stay at or under 24 (the starting cap, widened to 56 after
-// the first frame) instead of jumping to the worst allowed and climbing down
-// 1/8 a frame (with 56 from the start: 30-40 here). A low bitrate still gets
-// coarse quantizers (the cap does not hold it to 24), and the cap is gone
-// after the first frame.
+// AV1's and VP9's rate control starts near the quantizer its bitrate
+// affords: with a bitrate that lets the key frame take the finest
+// quantizer, the delta frames after it stay at or under 24 (the encoder
+// opens with 24 as the worst, which starts the rate control's average
+// there, and widens it to 56 before the first frame) instead of jumping to
+// the worst allowed and climbing down 1/8 a frame (with 56 from the start:
+// 36-41 here). A low bitrate still gets coarse quantizers: the range is 56
+// wide.
 class RateControlStart : public ::testing::TestWithParam<VideoCodec> {};
 
 TEST_P(RateControlStart, StartsAtAQuantizerItsBitrateAffords) {
