@@ -93,39 +93,54 @@ TEST(VideoFrames, OddSizesAndBitrateChangesEncode) {
   }
 }
 
-// The encoder's colour conversion against the BT.601 limited-range matrix
-// evaluated pixel by pixel from its definition (chroma from the rounded mean
-// of each 2x2 block, or of what an odd edge leaves), exactly: the fast row
-// form must give the same bytes. Odd and even sizes, one-pixel rows and
-// columns, 8- and 16-bit samples (the high byte is kept); noise, so that a
-// swapped channel, plane, row or block edge shows.
-TEST(VideoFrames, ConversionMatchesTheMatrix) {
-  auto clamp8 = [](int v) { return static_cast<int>(static_cast<unsigned char>(v)); };
+// Noise, so that a swapped channel, plane, row or block edge shows; the
+// first six pixels black, white, red, green, blue and yellow (the range's
+// ends). 16-bit samples have a random low byte (the conversion keeps the
+// high one).
+Image noise_picture(int w, int h, int depth) {
+  Image img;
+  img.width = w;
+  img.height = h;
+  img.bit_depth = depth;
+  img.rgb.resize(3 * static_cast<std::size_t>(w) * h);
+  std::uint32_t state = 12345u + static_cast<std::uint32_t>(w * 131 + h * 7 + depth);
+  for (auto& v : img.rgb) {
+    state = state * 1664525u + 1013904223u;
+    v = static_cast<std::uint16_t>(depth == 16 ? state >> 16 : state >> 24);
+  }
+  const int ends[][3] = {{0, 0, 0},   {255, 255, 255}, {255, 0, 0},
+                         {0, 255, 0}, {0, 0, 255},     {255, 255, 0}};
+  for (std::size_t i = 0; i < std::min<std::size_t>(6, img.rgb.size() / 3); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      img.rgb[3 * i + static_cast<std::size_t>(c)] =
+          static_cast<std::uint16_t>(depth == 16 ? ends[i][c] * 257 : ends[i][c]);
+    }
+  }
+  return img;
+}
+
+// rgb_to_i420 in `range` against the matrix evaluated pixel by pixel from
+// its definition: Y of each pixel, U and V of the rounded mean of each 2x2
+// block (or of what an odd edge leaves), each within `tolerance` of
+// want_y/u/v(r, g, b) of the 8-bit samples. Odd and even sizes, one-pixel
+// rows and columns, 8- and 16-bit samples, planes with padded strides.
+template <class Y, class U, class V>
+void expect_conversion(ColorRange range, Y want_y, U want_u, V want_v, double tolerance) {
   for (const int w : {1, 2, 3, 17, 64}) {
     for (const int h : {1, 2, 5, 33}) {
       for (const int depth : {8, 16}) {
-        Image img;
-        img.width = w;
-        img.height = h;
-        img.bit_depth = depth;
-        img.rgb.resize(3 * static_cast<std::size_t>(w) * h);
-        std::uint32_t state = 12345u + static_cast<std::uint32_t>(w * 131 + h * 7 + depth);
-        for (auto& v : img.rgb) {
-          state = state * 1664525u + 1013904223u;
-          v = static_cast<std::uint16_t>(depth == 16 ? state >> 16 : state >> 24);
-        }
+        const Image img = noise_picture(w, h, depth);
         const int cw = (w + 1) / 2, ch = (h + 1) / 2;
-        std::vector<std::uint8_t> y(static_cast<std::size_t>(w + 3) * h), u(static_cast<std::size_t>(cw + 1) * ch),
-            v(static_cast<std::size_t>(cw + 2) * ch);
-        rgb_to_i420(img, {y.data(), u.data(), v.data(), w + 3, cw + 1, cw + 2});
+        std::vector<std::uint8_t> y(static_cast<std::size_t>(w + 3) * h),
+            u(static_cast<std::size_t>(cw + 1) * ch), v(static_cast<std::size_t>(cw + 2) * ch);
+        rgb_to_i420(img, {y.data(), u.data(), v.data(), w + 3, cw + 1, cw + 2}, range);
         auto sample = [&](int x, int yy, int c) {
           return img.rgb[3 * (static_cast<std::size_t>(yy) * w + x) + c] >> (depth == 16 ? 8 : 0);
         };
         for (int yy = 0; yy < h; ++yy) {
           for (int x = 0; x < w; ++x) {
-            const int r = sample(x, yy, 0), g = sample(x, yy, 1), b = sample(x, yy, 2);
-            ASSERT_EQ(y[static_cast<std::size_t>(yy) * (w + 3) + x],
-                      clamp8(((66 * r + 129 * g + 25 * b + 128) >> 8) + 16))
+            ASSERT_NEAR(y[static_cast<std::size_t>(yy) * (w + 3) + x],
+                        want_y(sample(x, yy, 0), sample(x, yy, 1), sample(x, yy, 2)), tolerance)
                 << w << "x" << h << " depth " << depth << " Y at " << x << "," << yy;
           }
         }
@@ -143,11 +158,9 @@ TEST(VideoFrames, ConversionMatchesTheMatrix) {
             r = (r + n / 2) / n;
             g = (g + n / 2) / n;
             b = (b + n / 2) / n;
-            ASSERT_EQ(u[static_cast<std::size_t>(cy) * (cw + 1) + cx],
-                      clamp8(((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128))
+            ASSERT_NEAR(u[static_cast<std::size_t>(cy) * (cw + 1) + cx], want_u(r, g, b), tolerance)
                 << w << "x" << h << " depth " << depth << " U at " << cx << "," << cy;
-            ASSERT_EQ(v[static_cast<std::size_t>(cy) * (cw + 2) + cx],
-                      clamp8(((112 * r - 94 * g - 18 * b + 128) >> 8) + 128))
+            ASSERT_NEAR(v[static_cast<std::size_t>(cy) * (cw + 2) + cx], want_v(r, g, b), tolerance)
                 << w << "x" << h << " depth " << depth << " V at " << cx << "," << cy;
           }
         }
@@ -156,72 +169,30 @@ TEST(VideoFrames, ConversionMatchesTheMatrix) {
   }
 }
 
-// The full-range conversion (AV1's) against the BT.601 matrix in floating
-// point, JPEG's YCbCr: every Y, U and V sample is the matrix's value rounded
-// (within 0.51: the 16-bit coefficients move a value by at most 0.002, which
-// can tip a rounding at .5), chroma from the rounded mean of each 2x2 block;
-// U and V clamped to 0-255. Saturated primaries, black, white and noise, odd
-// and even sizes, 8- and 16-bit samples.
+// Limited range (VP8's) against the integer form of the BT.601
+// limited-range matrix, exactly: the fast row form must give the same bytes.
+TEST(VideoFrames, ConversionMatchesTheMatrix) {
+  expect_conversion(
+      ColorRange::kLimited,
+      [](int r, int g, int b) { return ((66 * r + 129 * g + 25 * b + 128) >> 8) + 16; },
+      [](int r, int g, int b) { return ((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128; },
+      [](int r, int g, int b) { return ((112 * r - 94 * g - 18 * b + 128) >> 8) + 128; }, 0.0);
+}
+
+// Full range (AV1's and VP9's) against the BT.601 matrix in floating point,
+// JPEG's YCbCr, U and V clamped to 0-255: each sample is the matrix's value
+// rounded, within 0.51 (the 16-bit coefficients move a value by at most
+// 0.002, which can tip a rounding at .5).
 TEST(VideoFrames, FullRangeConversionMatchesTheMatrix) {
-  for (const int w : {1, 3, 16}) {
-    for (const int h : {1, 4, 7}) {
-      for (const int depth : {8, 16}) {
-        Image img;
-        img.width = w;
-        img.height = h;
-        img.bit_depth = depth;
-        img.rgb.resize(3 * static_cast<std::size_t>(w) * h);
-        std::uint32_t state = 777u + static_cast<std::uint32_t>(w * 31 + h * 3 + depth);
-        const int extremes[][3] = {{0, 0, 0},   {255, 255, 255}, {255, 0, 0},
-                                   {0, 255, 0}, {0, 0, 255},     {255, 255, 0}};
-        for (std::size_t i = 0; i < img.rgb.size() / 3; ++i) {
-          for (int c = 0; c < 3; ++c) {
-            state = state * 1664525u + 1013904223u;
-            int v8 = static_cast<int>(state >> 24);
-            if (i < 6) v8 = extremes[i][c];
-            img.rgb[3 * i + c] = static_cast<std::uint16_t>(depth == 16 ? v8 * 257 : v8);
-          }
-        }
-        const int cw = (w + 1) / 2, ch = (h + 1) / 2;
-        std::vector<std::uint8_t> y(static_cast<std::size_t>(w) * h),
-            u(static_cast<std::size_t>(cw) * ch), v(static_cast<std::size_t>(cw) * ch);
-        rgb_to_i420(img, {y.data(), u.data(), v.data(), w, cw, cw}, ColorRange::kFull);
-        auto sample = [&](int x, int yy, int c) {
-          return img.rgb[3 * (static_cast<std::size_t>(yy) * w + x) + c] >> (depth == 16 ? 8 : 0);
-        };
-        for (int yy = 0; yy < h; ++yy) {
-          for (int x = 0; x < w; ++x) {
-            const double want =
-                0.299 * sample(x, yy, 0) + 0.587 * sample(x, yy, 1) + 0.114 * sample(x, yy, 2);
-            ASSERT_NEAR(y[static_cast<std::size_t>(yy) * w + x], want, 0.51)
-                << w << "x" << h << " depth " << depth << " Y at " << x << "," << yy;
-          }
-        }
-        for (int cy = 0; cy < ch; ++cy) {
-          for (int cx = 0; cx < cw; ++cx) {
-            int r = 0, g = 0, b = 0, n = 0;
-            for (int yy = 2 * cy; yy < std::min(h, 2 * cy + 2); ++yy) {
-              for (int x = 2 * cx; x < std::min(w, 2 * cx + 2); ++x) {
-                r += sample(x, yy, 0);
-                g += sample(x, yy, 1);
-                b += sample(x, yy, 2);
-                ++n;
-              }
-            }
-            r = (r + n / 2) / n;
-            g = (g + n / 2) / n;
-            b = (b + n / 2) / n;
-            const double cb = std::clamp(128.0 - 0.168736 * r - 0.331264 * g + 0.5 * b, 0.0, 255.0);
-            const double cr = std::clamp(128.0 + 0.5 * r - 0.418688 * g - 0.081312 * b, 0.0, 255.0);
-            ASSERT_NEAR(u[static_cast<std::size_t>(cy) * cw + cx], cb, 0.51)
-                << w << "x" << h << " depth " << depth << " U at " << cx << "," << cy;
-            ASSERT_NEAR(v[static_cast<std::size_t>(cy) * cw + cx], cr, 0.51)
-                << w << "x" << h << " depth " << depth << " V at " << cx << "," << cy;
-          }
-        }
-      }
-    }
-  }
+  expect_conversion(
+      ColorRange::kFull, [](int r, int g, int b) { return 0.299 * r + 0.587 * g + 0.114 * b; },
+      [](int r, int g, int b) {
+        return std::clamp(128.0 - 0.168736 * r - 0.331264 * g + 0.5 * b, 0.0, 255.0);
+      },
+      [](int r, int g, int b) {
+        return std::clamp(128.0 + 0.5 * r - 0.418688 * g - 0.081312 * b, 0.0, 255.0);
+      },
+      0.51);
 }
 
 // An AV1 stream says what its samples are: full range, the BT.601 matrix,
