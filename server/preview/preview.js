@@ -68,7 +68,7 @@ const preview = {
     errors: [],      // decoder errors (messages)
     recoveries: 0,   // key frames decoded after a decoder error
     decode_ms: [],   // decode() to the picture, per frame (the latest 200)
-    colorSpace: null,    // the latest picture's VideoColorSpace, as the browser read it from the stream
+    colorSpace: null,    // the latest picture's VideoColorSpace (the stream's, or the one given to the decoder)
     lastShown: null,     // {seq, camera} of the latest video response shown
     corruptNext: false,  // test hook: the next delta frame is fed as garbage
     keepLast: false,     // test hook: keep the latest picture for lastVideoPicture()
