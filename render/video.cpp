@@ -140,13 +140,18 @@ struct I420View {
 // vpx_image_t and aom_image_t name their planes (Y, U, V: 0, 1, 2),
 // strides, size and range alike (full range is 1 in both).
 template <class CodecImage>
-I420View i420_view(const CodecImage& img) {
+ColorRange color_range(const CodecImage& img) {
   static_assert(static_cast<int>(AOM_CR_FULL_RANGE) == 1 && static_cast<int>(VPX_CR_FULL_RANGE) == 1);
+  return static_cast<int>(img.range) == 1 ? ColorRange::kFull : ColorRange::kLimited;
+}
+
+template <class CodecImage>
+I420View i420_view(const CodecImage& img) {
   return {{img.planes[0], img.planes[1], img.planes[2]},
           {img.stride[0], img.stride[1], img.stride[2]},
           static_cast<int>(img.d_w),
           static_cast<int>(img.d_h),
-          static_cast<int>(img.range) == 1 ? ColorRange::kFull : ColorRange::kLimited};
+          color_range(img)};
 }
 
 template <class CodecImage>
@@ -427,13 +432,9 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
   cfg.kf_mode = VPX_KF_DISABLED;  // key frames at the start and on request only
   if (vp9) cfg.rc_max_quantizer = kStartMaxQuantizer;
   if (vpx_codec_enc_init(&impl_->ctx, iface, &cfg, 0) != VPX_CODEC_OK) vpx_fail(&impl_->ctx, "enc_init");
-  if (vp9) {
-    cfg.rc_max_quantizer = kMaxQuantizer;  // the rate control's average starts at the start cap
-    if (vpx_codec_enc_config_set(&impl_->ctx, &cfg) != VPX_CODEC_OK) {
-      vpx_fail(&impl_->ctx, "enc_config_set (quantizer range)");
-    }
-  }
   impl_->open = true;
+  impl_->img = vpx_img_alloc(nullptr, VPX_IMG_FMT_I420, cfg.g_w, cfg.g_h, 16);
+  if (!impl_->img) throw std::runtime_error("libvpx: vpx_img_alloc failed");
   vpx_codec_ctx_t* c = &impl_->ctx;
   // Realtime speed settings (libvpx's own realtime examples use these
   // ranges): VP8 -cpu-used 8 (of 16), VP9 speed 8 (of 9), no alt-ref frames,
@@ -450,6 +451,16 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
     vpx_codec_control(c, VP9E_SET_ROW_MT, 1);
     vpx_codec_control(c, VP9E_SET_AQ_MODE, 3);
     vpx_codec_control(c, VP9E_SET_TILE_COLUMNS, std::max(1, log2_tile_columns(threads, settings.width)));
+    // Full-range BT.601, said in the frame headers, as for AV1 (VP8 has no
+    // way to say it and stays limited range).
+    if (vpx_codec_control(c, VP9E_SET_COLOR_SPACE, VPX_CS_BT_601) != VPX_CODEC_OK ||
+        vpx_codec_control(c, VP9E_SET_COLOR_RANGE, VPX_CR_FULL_RANGE) != VPX_CODEC_OK) {
+      vpx_fail(c, "codec_control (colour)");
+    }
+    impl_->img->cs = VPX_CS_BT_601;
+    impl_->img->range = VPX_CR_FULL_RANGE;
+    cfg.rc_max_quantizer = kMaxQuantizer;  // the rate control's average starts at the start cap
+    if (vpx_codec_enc_config_set(c, &cfg) != VPX_CODEC_OK) vpx_fail(c, "enc_config_set (quantizer range)");
   } else {
     int log2_parts = 0;
     while (log2_parts < 3 && (2 << log2_parts) <= threads) ++log2_parts;
@@ -460,18 +471,6 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
   }
   vpx_codec_control(c, VP8E_SET_ENABLEAUTOALTREF, 0);
   vpx_codec_control(c, VP8E_SET_MAX_INTRA_BITRATE_PCT, 300);
-  impl_->img = vpx_img_alloc(nullptr, VPX_IMG_FMT_I420, cfg.g_w, cfg.g_h, 16);
-  if (!impl_->img) throw std::runtime_error("libvpx: vpx_img_alloc failed");
-  if (vp9) {
-    // Full-range BT.601, said in the frame headers, as for AV1 (VP8 has no
-    // way to say it and stays limited range).
-    if (vpx_codec_control(c, VP9E_SET_COLOR_SPACE, VPX_CS_BT_601) != VPX_CODEC_OK ||
-        vpx_codec_control(c, VP9E_SET_COLOR_RANGE, VPX_CR_FULL_RANGE) != VPX_CODEC_OK) {
-      vpx_fail(c, "codec_control (colour)");
-    }
-    impl_->img->cs = VPX_CS_BT_601;
-    impl_->img->range = VPX_CR_FULL_RANGE;
-  }
 }
 
 VideoEncoder::~VideoEncoder() = default;
@@ -515,11 +514,11 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
                  "VideoEncoder::encode: frame size differs from the encoder's");
   const auto t0 = std::chrono::steady_clock::now();
   const bool av1 = settings_.codec == VideoCodec::kAv1;
+  // The encoder's picture says its range (set where the encoder opened).
   if (av1) {
-    rgb_to_i420(img, i420_planes(*impl_->aimg), ColorRange::kFull);
+    rgb_to_i420(img, i420_planes(*impl_->aimg), color_range(*impl_->aimg));
   } else {
-    rgb_to_i420(img, i420_planes(*impl_->img),
-                impl_->img->range == VPX_CR_FULL_RANGE ? ColorRange::kFull : ColorRange::kLimited);
+    rgb_to_i420(img, i420_planes(*impl_->img), color_range(*impl_->img));
   }
   // The frame lasts until the next one; the first gets a 30 frames/s share.
   const double gap = frames_ == 0 ? 33.0 : time_ms - last_ms_;
