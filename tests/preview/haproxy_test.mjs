@@ -123,11 +123,7 @@ async function sessionServer(servers) {
 
 const pagePng = (page) => page.evaluate(() => {
   const s = window.beamcastPreview.lastStill;
-  let bin = '';
-  for (let i = 0; i < s.bytes.length; i += 0x8000) {
-    bin += String.fromCharCode.apply(null, s.bytes.subarray(i, i + 0x8000));
-  }
-  return {camera: s.camera, png: btoa(bin)};
+  return {camera: s.camera, png: window.beamcastPreview.base64(s.bytes)};
 });
 
 // The page's clock and counters just before a kill.

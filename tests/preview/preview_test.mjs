@@ -92,11 +92,7 @@ async function timed(what, fn) {
 async function stillOf(page) {
   const s = await page.evaluate(() => {
     const s = window.beamcastPreview.lastStill;
-    let bin = '';
-    for (let i = 0; i < s.bytes.length; i += 0x8000) {
-      bin += String.fromCharCode.apply(null, s.bytes.subarray(i, i + 0x8000));
-    }
-    return {camera: s.camera, png: btoa(bin)};
+    return {camera: s.camera, png: window.beamcastPreview.base64(s.bytes)};
   });
   return {camera: s.camera, png: Buffer.from(s.png, 'base64')};
 }
@@ -141,6 +137,7 @@ async function checkVideoPicture(page, still, result) {
         `the ${movingFormat} pictures are ${full ? 'full' : 'limited'}-range BT.601 sRGB to the ` +
         `browser (${JSON.stringify(cs)})`);
   const pic = await page.evaluate(() => window.beamcastPreview.lastVideoPicture());
+  const rgba = pic ? Buffer.from(pic.rgba, 'base64') : null;
   const shown = v.lastShown;
   const samePose = pic && shown && pic.seq === shown.seq &&
                    JSON.stringify(shown.camera) === JSON.stringify(still.camera);
@@ -155,7 +152,7 @@ async function checkVideoPicture(page, still, result) {
   for (let i = 0; i < png.width * png.height; ++i) {
     for (let c = 0; c < 3; ++c) {
       const ref = png.data[(i * png.channels + c) * bytes];  // the high byte of 16-bit samples
-      const d = pic.rgba[4 * i + c] - ref;
+      const d = rgba[4 * i + c] - ref;
       sq += d * d;
       ++n;
     }
