@@ -17,13 +17,14 @@
 // av1); --kbps and --jpeg the bitrates and qualities tried;
 // --max-encode-ms MS lets AV1's speed follow the encode time as the server's
 // does (VideoEncoderSettings::max_encode_ms); --native 1 sends each frame at
-// the size the level renders and shows it upscaled bilinearly.
+// the size the level renders and shows it upscaled bilinearly; --bits 8 or
+// 10 sets AV1's sample depth (default 8).
 //
 // Not a test: prints a markdown table, and CSV with --csv FILE (for
 // bench/plot_video.py). Usage:
 //   beamcast_bench_video [--scene NAME] [--size WxH] [--level L] [--frames N] [--csv FILE]
 //                        [--threads N] [--speeds S,S..] [--kbps R,R..] [--jpeg Q,Q..]
-//                        [--codecs C,C..] [--max-encode-ms MS] [--native 0|1]
+//                        [--codecs C,C..] [--max-encode-ms MS] [--native 0|1] [--bits 8|10]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -201,6 +202,8 @@ struct Result {
   std::vector<double> psnr{}, ssim{}, encode_ms{}, encode_wall_ms{}, decode_ms{};
   std::size_t bytes = 0, key_bytes = 0;
   int speed = 0;  // the video encoder's at the start (0 for JPEG)
+  int bits = 8;   // the video stream's sample depth at the start
+  int frames_8bit = 0;  // its frames at 8 bits (a 10-bit stream falls back when too slow)
   std::vector<double> speeds{};  // per frame (with --max-encode-ms it moves)
 };
 
@@ -209,6 +212,7 @@ struct Result {
 int main(int argc, char** argv) {
   std::string name = "paper_10sets", csv_path;
   int width = 512, height = 512, level_index = 3, frames = 60, threads = 1;
+  int bits = 8;  // AV1's sample depth
   bool native = false;  // send the level at the size it renders; the display upscales
   double max_encode_ms = 0.0;  // > 0: AV1's speed follows the encode time (VideoEncoderSettings)
   std::vector<int> speeds{0}, rates{125, 250, 500, 1000, 2000, 4000}, qualities{50, 75, 85, 92};
@@ -239,6 +243,7 @@ int main(int argc, char** argv) {
     else if (a == "--kbps") rates = int_list(v);
     else if (a == "--jpeg") qualities = int_list(v);
     else if (a == "--native") native = v == "1";
+    else if (a == "--bits") bits = std::atoi(v.c_str());
     else if (a == "--max-encode-ms") max_encode_ms = std::atof(v.c_str());
     else if (a == "--codecs") {
       codecs.clear();
@@ -324,7 +329,10 @@ int main(int argc, char** argv) {
     for (int kbps : rates) {
       Result r{.path = std::string(video_codec_name(codec)), .setting = static_cast<double>(kbps),
                .speed = speed};
-      VideoEncoder enc({codec, ew, eh, kbps, threads, speed, max_encode_ms});
+      VideoEncoder enc({codec, ew, eh, kbps, threads, speed, max_encode_ms,
+                        codec == VideoCodec::kAv1 ? bits : 8});
+      r.bits = enc.settings().bit_depth;
+      r.speed = enc.settings().speed;  // a 10-bit stream keeps to 6
       VideoDecoder dec(codec);
       for (int i = 0; i < frames; ++i) {
         double t = process_cpu_ms();
@@ -339,6 +347,7 @@ int main(int argc, char** argv) {
         r.bytes += f.data.size();
         if (f.key) r.key_bytes += f.data.size();
         r.speeds.push_back(f.speed);
+        if (f.bit_depth == 8) ++r.frames_8bit;
         r.psnr.push_back(compare_levels(shown, full[i]).psnr_db);
         r.ssim.push_back(ssim(shown, full[i]));
       }
@@ -360,23 +369,29 @@ int main(int argc, char** argv) {
     }
     std::printf("\n\n");
   }
-  std::printf("| path | speed | setting | KiB/s | Mbit/s | PSNR dB (mean) | PSNR min | SSIM (mean) | encode CPU ms (median) | encode wall ms (median) | encode wall ms (90th pct.) | decode CPU ms (median) | key frame bytes |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("| path | bits | speed | setting | KiB/s | Mbit/s | PSNR dB (mean) | PSNR min | SSIM (mean) | encode CPU ms (median) | encode wall ms (median) | encode wall ms (90th pct.) | decode CPU ms (median) | key frame bytes |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "a");
   for (const Result& r : results) {
     const double bps = r.bytes / seconds;
-    std::printf("| %s | %d | %s%g | %.1f | %.3f | %.2f | %.2f | %.4f | %.2f | %.2f | %.2f | %.2f | %zu |\n",
-                r.path.c_str(), r.speed, r.path == "jpeg" ? "q" : "", r.setting, bps / 1024, bps * 8 / 1e6,
+    std::string bits_cell = std::to_string(r.bits);
+    if (r.bits == 10 && r.frames_8bit > 0) bits_cell += " (8 from frame " + std::to_string(frames - r.frames_8bit) + ")";
+    if (r.path == "jpeg") bits_cell = "8";
+    std::printf("| %s | %s | %d | %s%g | %.1f | %.3f | %.2f | %.2f | %.4f | %.2f | %.2f | %.2f | %.2f | %zu |\n",
+                r.path.c_str(), bits_cell.c_str(), r.speed, r.path == "jpeg" ? "q" : "", r.setting, bps / 1024, bps * 8 / 1e6,
                 mean(r.psnr), *std::min_element(r.psnr.begin(), r.psnr.end()), mean(r.ssim),
                 median(r.encode_ms), median(r.encode_wall_ms), percentile(r.encode_wall_ms, 0.9),
                 median(r.decode_ms), r.key_bytes);
     if (csv) {
       // The last three columns (wall ms, threads, speed) were added after
-      // docs/data/video_bench_{512,1080}.csv were recorded.
-      std::fprintf(csv, "%s,%dx%d,%s,%g,%.1f,%.3f,%.4f,%.3f,%.3f,%.3f,%.4f,%.3f,%d,%d\n", name.c_str(),
+      // docs/data/video_bench_{512,1080}.csv were recorded, the last two
+      // (bits at the start, frames at 8 bits) after
+      // docs/data/video_av1_rc_start_full_range/.
+      std::fprintf(csv, "%s,%dx%d,%s,%g,%.1f,%.3f,%.4f,%.3f,%.3f,%.3f,%.4f,%.3f,%d,%d,%d,%d\n", name.c_str(),
                    width, height, r.path.c_str(), r.setting, bps, mean(r.psnr), mean(r.ssim),
                    median(r.encode_ms), median(r.decode_ms), mean(raw.psnr), mean(raw.ssim),
-                   median(r.encode_wall_ms), r.path == "jpeg" ? 1 : threads, r.speed);
+                   median(r.encode_wall_ms), r.path == "jpeg" ? 1 : threads, r.speed,
+                   r.path == "jpeg" ? 8 : r.bits, r.path == "jpeg" ? frames : r.frames_8bit);
     }
   }
   if (csv) std::fclose(csv);

@@ -86,6 +86,7 @@ json to_json(const QualityReport& q) {
   if (q.bitrate_kbps) j["bitrate_kbps"] = *q.bitrate_kbps;
   if (q.keyframe) j["keyframe"] = *q.keyframe;
   if (q.encoder_speed) j["encoder_speed"] = *q.encoder_speed;
+  if (q.encoder_bit_depth) j["encoder_bit_depth"] = *q.encoder_bit_depth;
   return j;
 }
 
@@ -213,6 +214,7 @@ QualityReport read_quality(const Node& n) {
   q.bitrate_kbps = read_optional<int>(r, "bitrate_kbps", read_int);
   q.keyframe = read_optional<bool>(r, "keyframe", read_bool);
   q.encoder_speed = read_optional<int>(r, "encoder_speed", read_int);
+  q.encoder_bit_depth = read_optional<int>(r, "encoder_bit_depth", read_int);
   q.budget_ms = read_number(r.required("budget_ms"));
   q.estimate_ms = read_number(r.required("estimate_ms"));
   q.frame_ms = read_number(r.required("frame_ms"));

@@ -179,9 +179,10 @@ const nlohmann::json& object_at(const json_read::Node& n, std::string_view what)
   return n.json();
 }
 
-// "video": {"codec": "vp8"|"vp9"|"av1", "bitrate_kbps": N, "keyframe": bool}.
+// "video": {"codec": "vp8"|"vp9"|"av1", "bitrate_kbps": N, "keyframe": bool,
+// "bit_depth": 8|10}.
 VideoParams parse_video_params(const json_read::Node& n) {
-  static constexpr std::string_view kKeys[] = {"codec", "bitrate_kbps", "keyframe"};
+  static constexpr std::string_view kKeys[] = {"codec", "bitrate_kbps", "keyframe", "bit_depth"};
   const json_read::ObjectReader r(n, "video");
   r.allow_only(kKeys);
   VideoParams v;
@@ -192,6 +193,11 @@ VideoParams parse_video_params(const json_read::Node& n) {
         kMaxVideoBitrateKbps));
   }
   if (auto k = r.optional("keyframe")) v.keyframe = json_read::read_bool(*k);
+  if (auto d = r.optional("bit_depth")) {
+    const auto bits = json_read::read_integer(*d);
+    if (bits != 8 && bits != 10) fail("invalid_value", d->path, d->name() + " must be 8 or 10");
+    v.bit_depth = static_cast<int>(bits);
+  }
   return v;
 }
 

@@ -129,12 +129,70 @@ void rgb_to_i420_rows(const Image& src, const I420Planes& dst) {
   }
 }
 
-// A decoded 8-bit I420 picture, libvpx's or libaom's.
+// Full-range BT.601 at 10 bits: the coefficients of FullRange scaled by
+// 1023/255 (an 8-bit sample's share of the 10-bit scale), in 16 fractional
+// bits. Y from one pixel; U and V from the sum of 4 pixels (two more
+// fractional bits), centred on 512.
+constexpr int coefficient10(double c) {
+  const double x = c * 65536.0 * 1023.0 / 255.0;
+  return static_cast<int>(x < 0 ? x - 0.5 : x + 0.5);
+}
+struct FullRange10 {
+  static std::uint16_t y(int r, int g, int b) {
+    constexpr int kr = coefficient10(0.299), kg = coefficient10(0.587), kb = coefficient10(0.114);
+    return static_cast<std::uint16_t>((kr * r + kg * g + kb * b + (1 << 15)) >> 16);
+  }
+  // r, g, b: sums of 4 samples.
+  static std::uint16_t u4(int r, int g, int b) {
+    constexpr int kr = coefficient10(-0.168736), kg = coefficient10(-0.331264), kb = coefficient10(0.5);
+    return static_cast<std::uint16_t>(std::clamp(((kr * r + kg * g + kb * b + (1 << 17)) >> 18) + 512, 0, 1023));
+  }
+  static std::uint16_t v4(int r, int g, int b) {
+    constexpr int kr = coefficient10(0.5), kg = coefficient10(-0.418688), kb = coefficient10(-0.081312);
+    return static_cast<std::uint16_t>(std::clamp(((kr * r + kg * g + kb * b + (1 << 17)) >> 18) + 512, 0, 1023));
+  }
+};
+
+template <int Shift>
+void rgb_to_i010_rows(const Image& src, const I010Planes& dst) {
+  const int w = src.width, h = src.height;
+  auto luma = [](const std::uint16_t* p) { return FullRange10::y(p[0] >> Shift, p[1] >> Shift, p[2] >> Shift); };
+  for (int y0 = 0; y0 < h; y0 += 2) {
+    const bool two_rows = y0 + 1 < h;
+    const std::uint16_t* r0 = src.rgb.data() + 3 * static_cast<std::size_t>(y0) * w;
+    const std::uint16_t* r1 = two_rows ? r0 + 3 * static_cast<std::size_t>(w) : r0;
+    std::uint16_t* y0p = dst.y + static_cast<std::size_t>(y0) * dst.y_stride;
+    for (int x = 0; x < w; ++x) y0p[x] = luma(r0 + 3 * x);
+    if (two_rows) {
+      std::uint16_t* y1p = y0p + dst.y_stride;
+      for (int x = 0; x < w; ++x) y1p[x] = luma(r1 + 3 * x);
+    }
+    std::uint16_t* u = dst.u + static_cast<std::size_t>(y0 / 2) * dst.u_stride;
+    std::uint16_t* v = dst.v + static_cast<std::size_t>(y0 / 2) * dst.v_stride;
+    for (int cx = 0; cx < (w + 1) / 2; ++cx) {
+      // The 2x2 block's sum; at an odd edge the pixels there are counted
+      // twice (or four times), which is their mean times 4.
+      const std::uint16_t* p = r0 + 3 * (2 * cx);
+      const std::uint16_t* q = r1 + 3 * (2 * cx);
+      const int dx = 2 * cx + 1 < w ? 3 : 0;
+      int sum[3];
+      for (int c = 0; c < 3; ++c) {
+        sum[c] = (p[c] >> Shift) + (p[c + dx] >> Shift) + (q[c] >> Shift) + (q[c + dx] >> Shift);
+      }
+      u[cx] = FullRange10::u4(sum[0], sum[1], sum[2]);
+      v[cx] = FullRange10::v4(sum[0], sum[1], sum[2]);
+    }
+  }
+}
+
+// A decoded 4:2:0 picture, libvpx's or libaom's: 8-bit samples, or 16-bit
+// ones holding `bits` (10).
 struct I420View {
   const unsigned char* planes[3];
-  int stride[3];
+  int stride[3];  // bytes
   int w, h;
   ColorRange range = ColorRange::kLimited;
+  int bits = 8;
 };
 
 // vpx_image_t and aom_image_t name their planes (Y, U, V: 0, 1, 2),
@@ -151,7 +209,8 @@ I420View i420_view(const CodecImage& img) {
           {img.stride[0], img.stride[1], img.stride[2]},
           static_cast<int>(img.d_w),
           static_cast<int>(img.d_h),
-          color_range(img)};
+          color_range(img),
+          static_cast<int>(img.bit_depth)};
 }
 
 template <class CodecImage>
@@ -211,25 +270,31 @@ Image i420_to_rgb(const I420View& src) {
   out.height = h;
   out.bit_depth = 8;
   out.rgb.resize(3 * static_cast<std::size_t>(w) * h);
+  BEAMCAST_CHECK(src.bits == 8 || src.range == ColorRange::kFull, "a 10-bit picture is full range");
+  auto sample = [&](int plane, int x, int y) -> double {
+    const unsigned char* row = src.planes[plane] + static_cast<std::size_t>(y) * src.stride[plane];
+    if (src.bits > 8) return reinterpret_cast<const std::uint16_t*>(row)[x];
+    return row[x];
+  };
   auto chroma = [&](int plane, double fx, double fy) {
     const int x0 = std::clamp(static_cast<int>(std::floor(fx)), 0, cw - 1);
     const int y0 = std::clamp(static_cast<int>(std::floor(fy)), 0, ch - 1);
     const int x1 = std::min(x0 + 1, cw - 1), y1 = std::min(y0 + 1, ch - 1);
     const double ax = std::clamp(fx - x0, 0.0, 1.0), ay = std::clamp(fy - y0, 0.0, 1.0);
-    const unsigned char* p = src.planes[plane];
-    const int s = src.stride[plane];
-    auto at = [&](int x, int y) {
-      return static_cast<double>(p[static_cast<std::size_t>(y) * s + x]);
-    };
+    auto at = [&](int x, int y) { return sample(plane, x, y); };
     return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x1, y0)) +
            ay * ((1 - ax) * at(x0, y1) + ax * at(x1, y1));
   };
+  // Full range: samples to the 8-bit scale (x 255/1023 at 10 bits), offset
+  // 128 of it for U and V.
+  const double to8 = src.bits > 8 ? 255.0 / ((1 << src.bits) - 1) : 1.0;
+  const double mid = src.bits > 8 ? (1 << (src.bits - 1)) : 128.0;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const double fx = (x - 0.5) / 2.0, fy = (y - 0.5) / 2.0;
       if (src.range == ColorRange::kFull) {
-        const double l = src.planes[0][static_cast<std::size_t>(y) * src.stride[0] + x];
-        const double cb = chroma(1, fx, fy) - 128.0, cr = chroma(2, fx, fy) - 128.0;
+        const double l = to8 * sample(0, x, y);
+        const double cb = to8 * (chroma(1, fx, fy) - mid), cr = to8 * (chroma(2, fx, fy) - mid);
         std::uint16_t* o = &out.rgb[3 * (static_cast<std::size_t>(y) * w + x)];
         o[0] =
             static_cast<std::uint16_t>(clamp_byte(static_cast<int>(std::lround(l + 1.402 * cr))));
@@ -239,7 +304,7 @@ Image i420_to_rgb(const I420View& src) {
             static_cast<std::uint16_t>(clamp_byte(static_cast<int>(std::lround(l + 1.772 * cb))));
         continue;
       }
-      const int c = src.planes[0][static_cast<std::size_t>(y) * src.stride[0] + x] - 16;
+      const int c = static_cast<int>(sample(0, x, y)) - 16;
       const int d = static_cast<int>(std::lround(chroma(1, fx, fy))) - 128;
       const int e = static_cast<int>(std::lround(chroma(2, fx, fy))) - 128;
       std::uint16_t* o = &out.rgb[3 * (static_cast<std::size_t>(y) * w + x)];
@@ -262,9 +327,13 @@ void rgb_to_i420(const Image& src, const I420Planes& dst, ColorRange range) {
   }
 }
 
-int video_encoder_threads(int width, int height, int cores) {
+void rgb_to_i010(const Image& src, const I010Planes& dst) {
+  src.bit_depth == 16 ? rgb_to_i010_rows<8>(src, dst) : rgb_to_i010_rows<0>(src, dst);
+}
+
+int video_encoder_threads(int width, int height, int cores, int bit_depth) {
   const long long pixels = static_cast<long long>(std::max(0, width)) * std::max(0, height);
-  const long long per_thread = 1LL << 19;
+  const long long per_thread = bit_depth > 8 ? 1LL << 17 : 1LL << 19;
   const long long wanted = std::max(1LL, (pixels + per_thread - 1) / per_thread);
   return static_cast<int>(std::min<long long>(wanted, std::clamp(cores, 1, 4)));
 }
@@ -273,6 +342,10 @@ int video_encoder_speed(VideoCodec codec, int width, int height) {
   if (codec != VideoCodec::kAv1) return 8;
   const long long pixels = static_cast<long long>(std::max(0, width)) * std::max(0, height);
   return pixels <= (1LL << 19) ? 5 : pixels <= (1LL << 21) ? 6 : 8;
+}
+
+int video_encoder_bit_depth(VideoCodec codec, int width, int height, int cores) {
+  return codec == VideoCodec::kAv1 && video_encoder_speed(codec, width, height) <= 5 && cores >= 4 ? 10 : 8;
 }
 
 std::string_view video_codec_name(VideoCodec c) {
@@ -301,11 +374,16 @@ struct VideoEncoder::Impl {
   aom_image_t* aimg = nullptr;
   bool open = false, aopen = false;
   void open_av1(const VideoEncoderSettings& settings, int speed);
+  void close_av1() {
+    if (aimg) aom_img_free(aimg);
+    if (aopen) aom_codec_destroy(&actx);
+    aimg = nullptr;
+    aopen = false;
+  }
   ~Impl() {
     if (img) vpx_img_free(img);
     if (open) vpx_codec_destroy(&ctx);
-    if (aimg) aom_img_free(aimg);
-    if (aopen) aom_codec_destroy(&actx);
+    close_av1();
   }
 };
 
@@ -354,6 +432,13 @@ void set_av1_speed(aom_codec_ctx_t* c, int speed) {
 constexpr unsigned kStartMaxQuantizer = 24;
 constexpr unsigned kMaxQuantizer = 56;
 
+// The fastest speed a 10-bit AV1 stream runs at. libaom 3.6's realtime
+// speeds from 7 on take the non-RD mode search, which at 10 bits crashed (7)
+// or lost 4-5 dB at equal bytes (8, 9) on the demo drag; 5 and 6 are sound.
+// A 10-bit stream that is too slow at 6 goes on at 8 bits (adapt_speed).
+constexpr int kFastest10Bit = 6;
+constexpr int kSlowWindows10Bit = 3;
+
 // AV1 (libaom, realtime usage): one pass, no lag, CBR, no dropped frames,
 // key frames at the start and on request only. Unlike the libvpx streams the
 // key frame is not capped and the rate control's buffer is libaom's default
@@ -378,7 +463,12 @@ void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int spee
   cfg.g_pass = AOM_RC_ONE_PASS;
   cfg.rc_end_usage = AOM_CBR;
   cfg.kf_mode = AOM_KF_DISABLED;
-  if (aom_codec_enc_init(&impl.actx, iface, &cfg, 0) != AOM_CODEC_OK) aom_fail(&impl.actx, "enc_init");
+  const bool ten_bit = settings.bit_depth == 10;
+  cfg.g_bit_depth = ten_bit ? AOM_BITS_10 : AOM_BITS_8;
+  cfg.g_input_bit_depth = ten_bit ? 10 : 8;
+  if (aom_codec_enc_init(&impl.actx, iface, &cfg, ten_bit ? AOM_CODEC_USE_HIGHBITDEPTH : 0) != AOM_CODEC_OK) {
+    aom_fail(&impl.actx, "enc_init");
+  }
   impl.aopen = true;
   aom_codec_ctx_t* c = &impl.actx;
   const bool ok =
@@ -404,8 +494,9 @@ void VideoEncoder::Impl::open_av1(const VideoEncoderSettings& settings, int spee
   set_av1_speed(c, speed);
   cfg.rc_max_quantizer = kMaxQuantizer;  // the rate control's average starts at the start cap
   if (aom_codec_enc_config_set(c, &cfg) != AOM_CODEC_OK) aom_fail(c, "enc_config_set (quantizer range)");
-  impl.aimg = aom_img_alloc(nullptr, AOM_IMG_FMT_I420, cfg.g_w, cfg.g_h, 16);
+  impl.aimg = aom_img_alloc(nullptr, ten_bit ? AOM_IMG_FMT_I42016 : AOM_IMG_FMT_I420, cfg.g_w, cfg.g_h, 16);
   if (!impl.aimg) throw std::runtime_error("libaom: aom_img_alloc failed");
+  impl.aimg->bit_depth = ten_bit ? 10 : 8;
   impl.aimg->range = AOM_CR_FULL_RANGE;
   impl.aimg->mc = AOM_CICP_MC_BT_601;
   impl.aimg->cp = AOM_CICP_CP_BT_709;
@@ -417,11 +508,13 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
   BEAMCAST_CHECK(settings.width > 0 && settings.height > 0, "VideoEncoder: empty frame size");
   if (settings_.speed <= 0) settings_.speed = video_encoder_speed(settings.codec, settings.width, settings.height);
   if (settings.codec == VideoCodec::kAv1) {
-    settings_.speed = std::clamp(settings_.speed, 5, 9);
+    BEAMCAST_CHECK(settings_.bit_depth == 8 || settings_.bit_depth == 10, "VideoEncoder: AV1 is 8- or 10-bit");
+    settings_.speed = std::clamp(settings_.speed, 5, settings_.bit_depth == 10 ? kFastest10Bit : 9);
     base_speed_ = settings_.speed;
     impl_->open_av1(settings_, settings_.speed);
     return;
   }
+  BEAMCAST_CHECK(settings_.bit_depth == 8, "VideoEncoder: VP8 and VP9 are 8-bit");
   const bool vp9 = settings.codec == VideoCodec::kVp9;
   vpx_codec_iface_t* iface = vp9 ? vpx_codec_vp9_cx() : vpx_codec_vp8_cx();
   vpx_codec_enc_cfg_t& cfg = impl_->cfg;
@@ -501,8 +594,28 @@ void VideoEncoder::adapt_speed(double encode_ms) {
   for (double ms : recent_) mean += ms;
   mean /= kWindow;
   int next = settings_.speed;
+  const bool ten_bit = settings_.bit_depth == 10;
   if (mean > settings_.max_encode_ms && next < kFastest) ++next;
   if (mean < 0.5 * settings_.max_encode_ms && next > base_speed_) --next;
+  if (ten_bit && next > kFastest10Bit) {
+    // Too slow at 10 bits' fastest for 3 windows in a row (9 delta frames,
+    // 0.3 s at 30 frames/s: not for a moment's load on the machine, which
+    // the browser test's first frames see): the stream goes on at 8 bits and
+    // the next speed, from a key frame (a new sequence header; it costs about
+    // five frames' bytes), and stays at 8 bits until the encoder is made
+    // again (a new size or codec).
+    recent_.clear();
+    if (++slow_windows_ < kSlowWindows10Bit) return;
+    settings_.bit_depth = 8;
+    settings_.speed = next;
+    base_speed_ = std::max(base_speed_, kFastest10Bit);
+    impl_->close_av1();
+    impl_->open_av1(settings_, next);
+    key_next_ = true;
+    recent_.clear();
+    return;
+  }
+  slow_windows_ = 0;
   if (next == settings_.speed) return;
   set_av1_speed(&impl_->actx, next);
   settings_.speed = next;
@@ -514,8 +627,14 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
                  "VideoEncoder::encode: frame size differs from the encoder's");
   const auto t0 = std::chrono::steady_clock::now();
   const bool av1 = settings_.codec == VideoCodec::kAv1;
+  BEAMCAST_CHECK(!av1 || impl_->aopen, "VideoEncoder: the AV1 encoder failed to reopen at 8 bits");
   // The encoder's picture says its range (set where the encoder opened).
-  if (av1) {
+  if (av1 && settings_.bit_depth == 10) {
+    aom_image_t& a = *impl_->aimg;
+    rgb_to_i010(img, {reinterpret_cast<std::uint16_t*>(a.planes[0]), reinterpret_cast<std::uint16_t*>(a.planes[1]),
+                      reinterpret_cast<std::uint16_t*>(a.planes[2]), a.stride[0] / 2, a.stride[1] / 2,
+                      a.stride[2] / 2});
+  } else if (av1) {
     rgb_to_i420(img, i420_planes(*impl_->aimg), color_range(*impl_->aimg));
   } else {
     rgb_to_i420(img, i420_planes(*impl_->img), color_range(*impl_->img));
@@ -524,7 +643,8 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
   const double gap = frames_ == 0 ? 33.0 : time_ms - last_ms_;
   const auto duration = static_cast<unsigned long>(std::clamp(std::lround(gap), 1L, 1000L));
   last_ms_ = time_ms;
-  const bool key = force_key || frames_ == 0;
+  const bool key = force_key || frames_ == 0 || key_next_;
+  key_next_ = false;
   EncodedVideoFrame out;
   if (av1) {
     if (aom_codec_encode(&impl_->actx, impl_->aimg, pts_ms_, duration,
@@ -551,6 +671,7 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
   out.pts = frames_++;
   BEAMCAST_CHECK(!out.data.empty(), "the encoder gave no packet for a frame (lag 0, no frame dropping)");
   out.speed = settings_.speed;
+  out.bit_depth = settings_.bit_depth;
   out.encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (av1 && settings_.max_encode_ms > 0.0 && !out.key) adapt_speed(out.encode_ms);
   return out;
@@ -572,7 +693,7 @@ VideoDecoder::VideoDecoder(VideoCodec codec) : impl_(std::make_unique<Impl>()) {
   if (codec == VideoCodec::kAv1) {
     aom_codec_dec_cfg_t cfg{};
     cfg.threads = 1;
-    cfg.allow_lowbitdepth = 1;  // 8-bit pictures of an 8-bit stream
+    cfg.allow_lowbitdepth = 1;  // 8-bit pictures of an 8-bit stream (16-bit ones of a 10-bit stream)
     if (aom_codec_dec_init(&impl_->actx, aom_codec_av1_dx(), &cfg, 0) != AOM_CODEC_OK) {
       aom_fail(&impl_->actx, "dec_init");
     }
@@ -596,7 +717,9 @@ Image VideoDecoder::decode(std::span<const std::uint8_t> frame) {
     aom_codec_iter_t iter = nullptr;
     const aom_image_t* img = aom_codec_get_frame(&impl_->actx, &iter);
     if (!img) throw std::runtime_error("libaom: decode: no picture");
-    if (img->fmt != AOM_IMG_FMT_I420) throw std::runtime_error("libaom: decode: not 8-bit I420");
+    const bool ok = img->fmt == AOM_IMG_FMT_I420 ||
+                    (img->fmt == AOM_IMG_FMT_I42016 && img->bit_depth == 10 && img->range == AOM_CR_FULL_RANGE);
+    if (!ok) throw std::runtime_error("libaom: decode: not 8-bit I420 or full-range 10-bit I420");
     return i420_to_rgb(i420_view(*img));
   }
   if (vpx_codec_decode(&impl_->ctx, frame.data(), static_cast<unsigned>(frame.size()), nullptr, 0) !=

@@ -3,8 +3,9 @@
 // alt-ref, constant bitrate, a key frame at the start and on request), and a
 // decoder for the tests and the bench. Pure CPU: no GL, no sockets.
 //
-// Frames are converted from RGB to I420 with BT.601 limited-range
-// coefficients, what a browser assumes for VP8/VP9/AV1 without colour metadata.
+// Frames are converted from RGB to YUV 4:2:0 with the BT.601 matrix: limited
+// range for VP8, full range for VP9 and AV1 (whose streams say so), 10 bits
+// for AV1 where it affords them (rgb_to_i420, rgb_to_i010).
 #pragma once
 
 #include <cstdint>
@@ -41,6 +42,12 @@ struct VideoEncoderSettings {
   // (the preview's 33 ms): the encode and the browser's decode together add
   // about one frame's time.
   double max_encode_ms = 0.0;
+  // The stream's sample depth: 8, or 10 for AV1 (video_encoder_bit_depth()
+  // says when; a 10-bit stream asked for a speed over 6 runs at 6). VP8 and
+  // VP9 streams are 8-bit. A 10-bit stream keeps to speeds 5 and 6 and, when
+  // even 6 is over max_encode_ms, reopens at 8 bits and speed 7 with a key
+  // frame (the frame reports its depth); see video_encoder_bit_depth().
+  int bit_depth = 8;
 };
 
 // The speed (cpu-used) a stream gets by default: VP8 and VP9 8 at any size;
@@ -51,6 +58,20 @@ struct VideoEncoderSettings {
 // time at 30 frames/s on the 2-core machine (docs/performance.md, "Video
 // preview: AV1").
 int video_encoder_speed(VideoCodec codec, int width, int height);
+
+// The sample depth the server gives a stream on `cores` cores: AV1 10 bits
+// where it starts at speed 5 (up to 2^19 pixels) and the machine has at
+// least 4 cores, else 8; VP8 and VP9 8. Ten bits keep the colour conversion
+// and the encoder's predictions finer than a quantizer step at the
+// qualities the preview sends: on the volume's drag at 512² AV1 needs a
+// fifth fewer bytes at equal PSNR, for 1.3-1.5 times the encode CPU, which
+// the stream gets back from a second thread (video_encoder_threads). On 2
+// cores the render competes for both: in the browser test a 10-bit frame at
+// speed 6 took 20-35 ms, over the page's 16.5 ms, and the stream fell back.
+// libaom 3.6's realtime speeds from 7 on are not usable at 10 bits (7
+// crashes, 8 and 9 lose 4-5 dB), hence the fallback to 8 bits
+// (VideoEncoderSettings::bit_depth; docs/performance.md, "Ten-bit AV1").
+int video_encoder_bit_depth(VideoCodec codec, int width, int height, int cores);
 
 // The encoder's colour conversion: RGB (8-bit, or 16-bit whose high byte is
 // kept) to I420 with the BT.601 matrix; U and V are (w+1)/2 x (h+1)/2, each
@@ -73,13 +94,26 @@ struct I420Planes {
   int y_stride, u_stride, v_stride;
 };
 void rgb_to_i420(const Image& src, const I420Planes& dst, ColorRange range = ColorRange::kLimited);
+// The same at 10 bits, full range (Y, U and V 0-1023, U and V centred on
+// 512; BT.601, 16-bit coefficients): 10-bit AV1. U and V come from the sum of
+// their 2x2 block, not its rounded mean (the finer steps keep what the mean's
+// rounding would drop). Strides in samples.
+struct I010Planes {
+  std::uint16_t* y;
+  std::uint16_t* u;
+  std::uint16_t* v;
+  int y_stride, u_stride, v_stride;
+};
+void rgb_to_i010(const Image& src, const I010Planes& dst);
 
-// libvpx threads for one stream of width x height on `cores` cores: one per
+// Encoder threads for one stream of width x height on `cores` cores: one per
 // started 2^19 pixels (a 512x512 frame: 1; 1280x720: 2; 1920x1080: 4), at
-// most 4 and at most `cores`. A stream's frames are encoded one at a time, so
-// only threads inside the encoder shorten what one frame waits for
-// (docs/performance.md, "Video preview", at 1080p).
-int video_encoder_threads(int width, int height, int cores);
+// 10 bits one per started 2^17 (512x512: 2; a 10-bit frame costs 1.3-1.5
+// times the CPU and keeps to speeds 5 and 6), at most 4 and at most
+// `cores`. A stream's frames are encoded one at a time, so only threads
+// inside the encoder shorten what one frame waits for (docs/performance.md,
+// "Video preview", at 1080p, and "Ten-bit AV1").
+int video_encoder_threads(int width, int height, int cores, int bit_depth = 8);
 
 struct EncodedVideoFrame {
   std::vector<std::uint8_t> data;  // one compressed frame (the codec's bitstream)
@@ -88,6 +122,7 @@ struct EncodedVideoFrame {
   int speed = 0;         // the encoder's speed for this frame
   int quantizer = -1;    // the frame's base quantizer, 0-63 (the scale of
                          // rc_max_quantizer)
+  int bit_depth = 8;     // the stream's sample depth at this frame
   double encode_ms = 0;  // wall clock, conversion included
 };
 
@@ -120,6 +155,8 @@ class VideoEncoder {
   std::int64_t pts_ms_ = 0;
   int base_speed_ = 0;          // settings' speed: adaptation does not go below it
   std::vector<double> recent_;  // encode ms of the last (<= 3) delta frames since the last speed change
+  bool key_next_ = false;       // the encoder reopened: its next frame is a key frame
+  int slow_windows_ = 0;        // 10 bits at speed 6: windows in a row over max_encode_ms
   void adapt_speed(double encode_ms);
 };
 

@@ -88,7 +88,9 @@ json hello_result(const ServerCore& core, const json& params, FrameFormat format
                                            : "libpng"},
                        {"quality", {"full", "auto"}},
                        {"video", {{"codecs", {"vp8", "vp9", "av1"}},
-                                  {"bitrate_kbps", core.config.preview_bitrate_kbps}}},
+                                  {"bitrate_kbps", core.config.preview_bitrate_kbps},
+                                  {"bit_depths", {8, 10}},
+                                  {"bit_depth_setting", core.config.preview_bit_depth}}},
                        {"encodings", {"binary", "base64"}},
                        {"batch_window_ms", core.config.batch_window_ms},
                        {"stream", true},
@@ -239,7 +241,8 @@ struct RenderReply {
     if (frame->decision.still) return std::nullopt;
     try {
       VideoFrameReport report =
-          encode_video_frame(vs, *video, core.config.preview_bitrate_kbps, ctx.cameras[0].width,
+          encode_video_frame(vs, *video, core.config.preview_bitrate_kbps,
+                             core.config.preview_bit_depth, ctx.cameras[0].width,
                              ctx.cameras[0].height, ctx.bit_depth, steady_ms(arrived),
                              frame->budget_ms, out);
       ctx.video_codec = report.codec;

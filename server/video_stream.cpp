@@ -13,7 +13,8 @@ void note_video_request(VideoStream& stream, const VideoParams& params) {
 }
 
 VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& params,
-                                    int default_kbps, int width, int height, int bit_depth,
+                                    int default_kbps, const std::string& depth_setting,
+                                    int width, int height, int bit_depth,
                                     double time_ms, double budget_ms, RenderOutcome* out) {
   BEAMCAST_CHECK(out->pngs.size() == 1 && out->is_jpeg.size() == 1 && !out->is_jpeg[0],
                  "a video frame is one raw frame");
@@ -25,11 +26,20 @@ VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& para
   img.height = height;
   img.bit_depth = bit_depth;
   img.rgb = decode_raw_frame(out->pngs[0], width, height, bit_depth, FrameFormat::kRaw);
+  const int cores = usable_cores();
+  int bits = 8;
+  if (codec == VideoCodec::kAv1 && params.bit_depth == 10) {
+    bits = depth_setting == "10"  ? 10
+           : depth_setting == "8" ? 8
+                                  : video_encoder_bit_depth(codec, width, height, cores);
+  }
   VideoEncoder* enc = stream.encoder.get();
   if (!enc || enc->settings().codec != codec || enc->settings().width != width ||
-      enc->settings().height != height) {
-    const int threads = video_encoder_threads(width, height, usable_cores());
-    stream.encoder = std::make_unique<VideoEncoder>(VideoEncoderSettings{codec, width, height, kbps, threads});
+      enc->settings().height != height || stream.opened_bit_depth != bits) {
+    stream.opened_bit_depth = bits;
+    const int threads = video_encoder_threads(width, height, cores, bits);
+    stream.encoder = std::make_unique<VideoEncoder>(
+        VideoEncoderSettings{codec, width, height, kbps, threads, 0, 0.0, bits});
     enc = stream.encoder.get();
   }
   enc->set_bitrate(kbps);
@@ -45,6 +55,7 @@ VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& para
   r.key = f.key;
   r.pts = static_cast<std::uint32_t>(f.pts);
   r.speed = f.speed;
+  r.bit_depth = f.bit_depth;
   r.encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   out->encode_ms[0] += r.encode_ms;
   out->encode_wall_ms += r.encode_ms;
@@ -57,6 +68,7 @@ void set_video_report(const VideoFrameReport& f, QualityReport* q) {
   q->bitrate_kbps = f.bitrate_kbps;
   q->keyframe = f.key;
   q->encoder_speed = f.speed;
+  q->encoder_bit_depth = f.bit_depth;
 }
 
 }  // namespace beamcast

@@ -21,6 +21,7 @@ struct VideoStream {
   // encoder made them (the order a decoder needs).
   std::mutex mu;
   std::unique_ptr<VideoEncoder> encoder;
+  int opened_bit_depth = 8;  // the depth the encoder was made with (it may fall back to 8)
   bool key_pending = false;  // a key frame was asked for and not yet sent
 };
 
@@ -30,6 +31,7 @@ struct VideoFrameReport {
   bool key = false;
   std::uint32_t pts = 0;
   int speed = 0;  // the encoder's speed (cpu-used) for this frame
+  int bit_depth = 8;  // the stream's sample depth at this frame
   double encode_ms = 0.0;
 };
 
@@ -41,13 +43,17 @@ void note_video_request(VideoStream& stream, const VideoParams& params);
 // `bit_depth`, into `stream` and replaces its bytes with the packed video
 // frame (render/video.hpp: the BCV1 header and the codec's frame). A new
 // encoder, and so a key frame, for the first frame, a new codec and a new
-// frame size; the bitrate is params' or `default_kbps`. The encode time is
+// frame size or a new depth; the bitrate is params' or `default_kbps`. The
+// stream's depth: 10 bits for AV1 where the client decodes them
+// (params.bit_depth) and `depth_setting` (the server's --preview-bit-depth:
+// "auto", "8", "10") allows, else 8. The encode time is
 // added to the outcome's encode times (the accuracy controller's frame cost).
 // An AV1 stream's speed follows its encode time against half of `budget_ms`,
 // the frame budget of the request (VideoEncoderSettings::max_encode_ms).
 // Call with stream.mu held. Throws std::runtime_error if the encoder fails.
 VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& params,
-                                    int default_kbps, int width, int height, int bit_depth,
+                                    int default_kbps, const std::string& depth_setting,
+                                    int width, int height, int bit_depth,
                                     double time_ms, double budget_ms, RenderOutcome* out);
 
 // The "quality" block of a video frame: the codec as its format, the

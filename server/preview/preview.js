@@ -61,6 +61,8 @@ const preview = {
   video: {
     want: videoParam === 'off' ? null : videoParam,
     codec: null, reason: 'starting', bitrate_kbps: null,
+    maxBitDepth: 8,  // 10 where the browser decodes 10-bit AV1 (the server may then send it)
+    bitDepth: null,  // the stream's, as the latest video frame's quality block says
     received: 0,     // video frames in
     decoded: 0,      // pictures out of the decoder
     keyframes: 0,    // key frames in
@@ -345,6 +347,7 @@ function renderRequest(camera, motion) {
   const v = preview.video;
   if (v.codec) {
     r.video = {codec: v.codec};
+    if (v.maxBitDepth === 10) r.video.bit_depth = 10;
     if (bitrateKbps) r.video.bitrate_kbps = bitrateKbps;
     if (needKey) r.video.keyframe = true;
   }
@@ -356,9 +359,13 @@ function renderRequest(camera, motion) {
 const isVideoFormat = (format) =>
   format === 'vp8' || format === 'vp9' || format === 'av1' || format === preview.video.codec;
 // WebCodecs codec strings (vp9: profile 0, level 4.1, 8 bits; av1: main
-// profile, level 4.0, 8 bits; h264: constrained baseline, level 3.1, which the
-// server does not encode: the browser test's refused codec); other names are
-// tried as they are, and the server refuses what it does not encode.
+// profile, level 4.0, 8 bits: a browser that decodes AV1 at all is not kept
+// from it by 10 bits it may lack in hardware; the server's 10-bit AV1
+// streams (on 4 cores or more) decode with the same decoder, as the browser
+// test checked with a 10-bit stream and a fall back to 8 bits within it;
+// h264: constrained baseline, level 3.1, which the server does not encode:
+// the browser test's refused codec); other names are tried as they are, and
+// the server refuses what it does not encode.
 const codecStrings = {vp8: 'vp8', vp9: 'vp09.00.41.08', av1: 'av01.0.08M.08', h264: 'avc1.42001f'};
 // What the server's streams carry (render/video.hpp): BT.601 YUV of sRGB
 // pixels, full range for AV1 and VP9, limited for VP8. Given to the decoder
@@ -408,6 +415,9 @@ async function setupVideo() {
   decoderConfig = config;
   v.codec = chosen;
   v.reason = '';
+  // 10-bit AV1 (main profile): asked for only where this browser says it
+  // decodes it; the same decoder takes the stream's 8-bit pictures too.
+  if (chosen === 'av1' && await supported('av01.0.08M.10')) v.maxBitDepth = 10;
   openDecoder();
 }
 
@@ -521,11 +531,12 @@ async function show(res, camera, socket) {
   }
   const q = r.quality || {};
   if (q.bitrate_kbps) preview.video.bitrate_kbps = q.bitrate_kbps;
+  if (q.encoder_bit_depth) preview.video.bitDepth = q.encoder_bit_depth;
   const now = performance.now();
   preview.frames.push({
     t: now, latency_ms: received - sent, level: q.level, levels: q.levels, still: !!q.still,
     reason: q.reason, label: q.label, scale: q.scale, format: f.format, bytes: data.length,
-    keyframe: q.keyframe,
+    keyframe: q.keyframe, encoder_speed: q.encoder_speed, encoder_bit_depth: q.encoder_bit_depth,
     frame_ms: q.frame_ms, budget_ms: q.budget_ms,
     server_ms: r.timings.server_ms, passes: r.passes, socket,
   });
@@ -600,7 +611,8 @@ function updateOverlay() {
   const v = preview.video;
   const path = v.codec
       ? `moving frames: ${v.codec} video (WebCodecs)` +
-        (v.bitrate_kbps ? ` ${v.bitrate_kbps} kbit/s` : '') + `, ${v.decoded} decoded` +
+        (v.bitrate_kbps ? ` ${v.bitrate_kbps} kbit/s` : '') +
+        (v.bitDepth ? ` ${v.bitDepth}-bit` : '') + `, ${v.decoded} decoded` +
         (v.errors.length ? `, ${v.errors.length} decoder errors, ${v.recoveries} recovered` : '')
       : `moving frames: JPEG (${v.reason})`;
   overlay.textContent =

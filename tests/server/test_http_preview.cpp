@@ -237,9 +237,12 @@ TEST(InteractiveQuality, MovingFramesAreReducedAndTheStillFrameIsExact) {
 // one VP8 stream (a key frame first, then predicted frames, a key frame on
 // request and on a new frame size), the still frame stays PNG and exact,
 // bad video params are errors naming the field, and a change of codec (to
-// AV1) starts a new stream. Costs ~1 s (llvmpipe, 64x64).
+// AV1, at 10 bits for a client that asks, then at 8) starts a new stream.
+// Costs ~1 s (llvmpipe, 64x64).
 TEST(InteractiveQuality, VideoFramesAreOneStreamAndTheStillFrameStaysExact) {
-  HttpTestServer s;
+  ServerConfig config;
+  config.preview_bit_depth = "10";  // AV1 at 10 bits for clients that decode them, on any machine
+  HttpTestServer s(config);
   store_demo(s.core());
   WsClient ws(s.http_port());
   const int size = 64;
@@ -266,6 +269,7 @@ TEST(InteractiveQuality, VideoFramesAreOneStreamAndTheStillFrameStaysExact) {
     const bool key = i == 0 || i == 3;
     EXPECT_EQ(v.key, key) << "frame " << i;
     EXPECT_EQ(q["keyframe"], key);
+    EXPECT_EQ(q["encoder_bit_depth"], 8) << "VP8 is 8-bit";
     EXPECT_EQ(v.pts, static_cast<std::uint32_t>(i));
     const Image img = dec.decode(v.data);
     EXPECT_EQ(img.width, size);
@@ -307,6 +311,10 @@ TEST(InteractiveQuality, VideoFramesAreOneStreamAndTheStillFrameStaysExact) {
   refused(33, {{"video", {{"bitrate_kbps", 500}}}}, "missing_field", "/params/video/codec");
   refused(34, {{"video", {{"codec", "vp8"}, {"gop", 5}}}}, "unknown_field", "/params/video/gop");
   refused(35, {{"video", "vp8"}}, "wrong_type", "/params/video");
+  refused(38, {{"video", {{"codec", "av1"}, {"bit_depth", 12}}}}, "invalid_value",
+          "/params/video/bit_depth");
+  refused(39, {{"video", {{"codec", "av1"}, {"bit_depth", "10"}}}}, "wrong_type",
+          "/params/video/bit_depth");
   json two = auto_render(36, 0.5, size, video);
   json second = camera(0.6, size);
   second["name"] = "second";
@@ -325,19 +333,23 @@ TEST(InteractiveQuality, VideoFramesAreOneStreamAndTheStillFrameStaysExact) {
   EXPECT_EQ(r.j["result"]["frames"][0]["format"], "vp8");
 
   // Another codec on the same connection: a new AV1 stream (a key frame
-  // numbered 0, then a predicted frame), decoded by libaom.
-  const json av1 = {{"budget_ms", 10000}, {"still_ms", 60000}, {"video", {{"codec", "av1"}}}};
+  // numbered 0, then a predicted frame), decoded by libaom: 10-bit for a
+  // client that says it decodes 10 bits (the server set to 10), then, when
+  // the client no longer says so, a new 8-bit stream.
+  json av1 = {{"budget_ms", 10000}, {"still_ms", 60000}, {"video", {{"codec", "av1"}, {"bit_depth", 10}}}};
   VideoDecoder av1_dec(VideoCodec::kAv1);
-  for (int i = 0; i < 2; ++i) {
+  for (int i = 0; i < 4; ++i) {
+    if (i == 2) av1["video"].erase("bit_depth");
     r = ws.call(auto_render(50 + i, 0.8 + 0.05 * i, size, av1));
     ASSERT_TRUE(r.j["ok"]) << r.j.dump();
     EXPECT_EQ(r.j["result"]["frames"][0]["format"], "av1");
     EXPECT_EQ(r.j["result"]["quality"]["format"], "av1");
+    EXPECT_EQ(r.j["result"]["quality"]["encoder_bit_depth"], i < 2 ? 10 : 8) << "frame " << i;
     const std::vector<std::uint8_t> bytes = ws.frame(r);
     const VideoFrameView v = unpack_video_frame(bytes);
     EXPECT_EQ(v.codec, VideoCodec::kAv1);
-    EXPECT_EQ(v.key, i == 0) << "frame " << i;
-    EXPECT_EQ(v.pts, static_cast<std::uint32_t>(i));
+    EXPECT_EQ(v.key, i == 0 || i == 2) << "frame " << i;
+    EXPECT_EQ(v.pts, static_cast<std::uint32_t>(i % 2));
     EXPECT_EQ(av1_dec.decode(v.data).width, size);
   }
 }
