@@ -344,8 +344,12 @@ int video_encoder_speed(VideoCodec codec, int width, int height) {
   return pixels <= (1LL << 19) ? 5 : pixels <= (1LL << 21) ? 6 : 8;
 }
 
+bool video_ten_bit_sound(int width, int height) { return std::min(width, height) < 1080; }
+
 int video_encoder_bit_depth(VideoCodec codec, int width, int height, int cores) {
-  return codec == VideoCodec::kAv1 && video_encoder_speed(codec, width, height) <= 5 && cores >= 4 ? 10 : 8;
+  const bool ten = codec == VideoCodec::kAv1 && video_encoder_speed(codec, width, height) <= 5 &&
+                   cores >= 4 && video_ten_bit_sound(width, height);
+  return ten ? 10 : 8;
 }
 
 std::string_view video_codec_name(VideoCodec c) {

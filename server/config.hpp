@@ -64,8 +64,9 @@ struct ServerConfig {
   int preview_bitrate_kbps = 1000;
   // AV1 preview streams' sample depth for clients that decode 10 bits
   // ("video": {"bit_depth": 10}): "auto" (video_encoder_bit_depth: 10 up to
-  // 2^19 pixels on 4 cores or more), "8" or "10" (any size; a stream too
-  // slow at 10 bits falls back to 8 within itself).
+  // 2^19 pixels on 4 cores or more), "8" or "10" (any machine, frames whose
+  // shorter side is under 1080: video_ten_bit_sound; a stream too slow at 10 bits
+  // falls back to 8 within itself).
   std::string preview_bit_depth = "auto";
   std::filesystem::path assets_dir;
 

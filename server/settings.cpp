@@ -142,8 +142,8 @@ const std::vector<Setting>& settings_table() {
               .type = SettingType::kText,
               .choices = {"auto", "8", "10"},
               .help = "Sample depth of AV1 preview streams for clients that decode 10 bits: auto "
-                      "(10 up to 2^19 pixels a frame on 4 cores or more, else 8), 8 or 10 (a "
-                      "stream too slow at 10 bits goes on at 8)",
+                      "(10 up to 2^19 pixels a frame on 4 cores or more, else 8), 8 or 10 (a shorter side under "
+                      "1080 pixels; a stream too slow at 10 bits goes on at 8)",
               .get = [](const ServerConfig& c) -> json { return c.preview_bit_depth; },
               .set = [](ServerConfig& c, const json& v) { c.preview_bit_depth = v.get<std::string>(); }},
       Setting{.name = "png_encoder",

@@ -28,7 +28,7 @@ VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& para
   img.rgb = decode_raw_frame(out->pngs[0], width, height, bit_depth, FrameFormat::kRaw);
   const int cores = usable_cores();
   int bits = 8;
-  if (codec == VideoCodec::kAv1 && params.bit_depth == 10) {
+  if (codec == VideoCodec::kAv1 && params.bit_depth == 10 && video_ten_bit_sound(width, height)) {
     bits = depth_setting == "10"  ? 10
            : depth_setting == "8" ? 8
                                   : video_encoder_bit_depth(codec, width, height, cores);

@@ -120,21 +120,24 @@ Image noise_picture(int w, int h, int depth) {
   return img;
 }
 
-// rgb_to_i420 in `range` against the matrix evaluated pixel by pixel from
-// its definition: Y of each pixel, U and V of the rounded mean of each 2x2
-// block (or of what an odd edge leaves), each within `tolerance` of
+// A colour conversion against the matrix evaluated pixel by pixel from its
+// definition: `convert(img, y, u, v, y_stride, u_stride, v_stride)` fills
+// planes of `Sample`; Y of each pixel, U and V of the mean of each 2x2 block
+// (or of what an odd edge leaves; rounded to integers where `rounded_mean`,
+// as rgb_to_i420 does, exact otherwise), each within `tolerance` of
 // want_y/u/v(r, g, b) of the 8-bit samples. Odd and even sizes, one-pixel
 // rows and columns, 8- and 16-bit samples, planes with padded strides.
-template <class Y, class U, class V>
-void expect_conversion(ColorRange range, Y want_y, U want_u, V want_v, double tolerance) {
+template <class Sample, class Convert, class Y, class U, class V>
+void expect_conversion(Convert convert, bool rounded_mean, Y want_y, U want_u, V want_v,
+                       double tolerance) {
   for (const int w : {1, 2, 3, 17, 64}) {
     for (const int h : {1, 2, 5, 33}) {
       for (const int depth : {8, 16}) {
         const Image img = noise_picture(w, h, depth);
         const int cw = (w + 1) / 2, ch = (h + 1) / 2;
-        std::vector<std::uint8_t> y(static_cast<std::size_t>(w + 3) * h),
+        std::vector<Sample> y(static_cast<std::size_t>(w + 3) * h),
             u(static_cast<std::size_t>(cw + 1) * ch), v(static_cast<std::size_t>(cw + 2) * ch);
-        rgb_to_i420(img, {y.data(), u.data(), v.data(), w + 3, cw + 1, cw + 2}, range);
+        convert(img, y.data(), u.data(), v.data(), w + 3, cw + 1, cw + 2);
         auto sample = [&](int x, int yy, int c) {
           return img.rgb[3 * (static_cast<std::size_t>(yy) * w + x) + c] >> (depth == 16 ? 8 : 0);
         };
@@ -147,21 +150,22 @@ void expect_conversion(ColorRange range, Y want_y, U want_u, V want_v, double to
         }
         for (int cy = 0; cy < ch; ++cy) {
           for (int cx = 0; cx < cw; ++cx) {
-            int r = 0, g = 0, b = 0, n = 0;
+            int sum[3] = {0, 0, 0}, n = 0;
             for (int yy = 2 * cy; yy < std::min(h, 2 * cy + 2); ++yy) {
               for (int x = 2 * cx; x < std::min(w, 2 * cx + 2); ++x) {
-                r += sample(x, yy, 0);
-                g += sample(x, yy, 1);
-                b += sample(x, yy, 2);
+                for (int c = 0; c < 3; ++c) sum[c] += sample(x, yy, c);
                 ++n;
               }
             }
-            r = (r + n / 2) / n;
-            g = (g + n / 2) / n;
-            b = (b + n / 2) / n;
-            ASSERT_NEAR(u[static_cast<std::size_t>(cy) * (cw + 1) + cx], want_u(r, g, b), tolerance)
+            double mean[3];
+            for (int c = 0; c < 3; ++c) {
+              mean[c] = rounded_mean ? (sum[c] + n / 2) / n : static_cast<double>(sum[c]) / n;
+            }
+            ASSERT_NEAR(u[static_cast<std::size_t>(cy) * (cw + 1) + cx], want_u(mean[0], mean[1], mean[2]),
+                        tolerance)
                 << w << "x" << h << " depth " << depth << " U at " << cx << "," << cy;
-            ASSERT_NEAR(v[static_cast<std::size_t>(cy) * (cw + 2) + cx], want_v(r, g, b), tolerance)
+            ASSERT_NEAR(v[static_cast<std::size_t>(cy) * (cw + 2) + cx], want_v(mean[0], mean[1], mean[2]),
+                        tolerance)
                 << w << "x" << h << " depth " << depth << " V at " << cx << "," << cy;
           }
         }
@@ -170,10 +174,20 @@ void expect_conversion(ColorRange range, Y want_y, U want_u, V want_v, double to
   }
 }
 
+// rgb_to_i420 in `range`, the mean of a 2x2 block rounded to integers.
+template <class Y, class U, class V>
+void expect_i420(ColorRange range, Y want_y, U want_u, V want_v, double tolerance) {
+  expect_conversion<std::uint8_t>(
+      [range](const Image& img, std::uint8_t* y, std::uint8_t* u, std::uint8_t* v, int ys, int us, int vs) {
+        rgb_to_i420(img, {y, u, v, ys, us, vs}, range);
+      },
+      true, want_y, want_u, want_v, tolerance);
+}
+
 // Limited range (VP8's) against the integer form of the BT.601
 // limited-range matrix, exactly: the fast row form must give the same bytes.
 TEST(VideoFrames, ConversionMatchesTheMatrix) {
-  expect_conversion(
+  expect_i420(
       ColorRange::kLimited,
       [](int r, int g, int b) { return ((66 * r + 129 * g + 25 * b + 128) >> 8) + 16; },
       [](int r, int g, int b) { return ((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128; },
@@ -185,7 +199,7 @@ TEST(VideoFrames, ConversionMatchesTheMatrix) {
 // rounded, within 0.51 (the 16-bit coefficients move a value by at most
 // 0.002, which can tip a rounding at .5).
 TEST(VideoFrames, FullRangeConversionMatchesTheMatrix) {
-  expect_conversion(
+  expect_i420(
       ColorRange::kFull, [](int r, int g, int b) { return 0.299 * r + 0.587 * g + 0.114 * b; },
       [](int r, int g, int b) {
         return std::clamp(128.0 - 0.168736 * r - 0.331264 * g + 0.5 * b, 0.0, 255.0);
@@ -369,50 +383,18 @@ TEST(VideoFrames, Av1SpeedFollowsTheEncodeTime) {
 // one-pixel rows and columns, 8- and 16-bit samples, padded strides.
 TEST(VideoFrames, TenBitConversionMatchesTheMatrix) {
   const double k = 1023.0 / 255.0;
-  for (const int w : {1, 2, 3, 17, 64}) {
-    for (const int h : {1, 2, 5, 33}) {
-      for (const int depth : {8, 16}) {
-        const Image img = noise_picture(w, h, depth);
-        const int cw = (w + 1) / 2, ch = (h + 1) / 2;
-        std::vector<std::uint16_t> y(static_cast<std::size_t>(w + 3) * h),
-            u(static_cast<std::size_t>(cw + 1) * ch), v(static_cast<std::size_t>(cw + 2) * ch);
-        rgb_to_i010(img, {y.data(), u.data(), v.data(), w + 3, cw + 1, cw + 2});
-        auto sample = [&](int x, int yy, int c) {
-          return img.rgb[3 * (static_cast<std::size_t>(yy) * w + x) + c] >> (depth == 16 ? 8 : 0);
-        };
-        for (int yy = 0; yy < h; ++yy) {
-          for (int x = 0; x < w; ++x) {
-            const double want = k * (0.299 * sample(x, yy, 0) + 0.587 * sample(x, yy, 1) + 0.114 * sample(x, yy, 2));
-            ASSERT_NEAR(y[static_cast<std::size_t>(yy) * (w + 3) + x], want, 0.51)
-                << w << "x" << h << " depth " << depth << " Y at " << x << "," << yy;
-          }
-        }
-        for (int cy = 0; cy < ch; ++cy) {
-          for (int cx = 0; cx < cw; ++cx) {
-            double r = 0, g = 0, b = 0;
-            int n = 0;
-            for (int yy = 2 * cy; yy < std::min(h, 2 * cy + 2); ++yy) {
-              for (int x = 2 * cx; x < std::min(w, 2 * cx + 2); ++x) {
-                r += sample(x, yy, 0);
-                g += sample(x, yy, 1);
-                b += sample(x, yy, 2);
-                ++n;
-              }
-            }
-            r /= n;
-            g /= n;
-            b /= n;
-            const double want_u = std::clamp(512.0 + k * (-0.168736 * r - 0.331264 * g + 0.5 * b), 0.0, 1023.0);
-            const double want_v = std::clamp(512.0 + k * (0.5 * r - 0.418688 * g - 0.081312 * b), 0.0, 1023.0);
-            ASSERT_NEAR(u[static_cast<std::size_t>(cy) * (cw + 1) + cx], want_u, 0.51)
-                << w << "x" << h << " depth " << depth << " U at " << cx << "," << cy;
-            ASSERT_NEAR(v[static_cast<std::size_t>(cy) * (cw + 2) + cx], want_v, 0.51)
-                << w << "x" << h << " depth " << depth << " V at " << cx << "," << cy;
-          }
-        }
-      }
-    }
-  }
+  expect_conversion<std::uint16_t>(
+      [](const Image& img, std::uint16_t* y, std::uint16_t* u, std::uint16_t* v, int ys, int us, int vs) {
+        rgb_to_i010(img, {y, u, v, ys, us, vs});
+      },
+      false, [k](double r, double g, double b) { return k * (0.299 * r + 0.587 * g + 0.114 * b); },
+      [k](double r, double g, double b) {
+        return std::clamp(512.0 + k * (-0.168736 * r - 0.331264 * g + 0.5 * b), 0.0, 1023.0);
+      },
+      [k](double r, double g, double b) {
+        return std::clamp(512.0 + k * (0.5 * r - 0.418688 * g - 0.081312 * b), 0.0, 1023.0);
+      },
+      0.51);
 }
 
 // A 10-bit AV1 stream keeps to speeds 5 and 6 (libaom 3.6 crashes at 7 at 10
@@ -454,9 +436,9 @@ TEST(VideoFrames, TenBitAv1FallsBackToEightBitsWhenTooSlow) {
 }
 
 // The server's depth: AV1 10 bits where it starts at speed 5 (up to 2^19
-// pixels) on a machine of 4 cores or more; 8 otherwise and for libvpx. An
-// encoder is 8-bit unless told; a 10-bit one asked for speed 9 runs at 6,
-// and VP9 cannot be 10-bit here.
+// pixels) on a machine of 4 cores or more, its shorter side under 1080; 8
+// otherwise and for libvpx. An encoder is 8-bit unless told; a 10-bit one
+// asked for speed 9 runs at 6, and VP9 cannot be 10-bit here.
 TEST(VideoFrames, BitDepthFollowsCodecSizeAndCores) {
   EXPECT_EQ(video_encoder_bit_depth(VideoCodec::kAv1, 512, 512, 4), 10);
   EXPECT_EQ(video_encoder_bit_depth(VideoCodec::kAv1, 1024, 512, 16), 10);
@@ -464,6 +446,11 @@ TEST(VideoFrames, BitDepthFollowsCodecSizeAndCores) {
   EXPECT_EQ(video_encoder_bit_depth(VideoCodec::kAv1, 1920, 1080, 16), 8);
   EXPECT_EQ(video_encoder_bit_depth(VideoCodec::kVp9, 512, 512, 16), 8);
   EXPECT_EQ(video_encoder_bit_depth(VideoCodec::kVp8, 512, 512, 16), 8);
+  EXPECT_EQ(video_encoder_bit_depth(VideoCodec::kAv1, 1080, 240, 16), 10);
+  EXPECT_TRUE(video_ten_bit_sound(1600, 900));
+  EXPECT_FALSE(video_ten_bit_sound(1440, 1080));
+  EXPECT_FALSE(video_ten_bit_sound(1080, 1920));
+  EXPECT_TRUE(video_ten_bit_sound(400, 1080));
   EXPECT_EQ(VideoEncoder({VideoCodec::kAv1, 64, 48, 500, 1}).settings().bit_depth, 8);
   EXPECT_EQ(VideoEncoder({VideoCodec::kAv1, 64, 48, 500, 1, 0, 0.0, 10}).settings().bit_depth, 10);
   EXPECT_EQ(VideoEncoder({VideoCodec::kAv1, 64, 48, 500, 1, 9, 0.0, 10}).settings().speed, 6);
