@@ -64,7 +64,7 @@ int video_encoder_speed(VideoCodec codec, int width, int height);
 // least 4 cores, else 8; VP8 and VP9 8. Ten bits keep the colour conversion
 // and the encoder's predictions finer than a quantizer step at the
 // qualities the preview sends: on the volume's drag at 512² AV1 needs a
-// fifth fewer bytes at equal PSNR, for 1.3-1.5 times the encode CPU, which
+// fifth fewer bytes at equal PSNR, for 1.1-2 times the encode CPU, which
 // the stream gets back from a second thread (video_encoder_threads). On 2
 // cores the render competes for both: in the browser test a 10-bit frame at
 // speed 6 took 20-35 ms, over the page's 16.5 ms, and the stream fell back.
@@ -116,7 +116,7 @@ void rgb_to_i010(const Image& src, const I010Planes& dst);
 
 // Encoder threads for one stream of width x height on `cores` cores: one per
 // started 2^19 pixels (a 512x512 frame: 1; 1280x720: 2; 1920x1080: 4), at
-// 10 bits one per started 2^17 (512x512: 2; a 10-bit frame costs 1.3-1.5
+// 10 bits one per started 2^17 (512x512: 2; a 10-bit frame costs 1.1-2
 // times the CPU and keeps to speeds 5 and 6), at most 4 and at most
 // `cores`. A stream's frames are encoded one at a time, so only threads
 // inside the encoder shorten what one frame waits for (docs/performance.md,

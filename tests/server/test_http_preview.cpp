@@ -245,6 +245,11 @@ TEST(InteractiveQuality, VideoFramesAreOneStreamAndTheStillFrameStaysExact) {
   HttpTestServer s(config);
   store_demo(s.core());
   WsClient ws(s.http_port());
+  // hello says what a client may ask for and how the server is set.
+  const auto hello = ws.call({{"id", 0}, {"method", "hello"}, {"params", {{"protocol", 1}}}});
+  ASSERT_TRUE(hello.j["ok"]) << hello.j.dump();
+  EXPECT_EQ(hello.j["result"]["capabilities"]["video"]["bit_depths"], json::array({8, 10}));
+  EXPECT_EQ(hello.j["result"]["capabilities"]["video"]["bit_depth_setting"], "10");
   const int size = 64;
   const json video = {{"budget_ms", 10000}, {"still_ms", 60000},
                       {"video", {{"codec", "vp8"}, {"bitrate_kbps", 400}}}};
