@@ -68,67 +68,6 @@ struct FullRange {
   }
 };
 
-// One pass over row pairs: Y of both rows, then U and V of each 2x2 block
-// from the rounded mean of its pixels (an odd last row or column averages
-// what there is). Shift keeps the high byte of 16-bit samples. Written for
-// speed (issue 42: at 1920x1080 the per-pixel form took ~15 ms of a frame's
-// encode); the tests VideoFrames.ConversionMatchesTheMatrix and
-// FullRangeConversionMatchesTheMatrix check it against the matrix pixel by
-// pixel.
-template <int Shift, class Range>
-void rgb_to_i420_rows(const Image& src, const I420Planes& dst) {
-  const int w = src.width, h = src.height;
-  const int ys = dst.y_stride, us = dst.u_stride, vs = dst.v_stride;
-  auto luma = [](const std::uint16_t* p) { return Range::y(p[0] >> Shift, p[1] >> Shift, p[2] >> Shift); };
-  for (int y0 = 0; y0 < h; y0 += 2) {
-    const bool two_rows = y0 + 1 < h;
-    const std::uint16_t* r0 = src.rgb.data() + 3 * static_cast<std::size_t>(y0) * w;
-    const std::uint16_t* r1 = r0 + 3 * static_cast<std::size_t>(w);  // read only if two_rows
-    unsigned char* y0p = dst.y + static_cast<std::size_t>(y0) * ys;
-    for (int x = 0; x < w; ++x) y0p[x] = luma(r0 + 3 * x);
-    if (two_rows) {
-      unsigned char* y1p = y0p + ys;
-      for (int x = 0; x < w; ++x) y1p[x] = luma(r1 + 3 * x);
-    }
-    unsigned char* u = dst.u + static_cast<std::size_t>(y0 / 2) * us;
-    unsigned char* v = dst.v + static_cast<std::size_t>(y0 / 2) * vs;
-    for (int cx = 0; cx < (w + 1) / 2; ++cx) {
-      const int x = 2 * cx;
-      const bool two_cols = x + 1 < w;
-      const std::uint16_t* p = r0 + 3 * x;
-      const std::uint16_t* q = two_rows ? r1 + 3 * x : p;
-      int r = p[0] >> Shift, g = p[1] >> Shift, b = p[2] >> Shift;
-      if (two_cols) {
-        r += p[3] >> Shift;
-        g += p[4] >> Shift;
-        b += p[5] >> Shift;
-      }
-      if (two_rows) {
-        r += q[0] >> Shift;
-        g += q[1] >> Shift;
-        b += q[2] >> Shift;
-        if (two_cols) {
-          r += q[3] >> Shift;
-          g += q[4] >> Shift;
-          b += q[5] >> Shift;
-        }
-      }
-      if (two_rows && two_cols) {
-        r = (r + 2) >> 2;
-        g = (g + 2) >> 2;
-        b = (b + 2) >> 2;
-      } else {
-        const int n = (two_rows ? 2 : 1) * (two_cols ? 2 : 1);
-        r = (r + n / 2) / n;
-        g = (g + n / 2) / n;
-        b = (b + n / 2) / n;
-      }
-      u[cx] = Range::u(r, g, b);
-      v[cx] = Range::v(r, g, b);
-    }
-  }
-}
-
 // Full-range BT.601 at 10 bits: the coefficients of FullRange scaled by
 // 1023/255 (an 8-bit sample's share of the 10-bit scale), in 16 fractional
 // bits. Y from one pixel; U and V from the sum of 4 pixels (two more
@@ -138,6 +77,7 @@ constexpr int coefficient10(double c) {
   return static_cast<int>(x < 0 ? x - 0.5 : x + 0.5);
 }
 struct FullRange10 {
+  static constexpr bool kFromSum = true;  // U and V from the 2x2 sum (u4, v4)
   static std::uint16_t y(int r, int g, int b) {
     constexpr int kr = coefficient10(0.299), kg = coefficient10(0.587), kb = coefficient10(0.114);
     return static_cast<std::uint16_t>((kr * r + kg * g + kb * b + (1 << 15)) >> 16);
@@ -153,34 +93,52 @@ struct FullRange10 {
   }
 };
 
-template <int Shift>
-void rgb_to_i010_rows(const Image& src, const I010Planes& dst) {
+// One pass over row pairs: Y of both rows, then U and V of each 2x2 block
+// from the sum of its pixels, where an odd last row or column counts its
+// pixels twice (or four times), which is 4 times their mean. 8-bit ranges
+// take the rounded mean, (sum + 2) >> 2, which is the rounded mean of the
+// pixels there are; FullRange10 (kFromSum) the sum itself. Shift keeps the
+// high byte of 16-bit samples. Written for speed (issue 42: at 1920x1080 the
+// per-pixel form took ~15 ms of a frame's encode); the tests
+// VideoFrames.*ConversionMatchesTheMatrix check it against the matrix pixel
+// by pixel. Planes: I420Planes (8-bit samples) or I010Planes (16-bit).
+template <class Range>
+constexpr bool from_sum() {
+  if constexpr (requires { Range::kFromSum; }) return Range::kFromSum;
+  return false;
+}
+
+template <int Shift, class Range, class Planes>
+void rgb_to_yuv420_rows(const Image& src, const Planes& dst) {
   const int w = src.width, h = src.height;
-  auto luma = [](const std::uint16_t* p) { return FullRange10::y(p[0] >> Shift, p[1] >> Shift, p[2] >> Shift); };
+  auto luma = [](const std::uint16_t* p) { return Range::y(p[0] >> Shift, p[1] >> Shift, p[2] >> Shift); };
   for (int y0 = 0; y0 < h; y0 += 2) {
     const bool two_rows = y0 + 1 < h;
     const std::uint16_t* r0 = src.rgb.data() + 3 * static_cast<std::size_t>(y0) * w;
     const std::uint16_t* r1 = two_rows ? r0 + 3 * static_cast<std::size_t>(w) : r0;
-    std::uint16_t* y0p = dst.y + static_cast<std::size_t>(y0) * dst.y_stride;
+    auto* y0p = dst.y + static_cast<std::size_t>(y0) * dst.y_stride;
     for (int x = 0; x < w; ++x) y0p[x] = luma(r0 + 3 * x);
     if (two_rows) {
-      std::uint16_t* y1p = y0p + dst.y_stride;
+      auto* y1p = y0p + dst.y_stride;
       for (int x = 0; x < w; ++x) y1p[x] = luma(r1 + 3 * x);
     }
-    std::uint16_t* u = dst.u + static_cast<std::size_t>(y0 / 2) * dst.u_stride;
-    std::uint16_t* v = dst.v + static_cast<std::size_t>(y0 / 2) * dst.v_stride;
+    auto* u = dst.u + static_cast<std::size_t>(y0 / 2) * dst.u_stride;
+    auto* v = dst.v + static_cast<std::size_t>(y0 / 2) * dst.v_stride;
     for (int cx = 0; cx < (w + 1) / 2; ++cx) {
-      // The 2x2 block's sum; at an odd edge the pixels there are counted
-      // twice (or four times), which is their mean times 4.
       const std::uint16_t* p = r0 + 3 * (2 * cx);
       const std::uint16_t* q = r1 + 3 * (2 * cx);
       const int dx = 2 * cx + 1 < w ? 3 : 0;
-      int sum[3];
-      for (int c = 0; c < 3; ++c) {
-        sum[c] = (p[c] >> Shift) + (p[c + dx] >> Shift) + (q[c] >> Shift) + (q[c + dx] >> Shift);
+      const int r = (p[0] >> Shift) + (p[dx] >> Shift) + (q[0] >> Shift) + (q[dx] >> Shift);
+      const int g = (p[1] >> Shift) + (p[dx + 1] >> Shift) + (q[1] >> Shift) + (q[dx + 1] >> Shift);
+      const int b = (p[2] >> Shift) + (p[dx + 2] >> Shift) + (q[2] >> Shift) + (q[dx + 2] >> Shift);
+      if constexpr (from_sum<Range>()) {
+        u[cx] = Range::u4(r, g, b);
+        v[cx] = Range::v4(r, g, b);
+      } else {
+        const int rm = (r + 2) >> 2, gm = (g + 2) >> 2, bm = (b + 2) >> 2;
+        u[cx] = Range::u(rm, gm, bm);
+        v[cx] = Range::v(rm, gm, bm);
       }
-      u[cx] = FullRange10::u4(sum[0], sum[1], sum[2]);
-      v[cx] = FullRange10::v4(sum[0], sum[1], sum[2]);
     }
   }
 }
@@ -216,6 +174,12 @@ I420View i420_view(const CodecImage& img) {
 template <class CodecImage>
 I420Planes i420_planes(CodecImage& img) {
   return {img.planes[0], img.planes[1], img.planes[2], img.stride[0], img.stride[1], img.stride[2]};
+}
+
+// libaom's 16-bit picture (AOM_IMG_FMT_I42016): strides in bytes, halved.
+I010Planes i010_planes(aom_image_t& img) {
+  auto plane = [&](int i) { return reinterpret_cast<std::uint16_t*>(img.planes[i]); };
+  return {plane(0), plane(1), plane(2), img.stride[0] / 2, img.stride[1] / 2, img.stride[2] / 2};
 }
 
 // The settings every stream shares, in libvpx's or libaom's encoder config
@@ -321,14 +285,15 @@ Image i420_to_rgb(const I420View& src) {
 void rgb_to_i420(const Image& src, const I420Planes& dst, ColorRange range) {
   const bool wide = src.bit_depth == 16;
   if (range == ColorRange::kFull) {
-    wide ? rgb_to_i420_rows<8, FullRange>(src, dst) : rgb_to_i420_rows<0, FullRange>(src, dst);
+    wide ? rgb_to_yuv420_rows<8, FullRange>(src, dst) : rgb_to_yuv420_rows<0, FullRange>(src, dst);
   } else {
-    wide ? rgb_to_i420_rows<8, LimitedRange>(src, dst) : rgb_to_i420_rows<0, LimitedRange>(src, dst);
+    wide ? rgb_to_yuv420_rows<8, LimitedRange>(src, dst) : rgb_to_yuv420_rows<0, LimitedRange>(src, dst);
   }
 }
 
 void rgb_to_i010(const Image& src, const I010Planes& dst) {
-  src.bit_depth == 16 ? rgb_to_i010_rows<8>(src, dst) : rgb_to_i010_rows<0>(src, dst);
+  src.bit_depth == 16 ? rgb_to_yuv420_rows<8, FullRange10>(src, dst)
+                       : rgb_to_yuv420_rows<0, FullRange10>(src, dst);
 }
 
 int video_encoder_threads(int width, int height, int cores, int bit_depth) {
@@ -616,7 +581,6 @@ void VideoEncoder::adapt_speed(double encode_ms) {
     impl_->close_av1();
     impl_->open_av1(settings_, next);
     key_next_ = true;
-    recent_.clear();
     return;
   }
   slow_windows_ = 0;
@@ -634,10 +598,7 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
   BEAMCAST_CHECK(!av1 || impl_->aopen, "VideoEncoder: the AV1 encoder failed to reopen at 8 bits");
   // The encoder's picture says its range (set where the encoder opened).
   if (av1 && settings_.bit_depth == 10) {
-    aom_image_t& a = *impl_->aimg;
-    rgb_to_i010(img, {reinterpret_cast<std::uint16_t*>(a.planes[0]), reinterpret_cast<std::uint16_t*>(a.planes[1]),
-                      reinterpret_cast<std::uint16_t*>(a.planes[2]), a.stride[0] / 2, a.stride[1] / 2,
-                      a.stride[2] / 2});
+    rgb_to_i010(img, i010_planes(*impl_->aimg));
   } else if (av1) {
     rgb_to_i420(img, i420_planes(*impl_->aimg), color_range(*impl_->aimg));
   } else {

@@ -26,7 +26,7 @@ VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& para
   img.height = height;
   img.bit_depth = bit_depth;
   img.rgb = decode_raw_frame(out->pngs[0], width, height, bit_depth, FrameFormat::kRaw);
-  const int cores = usable_cores();
+  static const int cores = usable_cores();  // the process's cores: read once
   int bits = 8;
   if (codec == VideoCodec::kAv1 && params.bit_depth == 10 && video_ten_bit_sound(width, height)) {
     bits = depth_setting == "10"  ? 10
