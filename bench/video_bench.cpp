@@ -18,13 +18,16 @@
 // --max-encode-ms MS lets AV1's speed follow the encode time as the server's
 // does (VideoEncoderSettings::max_encode_ms); --native 1 sends each frame at
 // the size the level renders and shows it upscaled bilinearly; --bits 8 or
-// 10 sets AV1's sample depth (default 8).
+// 10 sets AV1's sample depth (default 8); --bands N sends AV1 pictures as N
+// horizontal bands (0, the default: as the server sends them to the page,
+// video_encoder_bands: 2 at 1920x1080, else 1).
 //
 // Not a test: prints a markdown table, and CSV with --csv FILE (for
 // bench/plot_video.py). Usage:
 //   beamcast_bench_video [--scene NAME] [--size WxH] [--level L] [--frames N] [--csv FILE]
 //                        [--threads N] [--speeds S,S..] [--kbps R,R..] [--jpeg Q,Q..]
 //                        [--codecs C,C..] [--max-encode-ms MS] [--native 0|1] [--bits 8|10]
+//                        [--bands N]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -204,6 +207,7 @@ struct Result {
   int speed = 0;  // the video encoder's at the start (0 for JPEG)
   int bits = 8;   // the video stream's sample depth at the start
   int frames_8bit = 0;  // its frames at 8 bits (a 10-bit stream falls back when too slow)
+  int bands = 1;        // horizontal bands a picture is sent as
   std::vector<double> speeds{};  // per frame (with --max-encode-ms it moves)
 };
 
@@ -213,6 +217,7 @@ int main(int argc, char** argv) {
   std::string name = "paper_10sets", csv_path;
   int width = 512, height = 512, level_index = 3, frames = 60, threads = 1;
   int bits = 8;  // AV1's sample depth
+  int bands = 0;  // AV1's bands; 0: video_encoder_bands
   bool native = false;  // send the level at the size it renders; the display upscales
   double max_encode_ms = 0.0;  // > 0: AV1's speed follows the encode time (VideoEncoderSettings)
   std::vector<int> speeds{0}, rates{125, 250, 500, 1000, 2000, 4000}, qualities{50, 75, 85, 92};
@@ -244,6 +249,7 @@ int main(int argc, char** argv) {
     else if (a == "--jpeg") qualities = int_list(v);
     else if (a == "--native") native = v == "1";
     else if (a == "--bits") bits = std::atoi(v.c_str());
+    else if (a == "--bands") bands = std::max(0, std::atoi(v.c_str()));
     else if (a == "--max-encode-ms") max_encode_ms = std::atof(v.c_str());
     else if (a == "--codecs") {
       codecs.clear();
@@ -329,9 +335,11 @@ int main(int argc, char** argv) {
     for (int kbps : rates) {
       Result r{.path = std::string(video_codec_name(codec)), .setting = static_cast<double>(kbps),
                .speed = speed};
-      VideoEncoder enc({codec, ew, eh, kbps, threads, speed, max_encode_ms,
-                        codec == VideoCodec::kAv1 ? bits : 8});
+      const bool av1 = codec == VideoCodec::kAv1;
+      VideoEncoder enc({codec, ew, eh, kbps, threads, speed, max_encode_ms, av1 ? bits : 8,
+                        !av1 ? 1 : bands > 0 ? bands : video_encoder_bands(codec, ew, eh)});
       r.bits = enc.settings().bit_depth;
+      r.bands = enc.settings().bands;
       r.speed = enc.settings().speed;  // a 10-bit stream keeps to 6
       VideoDecoder dec(codec);
       for (int i = 0; i < frames; ++i) {
@@ -341,7 +349,7 @@ int main(int argc, char** argv) {
         r.encode_ms.push_back(process_cpu_ms() - t);
         r.encode_wall_ms.push_back(wall_ms() - w0);
         t = thread_cpu_ms();
-        const Image decoded = dec.decode(f.data);
+        const Image decoded = dec.decode(f);
         r.decode_ms.push_back(thread_cpu_ms() - t);
         const Image shown = upscale_bilinear(decoded, width, height);
         r.bytes += f.data.size();
@@ -377,6 +385,7 @@ int main(int argc, char** argv) {
     std::string bits_cell = std::to_string(r.bits);
     if (r.bits == 10 && r.frames_8bit > 0) bits_cell += " (8 from frame " + std::to_string(frames - r.frames_8bit) + ")";
     if (r.path == "jpeg") bits_cell = "8";
+    if (r.bands > 1) bits_cell += ", " + std::to_string(r.bands) + " bands";
     std::printf("| %s | %s | %d | %s%g | %.1f | %.3f | %.2f | %.2f | %.4f | %.2f | %.2f | %.2f | %.2f | %zu |\n",
                 r.path.c_str(), bits_cell.c_str(), r.speed, r.path == "jpeg" ? "q" : "", r.setting, bps / 1024, bps * 8 / 1e6,
                 mean(r.psnr), *std::min_element(r.psnr.begin(), r.psnr.end()), mean(r.ssim),
@@ -386,12 +395,13 @@ int main(int argc, char** argv) {
       // The last three columns (wall ms, threads, speed) were added after
       // docs/data/video_bench_{512,1080}.csv were recorded, the last two
       // (bits at the start, frames at 8 bits) after
-      // docs/data/video_av1_rc_start_full_range/.
-      std::fprintf(csv, "%s,%dx%d,%s,%g,%.1f,%.3f,%.4f,%.3f,%.3f,%.3f,%.4f,%.3f,%d,%d,%d,%d\n", name.c_str(),
+      // docs/data/video_av1_rc_start_full_range/, and the bands after
+      // docs/data/video_av1_10bit/.
+      std::fprintf(csv, "%s,%dx%d,%s,%g,%.1f,%.3f,%.4f,%.3f,%.3f,%.3f,%.4f,%.3f,%d,%d,%d,%d,%d\n", name.c_str(),
                    width, height, r.path.c_str(), r.setting, bps, mean(r.psnr), mean(r.ssim),
                    median(r.encode_ms), median(r.decode_ms), mean(raw.psnr), mean(raw.ssim),
                    median(r.encode_wall_ms), r.path == "jpeg" ? 1 : threads, r.speed,
-                   r.path == "jpeg" ? 8 : r.bits, r.path == "jpeg" ? frames : r.frames_8bit);
+                   r.path == "jpeg" ? 8 : r.bits, r.path == "jpeg" ? frames : r.frames_8bit, r.bands);
     }
   }
   if (csv) std::fclose(csv);

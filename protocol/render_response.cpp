@@ -87,6 +87,7 @@ json to_json(const QualityReport& q) {
   if (q.keyframe) j["keyframe"] = *q.keyframe;
   if (q.encoder_speed) j["encoder_speed"] = *q.encoder_speed;
   if (q.encoder_bit_depth) j["encoder_bit_depth"] = *q.encoder_bit_depth;
+  if (q.encoder_bands) j["encoder_bands"] = *q.encoder_bands;
   return j;
 }
 
@@ -215,6 +216,7 @@ QualityReport read_quality(const Node& n) {
   q.keyframe = read_optional<bool>(r, "keyframe", read_bool);
   q.encoder_speed = read_optional<int>(r, "encoder_speed", read_int);
   q.encoder_bit_depth = read_optional<int>(r, "encoder_bit_depth", read_int);
+  q.encoder_bands = read_optional<int>(r, "encoder_bands", read_int);
   q.budget_ms = read_number(r.required("budget_ms"));
   q.estimate_ms = read_number(r.required("estimate_ms"));
   q.frame_ms = read_number(r.required("frame_ms"));

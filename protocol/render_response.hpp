@@ -98,6 +98,7 @@ struct QualityReport {
   std::optional<bool> keyframe;     // video frames only
   std::optional<int> encoder_speed; // video frames only: the encoder's speed (cpu-used)
   std::optional<int> encoder_bit_depth;  // video frames only: the stream's sample depth (8 or 10)
+  std::optional<int> encoder_bands;  // video frames only: horizontal bands the picture is sent as (1: one picture)
   double budget_ms = 0.0, estimate_ms = 0.0, frame_ms = 0.0;
   bool operator==(const QualityReport&) const = default;
 };

@@ -180,9 +180,9 @@ const nlohmann::json& object_at(const json_read::Node& n, std::string_view what)
 }
 
 // "video": {"codec": "vp8"|"vp9"|"av1", "bitrate_kbps": N, "keyframe": bool,
-// "bit_depth": 8|10}.
+// "bit_depth": 8|10, "bands": bool}.
 VideoParams parse_video_params(const json_read::Node& n) {
-  static constexpr std::string_view kKeys[] = {"codec", "bitrate_kbps", "keyframe", "bit_depth"};
+  static constexpr std::string_view kKeys[] = {"codec", "bitrate_kbps", "keyframe", "bit_depth", "bands"};
   const json_read::ObjectReader r(n, "video");
   r.allow_only(kKeys);
   VideoParams v;
@@ -198,6 +198,7 @@ VideoParams parse_video_params(const json_read::Node& n) {
     if (bits != 8 && bits != 10) fail("invalid_value", d->path, d->name() + " must be 8 or 10");
     v.bit_depth = static_cast<int>(bits);
   }
+  if (auto b = r.optional("bands")) v.bands = json_read::read_bool(*b);
   return v;
 }
 

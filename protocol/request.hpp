@@ -76,6 +76,7 @@ struct VideoParams {
   std::optional<int> bitrate_kbps;  // the target; none: the server's --preview-bitrate
   bool keyframe = false;            // this frame a key frame (a decoder recovering)
   int bit_depth = 8;                // the deepest samples the client decodes: 8 or 10 (AV1)
+  bool bands = false;               // the client stacks a frame sent in horizontal bands (AV1)
 };
 inline constexpr int kMinVideoBitrateKbps = 50;
 inline constexpr int kMaxVideoBitrateKbps = 50000;

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <future>
 #include <stdexcept>
 #include <string>
 
@@ -309,7 +310,25 @@ int video_encoder_speed(VideoCodec codec, int width, int height) {
   return pixels <= (1LL << 19) ? 5 : pixels <= (1LL << 21) ? 6 : 8;
 }
 
-bool video_ten_bit_sound(int width, int height) { return std::min(width, height) < 1080; }
+int video_band_rows(int height, int bands, int index) {
+  BEAMCAST_CHECK(bands >= 1 && index >= 0 && index < bands, "video_band_rows: no such band");
+  if (bands == 1) return height;
+  const int rows = ((height + bands - 1) / bands + 1) & ~1;
+  return index + 1 < bands ? rows : height - rows * index;  // <= 0: too few rows for the bands
+}
+
+int video_encoder_bands(VideoCodec codec, int width, int height, int max_rows) {
+  max_rows = std::max(2, max_rows);
+  if (codec != VideoCodec::kAv1 || std::min(width, height) <= max_rows) return 1;
+  for (int n = 2; n <= kMaxVideoBands; ++n) {
+    if (video_band_rows(height, n, 0) <= max_rows && video_band_rows(height, n, n - 1) > 0) return n;
+  }
+  return kMaxVideoBands;
+}
+
+bool video_ten_bit_sound(int width, int height, int bands) {
+  return std::min(width, video_band_rows(height, std::max(1, bands), 0)) <= kAv1FullSpeedRows;
+}
 
 int video_encoder_bit_depth(VideoCodec codec, int width, int height, int cores) {
   const bool ten = codec == VideoCodec::kAv1 && video_encoder_speed(codec, width, height) <= 5 &&
@@ -476,11 +495,35 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
     : impl_(std::make_unique<Impl>()), settings_(settings) {
   BEAMCAST_CHECK(settings.width > 0 && settings.height > 0, "VideoEncoder: empty frame size");
   if (settings_.speed <= 0) settings_.speed = video_encoder_speed(settings.codec, settings.width, settings.height);
+  BEAMCAST_CHECK(settings_.bands >= 1 && settings_.bands <= kMaxVideoBands &&
+                     (settings_.bands == 1 || settings.codec == VideoCodec::kAv1) &&
+                     video_band_rows(settings.height, settings_.bands, settings_.bands - 1) > 0,
+                 "VideoEncoder: bands are for AV1, at most 16, each of at least one row");
   if (settings.codec == VideoCodec::kAv1) {
     BEAMCAST_CHECK(settings_.bit_depth == 8 || settings_.bit_depth == 10, "VideoEncoder: AV1 is 8- or 10-bit");
+    BEAMCAST_CHECK(settings_.bit_depth == 8 || video_ten_bit_sound(settings.width, settings.height, settings_.bands),
+                   "VideoEncoder: 10-bit AV1 with a shorter side of 1080 or more needs bands");
     settings_.speed = std::clamp(settings_.speed, 5, settings_.bit_depth == 10 ? kFastest10Bit : 9);
+    const int band0 = video_band_rows(settings.height, settings_.bands, 0);
+    // What libaom will run (kAv1FullSpeedRows), so that the frames say it
+    // and the adaptation starts from it.
+    if (std::min(settings.width, band0) > kAv1FullSpeedRows) settings_.speed = std::max(settings_.speed, 7);
     base_speed_ = settings_.speed;
-    impl_->open_av1(settings_, settings_.speed);
+    if (settings_.bands == 1) {
+      impl_->open_av1(settings_, settings_.speed);
+      return;
+    }
+    const int threads = std::max(1, settings.threads / settings_.bands);
+    for (int i = 0; i < settings_.bands; ++i) {
+      VideoEncoderSettings band = settings_;
+      band.height = video_band_rows(settings.height, settings_.bands, i);
+      band.bitrate_kbps = std::max(1, static_cast<int>(static_cast<long long>(settings.bitrate_kbps) *
+                                                       band.height / settings.height));
+      band.threads = threads;
+      band.max_encode_ms = 0.0;  // this encoder adapts the speed of all bands
+      band.bands = 1;
+      bands_.push_back(std::make_unique<VideoEncoder>(band));
+    }
     return;
   }
   BEAMCAST_CHECK(settings_.bit_depth == 8, "VideoEncoder: VP8 and VP9 are 8-bit");
@@ -539,6 +582,14 @@ VideoEncoder::~VideoEncoder() = default;
 
 void VideoEncoder::set_bitrate(int kbps) {
   if (kbps == settings_.bitrate_kbps) return;
+  for (auto& band : bands_) {
+    band->set_bitrate(std::max(1, static_cast<int>(static_cast<long long>(kbps) * band->settings_.height /
+                                                   settings_.height)));
+  }
+  if (!bands_.empty()) {
+    settings_.bitrate_kbps = kbps;
+    return;
+  }
   if (settings_.codec == VideoCodec::kAv1) {
     impl_->acfg.rc_target_bitrate = static_cast<unsigned>(kbps);
     if (aom_codec_enc_config_set(&impl_->actx, &impl_->acfg) != AOM_CODEC_OK) {
@@ -575,26 +626,85 @@ void VideoEncoder::adapt_speed(double encode_ms) {
     // again (a new size or codec).
     recent_.clear();
     if (++slow_windows_ < kSlowWindows10Bit) return;
-    settings_.bit_depth = 8;
-    settings_.speed = next;
-    base_speed_ = std::max(base_speed_, kFastest10Bit);
-    impl_->close_av1();
-    impl_->open_av1(settings_, next);
+    reopen_av1_8bit(next);
     key_next_ = true;
     return;
   }
   slow_windows_ = 0;
   if (next == settings_.speed) return;
-  set_av1_speed(&impl_->actx, next);
-  settings_.speed = next;
+  set_av1_speed_all(next);
   recent_.clear();
+}
+
+void VideoEncoder::set_av1_speed_all(int speed) {
+  settings_.speed = speed;
+  if (bands_.empty()) set_av1_speed(&impl_->actx, speed);
+  for (auto& band : bands_) band->set_av1_speed_all(speed);
+}
+
+void VideoEncoder::reopen_av1_8bit(int speed) {
+  settings_.bit_depth = 8;
+  settings_.speed = speed;
+  base_speed_ = std::max(base_speed_, kFastest10Bit);
+  if (bands_.empty()) {
+    impl_->close_av1();
+    impl_->open_av1(settings_, speed);
+  }
+  for (auto& band : bands_) band->reopen_av1_8bit(speed);
+}
+
+// Each band's rows copied out and encoded by its own encoder, bands 1.. on
+// threads of their own beside band 0 on this one; every band is a key frame
+// when one is.
+EncodedVideoFrame VideoEncoder::encode_bands(const Image& img, bool key, double time_ms) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t n = bands_.size();
+  std::vector<Image> parts(n);
+  std::size_t offset = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const int rows = bands_[i]->settings_.height;
+    const std::size_t count = 3 * static_cast<std::size_t>(img.width) * static_cast<std::size_t>(rows);
+    parts[i] = Image{.width = img.width, .height = rows, .bit_depth = img.bit_depth,
+                     .rgb = std::vector<std::uint16_t>(img.rgb.begin() + static_cast<std::ptrdiff_t>(offset),
+                                                       img.rgb.begin() + static_cast<std::ptrdiff_t>(offset + count))};
+    offset += count;
+  }
+  std::vector<std::future<EncodedVideoFrame>> others;
+  for (std::size_t i = 1; i < n; ++i) {
+    others.push_back(std::async(std::launch::async, [this, &parts, i, key, time_ms] {
+      return bands_[i]->encode(parts[i], time_ms, key);
+    }));
+  }
+  std::vector<EncodedVideoFrame> frames;
+  frames.push_back(bands_[0]->encode(parts[0], time_ms, key));
+  for (auto& f : others) frames.push_back(f.get());
+  EncodedVideoFrame out;
+  out.key = key;
+  for (const EncodedVideoFrame& f : frames) {
+    BEAMCAST_CHECK(f.key == key, "a band's frame is not of the frame's type");
+    out.data.insert(out.data.end(), f.data.begin(), f.data.end());
+    out.band_bytes.push_back(f.data.size());
+    out.quantizer = std::max(out.quantizer, f.quantizer);
+  }
+  out.encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return out;
 }
 
 EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool force_key) {
   BEAMCAST_CHECK(img.width == settings_.width && img.height == settings_.height,
                  "VideoEncoder::encode: frame size differs from the encoder's");
-  const auto t0 = std::chrono::steady_clock::now();
   const bool av1 = settings_.codec == VideoCodec::kAv1;
+  if (!bands_.empty()) {
+    const bool key = force_key || frames_ == 0 || key_next_;
+    key_next_ = false;
+    EncodedVideoFrame out = encode_bands(img, key, time_ms);
+    out.pts = frames_++;
+    out.speed = settings_.speed;
+    out.bit_depth = settings_.bit_depth;
+    if (settings_.max_encode_ms > 0.0 && !out.key) adapt_speed(out.encode_ms);
+    return out;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
   BEAMCAST_CHECK(!av1 || impl_->aopen, "VideoEncoder: the AV1 encoder failed to reopen at 8 bits");
   // The encoder's picture says its range (set where the encoder opened).
   if (av1 && settings_.bit_depth == 10) {
@@ -698,31 +808,97 @@ Image VideoDecoder::decode(std::span<const std::uint8_t> frame) {
   return i420_to_rgb(i420_view(*img));
 }
 
+Image VideoDecoder::decode(std::span<const std::span<const std::uint8_t>> bands) {
+  if (bands.size() == 1) return decode(bands[0]);
+  if (bands_.size() != bands.size()) {
+    bands_.clear();
+    for (std::size_t i = 0; i < bands.size(); ++i) bands_.push_back(std::make_unique<VideoDecoder>(impl_->codec));
+  }
+  Image out;
+  for (std::size_t i = 0; i < bands.size(); ++i) {
+    const Image part = bands_[i]->decode(bands[i]);
+    if (i == 0) {
+      out.width = part.width;
+      out.bit_depth = part.bit_depth;
+    } else if (part.width != out.width) {
+      throw std::runtime_error("video: bands of different widths");
+    }
+    out.height += part.height;
+    out.rgb.insert(out.rgb.end(), part.rgb.begin(), part.rgb.end());
+  }
+  return out;
+}
+
+Image VideoDecoder::decode(const EncodedVideoFrame& frame) {
+  if (frame.band_bytes.empty()) return decode(std::span<const std::uint8_t>(frame.data));
+  std::vector<std::span<const std::uint8_t>> parts;
+  std::size_t offset = 0;
+  for (std::size_t bytes : frame.band_bytes) {
+    parts.push_back(std::span<const std::uint8_t>(frame.data).subspan(offset, bytes));
+    offset += bytes;
+  }
+  return decode(std::span<const std::span<const std::uint8_t>>(parts));
+}
+
 static_assert(static_cast<int>(VideoCodec::kVp8) == 0 && static_cast<int>(VideoCodec::kVp9) == 1 &&
                   static_cast<int>(VideoCodec::kAv1) == 2,
               "the BCV1 header's codec byte is the enum's value");
 
+namespace {
+
+void put_u32(std::uint8_t* at, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) at[i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
+std::uint32_t get_u32(const std::uint8_t* at) {
+  std::uint32_t v = 0;
+  for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(at[i]) << (8 * i);
+  return v;
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> pack_video_frame(const EncodedVideoFrame& f, VideoCodec codec) {
-  std::vector<std::uint8_t> out(kVideoHeaderBytes + f.data.size());
+  const std::size_t bands = f.band_bytes.size();
+  BEAMCAST_CHECK(bands != 1 && bands <= static_cast<std::size_t>(kMaxVideoBands), "pack_video_frame: 2-16 bands");
+  const std::size_t table = 4 * bands;
+  std::vector<std::uint8_t> out(kVideoHeaderBytes + table + f.data.size());
   std::memcpy(out.data(), kMagic, 4);
   out[4] = f.key ? 1 : 0;
   out[5] = static_cast<std::uint8_t>(codec);  // 0 vp8, 1 vp9, 2 av1 (the enum's order)
-  const auto pts = static_cast<std::uint32_t>(f.pts);
-  for (int i = 0; i < 4; ++i) out[8 + i] = static_cast<std::uint8_t>(pts >> (8 * i));
-  std::copy(f.data.begin(), f.data.end(), out.begin() + kVideoHeaderBytes);
+  out[6] = static_cast<std::uint8_t>(bands);  // 0: one picture
+  put_u32(out.data() + 8, static_cast<std::uint32_t>(f.pts));
+  for (std::size_t i = 0; i < bands; ++i) {
+    put_u32(out.data() + kVideoHeaderBytes + 4 * i, static_cast<std::uint32_t>(f.band_bytes[i]));
+  }
+  std::copy(f.data.begin(), f.data.end(), out.begin() + static_cast<std::ptrdiff_t>(kVideoHeaderBytes + table));
   return out;
 }
 
 VideoFrameView unpack_video_frame(std::span<const std::uint8_t> bytes) {
   if (bytes.size() < kVideoHeaderBytes || std::memcmp(bytes.data(), kMagic, 4) != 0 ||
-      bytes[4] > 1 || bytes[5] > 2) {
+      bytes[4] > 1 || bytes[5] > 2 || bytes[6] == 1 || bytes[6] > kMaxVideoBands || bytes[7] != 0) {
     throw std::runtime_error("not a video frame: no BCV1 header");
   }
   VideoFrameView v;
   v.key = bytes[4] == 1;
   v.codec = static_cast<VideoCodec>(bytes[5]);
-  for (int i = 0; i < 4; ++i) v.pts |= static_cast<std::uint32_t>(bytes[8 + i]) << (8 * i);
-  v.data = bytes.subspan(kVideoHeaderBytes);
+  v.pts = get_u32(bytes.data() + 8);
+  const std::size_t bands = bytes[6];
+  if (bytes.size() < kVideoHeaderBytes + 4 * bands) throw std::runtime_error("video frame: band sizes cut short");
+  v.data = bytes.subspan(kVideoHeaderBytes + 4 * bands);
+  if (bands == 0) {
+    v.bands.push_back(v.data);
+    return v;
+  }
+  std::size_t offset = 0;
+  for (std::size_t i = 0; i < bands; ++i) {
+    const std::size_t size = get_u32(bytes.data() + kVideoHeaderBytes + 4 * i);
+    if (size > v.data.size() - offset) throw std::runtime_error("video frame: bands longer than the frame");
+    v.bands.push_back(v.data.subspan(offset, size));
+    offset += size;
+  }
+  if (offset != v.data.size()) throw std::runtime_error("video frame: bytes after the bands");
   return v;
 }
 

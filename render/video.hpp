@@ -8,6 +8,7 @@
 // for AV1 where it affords them (rgb_to_i420, rgb_to_i010).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -48,7 +49,38 @@ struct VideoEncoderSettings {
   // even 6 is over max_encode_ms, reopens at 8 bits and speed 7 with a key
   // frame (the frame reports its depth); see video_encoder_bit_depth().
   int bit_depth = 8;
+  // AV1 only: the picture is sent as this many horizontal bands, each its
+  // own libaom stream of video_band_rows() rows, encoded side by side on
+  // threads of their own (`threads` shared among them), each with its share
+  // of the bitrate; a client stacks the pictures. video_encoder_bands() says
+  // when (frames whose shorter side is 1080 or more, which libaom 3.6
+  // otherwise runs at speed 7 and not at all well at 10 bits).
+  int bands = 1;
 };
+
+// libaom 3.6 runs a realtime AV1 stream whose configured frame has a
+// shorter side of 1080 or more at speed 7 or faster, whatever cpu-used says
+// (av1_cx_iface.c, set_encoder_config: "1080p performance at speed 5 & 6 is
+// quite bad"). Speed 7 is its non-RD mode search, which at 10 bits lost 4-6
+// dB (the volume's drag at 1920x1080). A picture of up to this many rows on
+// its shorter side gets the speed it asks for.
+inline constexpr int kAv1FullSpeedRows = 1079;
+
+// How many horizontal bands a picture is sent as: 1 for VP8 and VP9, and for
+// AV1 where the shorter side is at most `max_rows`; else the fewest whose
+// bands have at most `max_rows` rows (1920x1080 with the default: 2 bands of
+// 540). Each band is then a stream libaom encodes at the speed asked and at
+// 10 bits: on the volume's drag at 1920x1080, 2 bands at speed 6 gave 0.6 dB
+// more at 8 bits and 1.6-2.7 dB more at 10 bits than the one picture libaom
+// ran at 7, for about twice the encode CPU (docs/performance.md, "AV1 in
+// bands at 1080 rows"). `max_rows` under the default is for tests (2 bands
+// at 512x512).
+int video_encoder_bands(VideoCodec codec, int width, int height, int max_rows = kAv1FullSpeedRows);
+// The rows of band `index` of `bands` of a picture `height` rows high: each
+// but the last ceil(height / bands) rounded up to even (whole 4:2:0 chroma
+// rows), the last the rest (0 or less where `height` is too small for
+// `bands`: no such layout).
+int video_band_rows(int height, int bands, int index);
 
 // The speed (cpu-used) a stream gets by default: VP8 and VP9 8 at any size;
 // AV1 5 up to 2^19 pixels (512x512 is 2^18), 6 up to 2^21 (1920x1080), 8
@@ -74,12 +106,14 @@ int video_encoder_speed(VideoCodec codec, int width, int height);
 int video_encoder_bit_depth(VideoCodec codec, int width, int height, int cores);
 
 // Whether a 10-bit AV1 stream of width x height is sound with libaom 3.6:
-// frames whose shorter side is under 1080 pixels. At 1080 (1440x1080 and
-// 1920x1080, the volume's drag at 1 000 kbit/s) a 10-bit stream was 4.3-4.4
-// dB worse than an 8-bit one at equal bytes, at speeds 5 and 6; at 1600x900,
-// 1280x720 and 512x512 it was 0.6-0.9 dB better. The server streams 10
-// bits only where this holds, whatever --preview-bit-depth says.
-bool video_ten_bit_sound(int width, int height);
+// pictures whose shorter side is under 1080 pixels. At 1080 (1440x1080 and
+// 1920x1080, the volume's drag at 1 000 kbit/s) libaom runs at speed 7
+// (kAv1FullSpeedRows) and a 10-bit stream was 4.3-4.4 dB worse than an
+// 8-bit one at equal bytes; at 1600x900, 1280x720 and 512x512 it was 0.6-0.9
+// dB better. The server streams 10 bits only where this holds, whatever
+// --preview-bit-depth says: at 1080 rows only in bands.
+// With bands the test is on a band (video_band_rows of band 0).
+bool video_ten_bit_sound(int width, int height, int bands = 1);
 
 // The encoder's colour conversion: RGB (8-bit, or 16-bit whose high byte is
 // kept) to I420 with the BT.601 matrix; U and V are (w+1)/2 x (h+1)/2, each
@@ -132,6 +166,9 @@ struct EncodedVideoFrame {
                          // rc_max_quantizer)
   int bit_depth = 8;     // the stream's sample depth at this frame
   double encode_ms = 0;  // wall clock, conversion included
+  // In bands (VideoEncoderSettings::bands > 1): the bytes of each band's
+  // frame, top to bottom; `data` is their concatenation. Empty for one picture.
+  std::vector<std::size_t> band_bytes{};
 };
 
 class VideoEncoder {
@@ -165,7 +202,11 @@ class VideoEncoder {
   std::vector<double> recent_;  // encode ms of the last (<= 3) delta frames since the last speed change
   bool key_next_ = false;       // the encoder reopened: its next frame is a key frame
   int slow_windows_ = 0;        // 10 bits at speed 6: windows in a row over max_encode_ms
+  std::vector<std::unique_ptr<VideoEncoder>> bands_;  // in bands: one encoder per band
   void adapt_speed(double encode_ms);
+  void set_av1_speed_all(int speed);
+  void reopen_av1_8bit(int speed);
+  EncodedVideoFrame encode_bands(const Image& img, bool key, double time_ms);
 };
 
 // Decodes a stream frame by frame into 8-bit RGB (tests and the bench).
@@ -178,25 +219,36 @@ class VideoDecoder {
   // The picture of one compressed frame; throws std::runtime_error on a
   // corrupt frame or one that yields no picture.
   Image decode(std::span<const std::uint8_t> frame);
+  // A frame in bands: each band's frame to a decoder of its own (made for
+  // as many bands as come, anew when that changes, which a stream does only
+  // at a key frame), the pictures stacked top to bottom. One part: decode().
+  Image decode(std::span<const std::span<const std::uint8_t>> bands);
+  // An encoder's frame, in bands or not.
+  Image decode(const EncodedVideoFrame& frame);
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  std::vector<std::unique_ptr<VideoDecoder>> bands_;
 };
 
 // The frame header of the protocol's video frames (PROTOCOL.md, "Video
 // preview"): 12 bytes before the codec's frame: "BCV1", a flags byte (bit 0:
-// key frame), the codec (0 vp8, 1 vp9, 2 av1), two zero bytes, and the frame's
-// number on its stream (pts, uint32 little-endian; 0 at each key frame the
-// stream starts with).
+// key frame), the codec (0 vp8, 1 vp9, 2 av1), the number of bands (0: one
+// picture; 2-16: that many uint32 little-endian byte counts follow the
+// header, then the bands' frames top to bottom), a zero byte, and the
+// frame's number on its stream (pts, uint32 little-endian; 0 at each key
+// frame the stream starts with).
 inline constexpr std::size_t kVideoHeaderBytes = 12;
 std::vector<std::uint8_t> pack_video_frame(const EncodedVideoFrame& f, VideoCodec codec);
 struct VideoFrameView {
   bool key = false;
   VideoCodec codec = VideoCodec::kVp8;
   std::uint32_t pts = 0;
-  std::span<const std::uint8_t> data;
+  std::span<const std::uint8_t> data;  // everything after the header (and the band sizes)
+  std::vector<std::span<const std::uint8_t>> bands;  // the codec's frames: one, or one per band
 };
+inline constexpr int kMaxVideoBands = 16;
 // Throws std::runtime_error if `bytes` do not start with a valid header.
 VideoFrameView unpack_video_frame(std::span<const std::uint8_t> bytes);
 

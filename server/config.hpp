@@ -11,6 +11,7 @@
 #include "protocol/bounded_json.hpp"
 #include "protocol/scene_json.hpp"
 #include "render/image.hpp"
+#include "render/video.hpp"
 
 namespace beamcast {
 
@@ -68,6 +69,11 @@ struct ServerConfig {
   // shorter side is under 1080: video_ten_bit_sound; a stream too slow at 10 bits
   // falls back to 8 within itself).
   std::string preview_bit_depth = "auto";
+  // The most rows on the shorter side of one AV1 picture for clients that
+  // stack bands ("video": {"bands": true}): a larger frame goes as bands of at
+  // most this many rows (video_encoder_bands). libaom 3.6 runs pictures of
+  // 1080 rows and more at speed 7 (kAv1FullSpeedRows); under 1079 is for tests.
+  int preview_band_rows = kAv1FullSpeedRows;
   std::filesystem::path assets_dir;
 
   SceneLimits scene_limits = kServerSceneLimits;

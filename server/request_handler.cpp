@@ -90,7 +90,8 @@ json hello_result(const ServerCore& core, const json& params, FrameFormat format
                        {"video", {{"codecs", {"vp8", "vp9", "av1"}},
                                   {"bitrate_kbps", core.config.preview_bitrate_kbps},
                                   {"bit_depths", {8, 10}},
-                                  {"bit_depth_setting", core.config.preview_bit_depth}}},
+                                  {"bit_depth_setting", core.config.preview_bit_depth},
+                                  {"band_rows", core.config.preview_band_rows}}},
                        {"encodings", {"binary", "base64"}},
                        {"batch_window_ms", core.config.batch_window_ms},
                        {"stream", true},
@@ -242,7 +243,8 @@ struct RenderReply {
     try {
       VideoFrameReport report =
           encode_video_frame(vs, *video, core.config.preview_bitrate_kbps,
-                             core.config.preview_bit_depth, ctx.cameras[0].width,
+                             core.config.preview_bit_depth, core.config.preview_band_rows,
+                             ctx.cameras[0].width,
                              ctx.cameras[0].height, ctx.bit_depth, steady_ms(arrived),
                              frame->budget_ms, out);
       ctx.video_codec = report.codec;

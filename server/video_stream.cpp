@@ -14,7 +14,7 @@ void note_video_request(VideoStream& stream, const VideoParams& params) {
 
 VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& params,
                                     int default_kbps, const std::string& depth_setting,
-                                    int width, int height, int bit_depth,
+                                    int max_band_rows, int width, int height, int bit_depth,
                                     double time_ms, double budget_ms, RenderOutcome* out) {
   BEAMCAST_CHECK(out->pngs.size() == 1 && out->is_jpeg.size() == 1 && !out->is_jpeg[0],
                  "a video frame is one raw frame");
@@ -27,19 +27,21 @@ VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& para
   img.bit_depth = bit_depth;
   img.rgb = decode_raw_frame(out->pngs[0], width, height, bit_depth, FrameFormat::kRaw);
   static const int cores = usable_cores();  // the process's cores: read once
+  const int bands = params.bands ? video_encoder_bands(codec, width, height, max_band_rows) : 1;
   int bits = 8;
-  if (codec == VideoCodec::kAv1 && params.bit_depth == 10 && video_ten_bit_sound(width, height)) {
+  if (codec == VideoCodec::kAv1 && params.bit_depth == 10 && video_ten_bit_sound(width, height, bands)) {
     bits = depth_setting == "10"  ? 10
            : depth_setting == "8" ? 8
                                   : video_encoder_bit_depth(codec, width, height, cores);
   }
   VideoEncoder* enc = stream.encoder.get();
   if (!enc || enc->settings().codec != codec || enc->settings().width != width ||
-      enc->settings().height != height || stream.opened_bit_depth != bits) {
+      enc->settings().height != height || stream.opened_bit_depth != bits ||
+      enc->settings().bands != bands) {
     stream.opened_bit_depth = bits;
     const int threads = video_encoder_threads(width, height, cores, bits);
     stream.encoder = std::make_unique<VideoEncoder>(
-        VideoEncoderSettings{codec, width, height, kbps, threads, 0, 0.0, bits});
+        VideoEncoderSettings{codec, width, height, kbps, threads, 0, 0.0, bits, bands});
     enc = stream.encoder.get();
   }
   enc->set_bitrate(kbps);
@@ -56,6 +58,7 @@ VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& para
   r.pts = static_cast<std::uint32_t>(f.pts);
   r.speed = f.speed;
   r.bit_depth = f.bit_depth;
+  r.bands = bands;
   r.encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   out->encode_ms[0] += r.encode_ms;
   out->encode_wall_ms += r.encode_ms;
@@ -69,6 +72,7 @@ void set_video_report(const VideoFrameReport& f, QualityReport* q) {
   q->keyframe = f.key;
   q->encoder_speed = f.speed;
   q->encoder_bit_depth = f.bit_depth;
+  q->encoder_bands = f.bands;
 }
 
 }  // namespace beamcast

@@ -32,6 +32,7 @@ struct VideoFrameReport {
   std::uint32_t pts = 0;
   int speed = 0;  // the encoder's speed (cpu-used) for this frame
   int bit_depth = 8;  // the stream's sample depth at this frame
+  int bands = 1;      // horizontal bands the picture went as
   double encode_ms = 0.0;
 };
 
@@ -46,14 +47,16 @@ void note_video_request(VideoStream& stream, const VideoParams& params);
 // frame size or a new depth; the bitrate is params' or `default_kbps`. The
 // stream's depth: 10 bits for AV1 where the client decodes them
 // (params.bit_depth) and `depth_setting` (the server's --preview-bit-depth:
-// "auto", "8", "10") allows, else 8. The encode time is
+// "auto", "8", "10") allows, else 8. An AV1 picture whose shorter side is
+// over `max_band_rows` goes as bands (video_encoder_bands) to a client that
+// stacks them (params.bands), else as one picture. The encode time is
 // added to the outcome's encode times (the accuracy controller's frame cost).
 // An AV1 stream's speed follows its encode time against half of `budget_ms`,
 // the frame budget of the request (VideoEncoderSettings::max_encode_ms).
 // Call with stream.mu held. Throws std::runtime_error if the encoder fails.
 VideoFrameReport encode_video_frame(VideoStream& stream, const VideoParams& params,
                                     int default_kbps, const std::string& depth_setting,
-                                    int width, int height, int bit_depth,
+                                    int max_band_rows, int width, int height, int bit_depth,
                                     double time_ms, double budget_ms, RenderOutcome* out);
 
 // The "quality" block of a video frame: the codec as its format, the

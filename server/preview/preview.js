@@ -63,6 +63,7 @@ const preview = {
     codec: null, reason: 'starting', bitrate_kbps: null,
     maxBitDepth: 8,  // 10 where the browser decodes 10-bit AV1 (the server may then send it)
     bitDepth: null,  // the stream's, as the latest video frame's quality block says
+    bands: 1,        // horizontal bands the latest frame came in (a decoder each)
     received: 0,     // video frames in
     decoded: 0,      // pictures out of the decoder
     keyframes: 0,    // key frames in
@@ -348,6 +349,7 @@ function renderRequest(camera, motion) {
   if (v.codec) {
     r.video = {codec: v.codec};
     if (v.maxBitDepth === 10) r.video.bit_depth = 10;
+    r.video.bands = true;  // this page stacks bands (feedVideo)
     if (bitrateKbps) r.video.bitrate_kbps = bitrateKbps;
     if (needKey) r.video.keyframe = true;
   }
@@ -378,7 +380,11 @@ const streamColor = (name) => ({primaries: 'bt709', transfer: 'iec61966-2-1', ma
 // bytes at the same PSNR on the preview's drags (docs/performance.md, "Video
 // preview: AV1"), for more encode time on the server.
 const autoCodecs = ['av1', 'vp9', 'vp8'];
-let decoder = null;
+// One decoder per horizontal band of the stream (one for a picture sent
+// whole): an AV1 picture whose shorter side is over the server's
+// --preview-band-rows (1079: 1920x1080, or ?size=1080) comes as bands, each
+// its own stream (PROTOCOL.md, "Video preview").
+let decoders = [];
 let decoderConfig = null;
 let needKey = true;        // drop delta frames until a key frame (at start and after an error)
 let recovering = false;    // a decoder error happened; the next key frame is the recovery
@@ -418,12 +424,30 @@ async function setupVideo() {
   // 10-bit AV1 (main profile): asked for only where this browser says it
   // decodes it; the same decoder takes the stream's 8-bit pictures too.
   if (chosen === 'av1' && await supported('av01.0.08M.10')) v.maxBitDepth = 10;
-  openDecoder();
+  openDecoders(1);
 }
 
-function openDecoder() {
-  decoder = new VideoDecoder({output: onVideoFrame, error: onDecoderError});
-  decoder.configure(decoderConfig);
+// The rows of band `i` of `n` of a picture `height` rows high: each but the
+// last ceil(height / n) rounded up to even, the last the rest (as the server
+// cuts them, render/video.hpp video_band_rows).
+function bandRows(height, n, i) {
+  if (n === 1) return height;
+  const rows = (Math.ceil(height / n) + 1) & ~1;
+  return i + 1 < n ? rows : height - rows * i;
+}
+
+function closeDecoders() {
+  for (const d of decoders) if (d.state !== 'closed') d.close();
+  decoders = [];
+}
+
+function openDecoders(n) {
+  closeDecoders();
+  for (let i = 0; i < n; ++i) {
+    const d = new VideoDecoder({output: (frame) => onVideoFrame(frame, i, n), error: onDecoderError});
+    d.configure(n === 1 ? decoderConfig : {...decoderConfig, codedHeight: bandRows(size, n, i)});
+    decoders.push(d);
+  }
   needKey = true;
 }
 
@@ -434,7 +458,7 @@ function onDecoderError(e) {
   console.warn('preview: video decoder error, asking for a key frame: ' + (e && e.message || e));
   recovering = true;
   decodeStarted.clear();
-  if (preview.video.codec) openDecoder();
+  if (preview.video.codec) openDecoders(Math.max(1, decoders.length));
 }
 
 // The server refused video (an unknown codec, an older server): JPEG from now on.
@@ -442,8 +466,7 @@ function refuseVideo(e) {
   const v = preview.video;
   v.reason = `server refused ${v.codec}: ${e.code}: ${e.message}`;
   v.codec = null;
-  if (decoder && decoder.state !== 'closed') decoder.close();
-  decoder = null;
+  closeDecoders();
   lastSentKey = null;  // ask for the pose again, as JPEG
   updateOverlay();
 }
@@ -452,41 +475,68 @@ function feedVideo(f, bytes, seq) {
   const v = preview.video;
   const all = bytes.subarray(f.attachment.offset, f.attachment.offset + f.attachment.length);
   ++v.received;
-  if (!decoder || decoder.state !== 'configured' || all.length < 12) return;
-  // The 12-byte header: "BCV1", flags (bit 0: key frame), codec, 2 zero bytes, pts.
+  if (!decoders.length || all.length < 12) return;
+  // The 12-byte header: "BCV1", flags (bit 0: key frame), codec, the number
+  // of bands (0: one picture; else that many uint32 little-endian sizes
+  // follow), a zero byte, pts.
   const key = (all[4] & 1) === 1;
-  let data = all.subarray(12);
+  const n = Math.max(1, all[6]);
+  const view = new DataView(all.buffer, all.byteOffset, all.byteLength);
+  const start = 12 + (n > 1 ? 4 * n : 0);
+  if (all.length < start) return;
+  const parts = [];
+  for (let i = 0, at = start; i < n; ++i) {
+    const len = n > 1 ? view.getUint32(12 + 4 * i, true) : all.length - start;
+    parts.push(all.subarray(at, at + len));
+    at += len;
+  }
   if (key) ++v.keyframes;
-  if (needKey && !key) { ++v.dropped; return; }
+  // A stream's band count changes only at a key frame (a new stream).
+  if (key && n !== decoders.length) openDecoders(n);
+  if ((needKey || n !== decoders.length) && !key) { ++v.dropped; return; }
   if (key) needKey = false;
+  if (decoders.some((d) => d.state !== 'configured')) return;
   if (v.corruptNext && !key) {
     v.corruptNext = false;
-    data = new Uint8Array([0xff, 0xff, 0xff]);  // not a frame: the decoder must fail on it
+    parts[0] = new Uint8Array([0xff, 0xff, 0xff]);  // not a frame: the decoder must fail on it
   }
-  decodeStarted.set(seq, {t: performance.now(), recovery: recovering && key});
+  decodeStarted.set(seq, {t: performance.now(), recovery: recovering && key, left: n});
   if (key) recovering = false;
   try {
-    decoder.decode(new EncodedVideoChunk({type: key ? 'key' : 'delta', timestamp: seq, data}));
+    parts.forEach((data, i) =>
+      decoders[i].decode(new EncodedVideoChunk({type: key ? 'key' : 'delta', timestamp: seq, data})));
   } catch (e) {
     onDecoderError(e);
   }
 }
 
-let lastFrame = null;  // with video.keepLast: {seq, frame} (a clone, closed when replaced)
+let lastFrame = null;  // with video.keepLast: {seq, n, parts: [clones per band]} (closed when replaced)
 
-function onVideoFrame(frame) {
+// The band's place on the canvas: rows from the top of the picture, scaled.
+function bandRect(band, n) {
+  const sy = canvas.height / size;
+  let top = 0;
+  for (let i = 0; i < band; ++i) top += bandRows(size, n, i);
+  return [0, top * sy, canvas.width, bandRows(size, n, band) * sy];
+}
+
+function onVideoFrame(frame, band, n) {
   const v = preview.video;
   const seq = frame.timestamp;
   // A PNG or JPEG that arrived later is already on the canvas.
-  if (seq > lastImageSeq) ctx2d.drawImage(frame, 0, 0, canvas.width, canvas.height);
+  if (seq > lastImageSeq) ctx2d.drawImage(frame, ...bandRect(band, n));
   v.colorSpace = frame.colorSpace ? frame.colorSpace.toJSON() : null;
   if (v.keepLast) {
-    if (lastFrame) lastFrame.frame.close();
-    lastFrame = {seq, frame: frame.clone()};
+    if (!lastFrame || lastFrame.seq !== seq) {
+      if (lastFrame) for (const p of lastFrame.parts) if (p) p.close();
+      lastFrame = {seq, n, parts: new Array(n).fill(null)};
+    }
+    lastFrame.parts[band] = frame.clone();
   }
   frame.close();
-  ++v.decoded;
   const started = decodeStarted.get(seq);
+  if (started && --started.left > 0) return;  // the frame's other bands are to come
+  ++v.decoded;
   decodeStarted.delete(seq);
   if (started) {
     v.decode_ms.push(performance.now() - started.t);
@@ -510,7 +560,7 @@ preview.lastVideoPicture = () => {
   if (!lastFrame) return null;
   const c = new OffscreenCanvas(canvas.width, canvas.height);
   const g = c.getContext('2d');
-  g.drawImage(lastFrame.frame, 0, 0, c.width, c.height);
+  lastFrame.parts.forEach((p, i) => { if (p) g.drawImage(p, ...bandRect(i, lastFrame.n)); });
   return {seq: lastFrame.seq, width: c.width, height: c.height,
           rgba: preview.base64(new Uint8Array(g.getImageData(0, 0, c.width, c.height).data.buffer))};
 };
@@ -532,11 +582,13 @@ async function show(res, camera, socket) {
   const q = r.quality || {};
   if (q.bitrate_kbps) preview.video.bitrate_kbps = q.bitrate_kbps;
   if (q.encoder_bit_depth) preview.video.bitDepth = q.encoder_bit_depth;
+  if (q.encoder_bands) preview.video.bands = q.encoder_bands;
   const now = performance.now();
   preview.frames.push({
     t: now, latency_ms: received - sent, level: q.level, levels: q.levels, still: !!q.still,
     reason: q.reason, label: q.label, scale: q.scale, format: f.format, bytes: data.length,
     keyframe: q.keyframe, encoder_speed: q.encoder_speed, encoder_bit_depth: q.encoder_bit_depth,
+    encoder_bands: q.encoder_bands,
     frame_ms: q.frame_ms, budget_ms: q.budget_ms,
     server_ms: r.timings.server_ms, passes: r.passes, socket,
   });
@@ -612,7 +664,8 @@ function updateOverlay() {
   const path = v.codec
       ? `moving frames: ${v.codec} video (WebCodecs)` +
         (v.bitrate_kbps ? ` ${v.bitrate_kbps} kbit/s` : '') +
-        (v.bitDepth ? ` ${v.bitDepth}-bit` : '') + `, ${v.decoded} decoded` +
+        (v.bitDepth ? ` ${v.bitDepth}-bit` : '') + (v.bands > 1 ? ` in ${v.bands} bands` : '') +
+        `, ${v.decoded} decoded` +
         (v.errors.length ? `, ${v.errors.length} decoder errors, ${v.recoveries} recovered` : '')
       : `moving frames: JPEG (${v.reason})`;
   overlay.textContent =

@@ -35,12 +35,16 @@
 // node preview_test.mjs --server BIN --cli BIN --artifacts DIR
 //     [--scene demo] [--size 512] [--drag-ms 2000] [--budget 33]
 //     [--still-deadline-ms 1000] [--view-checks] [--video auto|av1|vp9|vp8|off] [--video-checks]
-//     [--bit-depth auto|8|10]
+//     [--bit-depth auto|8|10] [--band-rows N]
 // --bit-depth: the server's --preview-bit-depth (default: the server's own,
 // auto); with 10 the AV1 stream starts at 10 bits (the page asks for them
 // where chromium decodes them) and, on a machine too slow for them, goes on
 // at 8 within the stream: --video-checks then checks that its first moving
 // frames are 10-bit and that every frame decodes either way.
+// --band-rows: the server's --preview-band-rows (default 1079): under the
+// size (256 at 512) the AV1 pictures come in bands, as 1920x1080 does by
+// default; --video-checks then checks that they did and that every frame's
+// bands decoded and stacked into the picture (the colour check below).
 // --scene names a stored scene or an example file (volume_ml256.json: the
 // page stores it, as its picker does).
 import {execFileSync} from 'node:child_process';
@@ -75,6 +79,7 @@ const viewChecks = argv.includes('--view-checks');
 const video = opt('video', 'auto');
 const videoChecks = argv.includes('--video-checks');
 const bitDepth = opt('bit-depth', null);
+const bandRows = opt('band-rows', null);
 // auto: the first of the page's list (av1, vp9, vp8) that chromium decodes;
 // Debian's chromium decodes AV1 (dav1d), so auto streams AV1 there.
 const movingFormat = video === 'off' ? 'jpeg' : video === 'auto' ? 'av1' : video;
@@ -315,7 +320,8 @@ let server = null;
 let context = null;
 const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'beamcast-preview-'));
 try {
-  server = await startServer(serverBin, artifacts, bitDepth ? ['--preview-bit-depth', bitDepth] : []);
+  server = await startServer(serverBin, artifacts, [...(bitDepth ? ['--preview-bit-depth', bitDepth] : []),
+                                                   ...(bandRows ? ['--preview-band-rows', bandRows] : [])]);
   console.log(`server: ${server.url}`);
   context = await launchBrowser(userDataDir, size);
   const page = context.pages()[0] || await context.newPage();
@@ -381,6 +387,7 @@ try {
     video: {decoded: videoAtRelease.decoded, received: videoAtRelease.received,
             keyframes: videoAtRelease.keyframes,
             bit_depths: dragAll.filter((f) => f.encoder_bit_depth).map((f) => f.encoder_bit_depth),
+            bands: dragAll.filter((f) => f.encoder_bands).map((f) => f.encoder_bands),
             median_decode_ms: [...videoAtRelease.decode_ms].sort((a, b) => a - b)[videoAtRelease.decode_ms.length >> 1]},
     levels_while_dragging: levels,
     still_after_release_ms: stillAt === null ? null : +(stillAt - tRelease).toFixed(1),
@@ -447,6 +454,14 @@ try {
       check(depths.length > 0 && depths[0] === 10 && (fellBack < 0 || depths.slice(fellBack).every((d) => d === 8)),
             `10-bit AV1 streamed and decoded: ${depths.filter((d) => d === 10).length} frames at 10 bits, ` +
             `${depths.filter((d) => d === 8).length} at 8 (${fellBack < 0 ? 'no fall back' : 'fell back at frame ' + fellBack})`);
+    }
+    if (bandRows && movingFormat === 'av1') {
+      // 9b. The server sent the pictures in bands, every one of them (the
+      // frames were decoded above, a decoder per band).
+      const bands = result.video.bands;
+      const expected = Math.ceil(size / parseInt(bandRows, 10));
+      check(bands.length > 0 && bands.every((n) => n === expected),
+            `AV1 in ${expected} bands: ${bands.filter((n) => n === expected).length} of ${bands.length} frames`);
     }
     await timed('video picture colours', () => checkVideoPicture(page, still, result));
     check(movingOverlay.includes(`moving frames: ${movingFormat} video (WebCodecs)`),

@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <thread>
 
 #include "protocol/scene_json.hpp"
@@ -357,6 +358,49 @@ TEST(InteractiveQuality, VideoFramesAreOneStreamAndTheStillFrameStaysExact) {
     EXPECT_EQ(v.pts, static_cast<std::uint32_t>(i % 2));
     EXPECT_EQ(av1_dec.decode(v.data).width, size);
   }
+}
+
+// A client that stacks bands ("bands": true) gets an AV1 picture whose
+// shorter side is over --preview-band-rows (here its least, 64, at 96x96;
+// 1079 by default, for 1920x1080) as bands: the header's band count and
+// sizes, each band its own stream, the stacked picture the frame's size, 10
+// bits where asked (at 1080 rows only bands may be 10-bit). A client that
+// stops asking gets one picture again from a key frame; a client that never
+// asks never gets bands. hello says the setting; "bands" must be a boolean.
+TEST(InteractiveQuality, VideoInBandsForClientsThatStackThem) {
+  ServerConfig config;
+  config.preview_bit_depth = "10";
+  config.preview_band_rows = 64;
+  HttpTestServer s(config);
+  store_demo(s.core());
+  WsClient ws(s.http_port());
+  const auto hello = ws.call({{"id", 0}, {"method", "hello"}, {"params", {{"protocol", 1}}}});
+  EXPECT_EQ(hello.j["result"]["capabilities"]["video"]["band_rows"], 64) << hello.j.dump();
+  const int size = 96;
+  json av1 = {{"budget_ms", 10000}, {"still_ms", 60000},
+              {"video", {{"codec", "av1"}, {"bit_depth", 10}, {"bands", true}}}};
+  ASSERT_TRUE(ws.call(auto_render(1, 0.0, size, av1)).j["ok"]);  // the still frame
+  VideoDecoder dec(VideoCodec::kAv1);
+  for (int i = 0; i < 5; ++i) {
+    if (i == 3) av1["video"]["bands"] = false;
+    const auto r = ws.call(auto_render(2 + i, 0.1 + 0.05 * i, size, av1));
+    ASSERT_TRUE(r.j["ok"]) << r.j.dump();
+    const json& q = r.j["result"]["quality"];
+    EXPECT_EQ(q["encoder_bands"], i < 3 ? 2 : 1) << "frame " << i;
+    EXPECT_EQ(q["encoder_bit_depth"], 10) << "frame " << i;
+    const std::vector<std::uint8_t> bytes = ws.frame(r);
+    const VideoFrameView v = unpack_video_frame(bytes);
+    EXPECT_EQ(bytes[6], i < 3 ? 2 : 0) << "frame " << i;
+    ASSERT_EQ(v.bands.size(), i < 3 ? 2u : 1u);
+    EXPECT_EQ(v.key, i == 0 || i == 3) << "frame " << i;
+    const Image img = dec.decode(std::span<const std::span<const std::uint8_t>>(v.bands));
+    EXPECT_EQ(img.width, size);
+    EXPECT_EQ(img.height, size);
+  }
+  const auto e = ws.call(auto_render(9, 0.5, size, {{"video", {{"codec", "av1"}, {"bands", "yes"}}}}));
+  ASSERT_FALSE(e.j["ok"]) << e.j.dump();
+  EXPECT_EQ(e.j["error"]["code"], "wrong_type");
+  EXPECT_EQ(e.j["error"]["path"], "/params/video/bands");
 }
 
 TEST(InteractiveQuality, StillTimeElapsesOnTheServerClock) {

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdint>
 #include <vector>
+#include <span>
 #include <stdexcept>
+#include <utility>
 
 #include <aom/aom_decoder.h>
 #include <aom/aom_image.h>
@@ -342,6 +344,20 @@ TEST(VideoFrames, RejectsWhatIsNotAFrame) {
   EXPECT_THROW(unpack_video_frame(unknown_codec), std::runtime_error);
   unknown_codec[5] = 2;
   EXPECT_EQ(unpack_video_frame(unknown_codec).codec, VideoCodec::kAv1);
+  // Bands: a count of 1 or over 16, a table cut short, bands longer than
+  // the frame or bytes after them, a nonzero byte 7.
+  std::vector<std::uint8_t> banded = {'B', 'C', 'V', '1', 0, 2, 2, 0, 0, 0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 7, 7, 7};
+  const VideoFrameView v = unpack_video_frame(banded);
+  ASSERT_EQ(v.bands.size(), 2u);
+  EXPECT_EQ(v.bands[0].size(), 2u);
+  EXPECT_EQ(v.bands[1].size(), 1u);
+  for (const auto& [at, value] : std::vector<std::pair<std::size_t, std::uint8_t>>{
+           {6, 1}, {6, 17}, {7, 1}, {16, 2}, {12, 1}}) {
+    std::vector<std::uint8_t> bad_bands = banded;
+    bad_bands[at] = value;
+    EXPECT_THROW(unpack_video_frame(bad_bands), std::runtime_error) << at << " " << int{value};
+  }
+  EXPECT_THROW(unpack_video_frame(std::span(banded).first(15)), std::runtime_error);
   // A decoder given garbage says so; it does not crash.
   for (VideoCodec c : {VideoCodec::kVp8, VideoCodec::kVp9, VideoCodec::kAv1}) {
     VideoDecoder dec(c);
@@ -474,6 +490,90 @@ TEST(VideoFrames, DefaultSpeedFollowsCodecAndPictureSize) {
   EXPECT_EQ(parse_video_codec("av1"), VideoCodec::kAv1);
   EXPECT_EQ(video_codec_name(VideoCodec::kAv1), "av1");
   EXPECT_FALSE(parse_video_codec("h264").has_value());
+}
+
+// Bands (libaom 3.6 runs a picture whose shorter side is 1080 or more at
+// speed 7, kAv1FullSpeedRows): AV1 pictures over the row limit on their
+// shorter side go as the fewest bands of at most that many rows, even rows
+// but the last, which together cover the picture; VP8 and VP9 never. An
+// encoder of one such picture says the speed libaom runs (7), a band's
+// encoder the speed asked; 10 bits need bands there.
+TEST(VideoFrames, BandsKeepAv1UnderTheRowsLibaomSlowsDownAt) {
+  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 1920, 1080), 2);
+  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 1080, 1080), 2);
+  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 1920, 1076), 1);
+  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 720, 1280), 1);
+  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 3840, 2160), 3);
+  EXPECT_EQ(video_encoder_bands(VideoCodec::kVp9, 1920, 1080), 1);
+  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 512, 512, 256), 2);
+  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 512, 513, 256), 3);
+  for (const auto& [h, n] : std::vector<std::pair<int, int>>{{1080, 2}, {1081, 2}, {2160, 3}, {513, 3}, {7, 2}}) {
+    int sum = 0;
+    for (int i = 0; i < n; ++i) {
+      const int rows = video_band_rows(h, n, i);
+      EXPECT_GT(rows, 0) << h << " " << i;
+      if (i + 1 < n) EXPECT_EQ(rows % 2, 0) << h << " " << i;
+      sum += rows;
+    }
+    EXPECT_EQ(sum, h);
+  }
+  EXPECT_EQ(video_band_rows(1080, 2, 0), 540);
+  EXPECT_EQ(video_band_rows(1081, 2, 1), 539);
+  EXPECT_EQ(video_band_rows(2160, 3, 2), 720);
+  EXPECT_LE(video_band_rows(7, 3, 2), 0);
+  EXPECT_EQ(VideoEncoder({VideoCodec::kAv1, 1920, 1080, 1000, 1, 6}).settings().speed, 7);
+  EXPECT_EQ(VideoEncoder({VideoCodec::kAv1, 1920, 1076, 1000, 1, 6}).settings().speed, 6);
+  EXPECT_EQ(VideoEncoder({VideoCodec::kAv1, 1920, 1080, 1000, 2, 6, 0.0, 8, 2}).settings().speed, 6);
+  EXPECT_TRUE(video_ten_bit_sound(1920, 1080, 2));
+  EXPECT_EQ(VideoEncoder({VideoCodec::kAv1, 1920, 1080, 1000, 2, 6, 0.0, 10, 2}).settings().bit_depth, 10);
+  EXPECT_THROW(VideoEncoder({VideoCodec::kAv1, 1920, 1080, 1000, 2, 6, 0.0, 10}), InternalError);
+  EXPECT_THROW(VideoEncoder({VideoCodec::kVp9, 64, 48, 500, 1, 0, 0.0, 8, 2}), InternalError);
+  EXPECT_THROW(VideoEncoder({VideoCodec::kAv1, 64, 2, 500, 1, 0, 0.0, 8, 3}), InternalError);
+}
+
+// A stream in 2 bands (as 1920x1080 goes, here at 128x96 to be quick) at 8
+// and 10 bits: every frame is a key frame in every band or in none; packed
+// with the band sizes after the header and unpacked, each band decodes with
+// its own decoder and the stacked picture is within 30 dB of its source (as
+// above; a band out of place or of the wrong height gives under 20 dB); the
+// speed adapts in all bands together, and a 10-bit stream too slow falls
+// back to 8 bits in all bands with one key frame.
+TEST(VideoFrames, BandsDecodeToTheWholePicture) {
+  for (int bits : {8, 10}) {
+    VideoEncoder enc({VideoCodec::kAv1, 128, 96, 800, 2, 5, 1e-6, bits, 2});
+    VideoDecoder dec(VideoCodec::kAv1), packed_dec(VideoCodec::kAv1);
+    std::vector<int> keys, speeds, depths;
+    for (int t = 0; t < 16; ++t) {
+      const Image src = moving_picture(128, 96, t);
+      const EncodedVideoFrame f = enc.encode(src, 33.0 * t, t == 3);
+      ASSERT_EQ(f.band_bytes.size(), 2u);
+      EXPECT_EQ(f.band_bytes[0] + f.band_bytes[1], f.data.size());
+      if (f.key) keys.push_back(t);
+      speeds.push_back(f.speed);
+      depths.push_back(f.bit_depth);
+      const std::vector<std::uint8_t> wire = pack_video_frame(f, VideoCodec::kAv1);
+      EXPECT_EQ(wire[6], 2);
+      const VideoFrameView v = unpack_video_frame(wire);
+      ASSERT_EQ(v.bands.size(), 2u);
+      EXPECT_EQ(v.bands[0].size(), f.band_bytes[0]);
+      EXPECT_EQ(v.key, f.key);
+      const Image shown = packed_dec.decode(std::span<const std::span<const std::uint8_t>>(v.bands));
+      ASSERT_EQ(shown.height, 96);
+      EXPECT_GT(compare_levels(shown, src).psnr_db, 30.0) << bits << " bits, frame " << t;
+      EXPECT_EQ(compare_levels(dec.decode(f), shown).psnr_db, compare_levels(shown, shown).psnr_db);
+    }
+    if (bits == 8) {
+      EXPECT_EQ(keys, (std::vector<int>{0, 3}));
+      // Delta frames 1, 2 and 4 make the first window (key frames are not timed).
+      EXPECT_EQ(speeds, (std::vector<int>{5, 5, 5, 5, 5, 6, 6, 6, 7, 7, 7, 8, 8, 8, 9, 9}));
+    } else {
+      // 6 from frame 5; frames 5-13 are 3 windows over the bound at 6; frame
+      // 14 is the key frame at 8 bits and speed 7.
+      EXPECT_EQ(keys, (std::vector<int>{0, 3, 14}));
+      EXPECT_EQ(depths, (std::vector<int>{10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 8, 8}));
+      EXPECT_EQ(speeds[14], 7);
+    }
+  }
 }
 
 }  // namespace
