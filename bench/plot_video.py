@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 FIELDS = ["scene", "size", "path", "setting", "bytes_per_s", "psnr", "ssim",
           "encode_ms", "decode_ms", "raw_psnr", "raw_ssim", "encode_wall_ms", "threads", "speed",
-          "bits", "frames_8bit"]
+          "bits", "frames_8bit", "bands"]
 
 
 def main():
@@ -51,7 +51,9 @@ def main():
     styles = {"jpeg": ("C0", "o", "JPEG (q50-92)"), "vp8": ("C1", "s", "VP8"),
               "vp9": ("C2", "^", "VP9"), "av1": ("C3", "D", "AV1"),
               "av1-before": ("0.6", "d", "AV1, stop 52's encoder"),
-              "av1-8bit": ("C3", "D", "AV1, 8 bits"), "av1-10bit": ("C4", "P", "AV1, 10 bits")}
+              "av1-8bit": ("C3", "D", "AV1, 8 bits"), "av1-10bit": ("C4", "P", "AV1, 10 bits"),
+              "av1-1picture": ("C3", "D", "AV1, 8 bits, one picture (libaom at speed 7)"),
+              "av1-bands": ("C4", "P", "AV1, 10 bits, 2 bands (speed 6)")}
     for ax, key in zip(axes[0], keys):
         for i, (path, pts) in enumerate(sorted(panels[key].items())):
             pts.sort()

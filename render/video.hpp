@@ -86,9 +86,9 @@ int video_band_rows(int height, int bands, int index);
 // AV1 5 up to 2^19 pixels (512x512 is 2^18), 6 up to 2^21 (1920x1080), 8
 // above (not measured). On the demo drag at 512x512, AV1 at speed 5 was 0.6
 // dB better than at 6 at the same bitrate and 6 was 0.8 dB better than 7, for
-// 12-18 ms a frame; 1080p frames at 6 with 2 threads take about a frame's
-// time at 30 frames/s on the 2-core machine (docs/performance.md, "Video
-// preview: AV1").
+// 12-18 ms a frame (docs/performance.md, "Video preview: AV1"). One picture
+// whose shorter side is 1080 or more runs at 7 whatever this says
+// (kAv1FullSpeedRows; the encoder reports 7); in bands it runs at 6.
 int video_encoder_speed(VideoCodec codec, int width, int height);
 
 // The sample depth the server gives a stream on `cores` cores: AV1 10 bits

@@ -66,14 +66,9 @@ struct ServerConfig {
   // AV1 preview streams' sample depth for clients that decode 10 bits
   // ("video": {"bit_depth": 10}): "auto" (video_encoder_bit_depth: 10 up to
   // 2^19 pixels on 4 cores or more), "8" or "10" (any machine, frames whose
-  // shorter side is under 1080: video_ten_bit_sound; a stream too slow at 10 bits
-  // falls back to 8 within itself).
+  // shorter side is under 1080 or in bands: video_ten_bit_sound; a stream too
+  // slow at 10 bits falls back to 8 within itself).
   std::string preview_bit_depth = "auto";
-  // The most rows on the shorter side of one AV1 picture for clients that
-  // stack bands ("video": {"bands": true}): a larger frame goes as bands of at
-  // most this many rows (video_encoder_bands). libaom 3.6 runs pictures of
-  // 1080 rows and more at speed 7 (kAv1FullSpeedRows); under 1079 is for tests.
-  int preview_band_rows = kAv1FullSpeedRows;
   std::filesystem::path assets_dir;
 
   SceneLimits scene_limits = kServerSceneLimits;
@@ -102,6 +97,11 @@ struct ServerConfig {
   // Wall-clock time a render request may take from its arrival, queueing
   // included: past it, deadline_exceeded (RenderJob::deadline).
   int max_render_ms = 120000;
+  // The most rows on the shorter side of one AV1 picture for clients that
+  // stack bands ("video": {"bands": true}): a larger frame goes as bands of at
+  // most this many rows (video_encoder_bands). libaom 3.6 runs pictures of
+  // 1080 rows and more at speed 7 (kAv1FullSpeedRows); under 1079 is for tests.
+  int preview_band_rows = kAv1FullSpeedRows;
 };
 
 }  // namespace beamcast

@@ -499,14 +499,21 @@ TEST(VideoFrames, DefaultSpeedFollowsCodecAndPictureSize) {
 // encoder of one such picture says the speed libaom runs (7), a band's
 // encoder the speed asked; 10 bits need bands there.
 TEST(VideoFrames, BandsKeepAv1UnderTheRowsLibaomSlowsDownAt) {
-  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 1920, 1080), 2);
-  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 1080, 1080), 2);
-  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 1920, 1076), 1);
-  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 720, 1280), 1);
-  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 3840, 2160), 3);
-  EXPECT_EQ(video_encoder_bands(VideoCodec::kVp9, 1920, 1080), 1);
-  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 512, 512, 256), 2);
-  EXPECT_EQ(video_encoder_bands(VideoCodec::kAv1, 512, 513, 256), 3);
+  struct Case {
+    VideoCodec codec;
+    int width, height, max_rows, bands;
+  };
+  for (const Case& c : std::vector<Case>{{VideoCodec::kAv1, 1920, 1080, kAv1FullSpeedRows, 2},
+                                         {VideoCodec::kAv1, 1080, 1080, kAv1FullSpeedRows, 2},
+                                         {VideoCodec::kAv1, 1920, 1076, kAv1FullSpeedRows, 1},
+                                         {VideoCodec::kAv1, 720, 1280, kAv1FullSpeedRows, 1},
+                                         {VideoCodec::kAv1, 3840, 2160, kAv1FullSpeedRows, 3},
+                                         {VideoCodec::kVp9, 1920, 1080, kAv1FullSpeedRows, 1},
+                                         {VideoCodec::kAv1, 512, 512, 256, 2},
+                                         {VideoCodec::kAv1, 512, 513, 256, 3}}) {
+    EXPECT_EQ(video_encoder_bands(c.codec, c.width, c.height, c.max_rows), c.bands)
+        << c.width << "x" << c.height << " at most " << c.max_rows << " rows";
+  }
   for (const auto& [h, n] : std::vector<std::pair<int, int>>{{1080, 2}, {1081, 2}, {2160, 3}, {513, 3}, {7, 2}}) {
     int sum = 0;
     for (int i = 0; i < n; ++i) {
