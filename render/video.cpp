@@ -109,13 +109,25 @@ constexpr bool from_sum() {
   return false;
 }
 
+// Rows of an RGB image: `height` rows of `width` pixels from `rgb` (a band
+// of a picture sent in bands is converted in place, not copied out).
+struct RgbRows {
+  const std::uint16_t* rgb;
+  int width, height, bit_depth;
+};
+
+RgbRows rows_of(const Image& img, int first_row, int rows) {
+  return {img.rgb.data() + 3 * static_cast<std::size_t>(img.width) * static_cast<std::size_t>(first_row),
+          img.width, rows, img.bit_depth};
+}
+
 template <int Shift, class Range, class Planes>
-void rgb_to_yuv420_rows(const Image& src, const Planes& dst) {
+void rgb_to_yuv420_rows(const RgbRows& src, const Planes& dst) {
   const int w = src.width, h = src.height;
   auto luma = [](const std::uint16_t* p) { return Range::y(p[0] >> Shift, p[1] >> Shift, p[2] >> Shift); };
   for (int y0 = 0; y0 < h; y0 += 2) {
     const bool two_rows = y0 + 1 < h;
-    const std::uint16_t* r0 = src.rgb.data() + 3 * static_cast<std::size_t>(y0) * w;
+    const std::uint16_t* r0 = src.rgb + 3 * static_cast<std::size_t>(y0) * w;
     const std::uint16_t* r1 = two_rows ? r0 + 3 * static_cast<std::size_t>(w) : r0;
     auto* y0p = dst.y + static_cast<std::size_t>(y0) * dst.y_stride;
     for (int x = 0; x < w; ++x) y0p[x] = luma(r0 + 3 * x);
@@ -283,7 +295,9 @@ Image i420_to_rgb(const I420View& src) {
 
 }  // namespace
 
-void rgb_to_i420(const Image& src, const I420Planes& dst, ColorRange range) {
+namespace {
+
+void to_i420(const RgbRows& src, const I420Planes& dst, ColorRange range) {
   const bool wide = src.bit_depth == 16;
   if (range == ColorRange::kFull) {
     wide ? rgb_to_yuv420_rows<8, FullRange>(src, dst) : rgb_to_yuv420_rows<0, FullRange>(src, dst);
@@ -292,10 +306,18 @@ void rgb_to_i420(const Image& src, const I420Planes& dst, ColorRange range) {
   }
 }
 
-void rgb_to_i010(const Image& src, const I010Planes& dst) {
+void to_i010(const RgbRows& src, const I010Planes& dst) {
   src.bit_depth == 16 ? rgb_to_yuv420_rows<8, FullRange10>(src, dst)
                        : rgb_to_yuv420_rows<0, FullRange10>(src, dst);
 }
+
+}  // namespace
+
+void rgb_to_i420(const Image& src, const I420Planes& dst, ColorRange range) {
+  to_i420(rows_of(src, 0, src.height), dst, range);
+}
+
+void rgb_to_i010(const Image& src, const I010Planes& dst) { to_i010(rows_of(src, 0, src.height), dst); }
 
 int video_encoder_threads(int width, int height, int cores, int bit_depth) {
   const long long pixels = static_cast<long long>(std::max(0, width)) * std::max(0, height);
@@ -309,6 +331,15 @@ int video_encoder_speed(VideoCodec codec, int width, int height) {
   const long long pixels = static_cast<long long>(std::max(0, width)) * std::max(0, height);
   return pixels <= (1LL << 19) ? 5 : pixels <= (1LL << 21) ? 6 : 8;
 }
+
+namespace {
+
+// A band's share of the stream's bitrate: its share of the rows.
+int band_kbps(int kbps, int rows, int height) {
+  return std::max(1, static_cast<int>(static_cast<long long>(kbps) * rows / height));
+}
+
+}  // namespace
 
 int video_band_rows(int height, int bands, int index) {
   BEAMCAST_CHECK(bands >= 1 && index >= 0 && index < bands, "video_band_rows: no such band");
@@ -517,8 +548,7 @@ VideoEncoder::VideoEncoder(const VideoEncoderSettings& settings)
     for (int i = 0; i < settings_.bands; ++i) {
       VideoEncoderSettings band = settings_;
       band.height = video_band_rows(settings.height, settings_.bands, i);
-      band.bitrate_kbps = std::max(1, static_cast<int>(static_cast<long long>(settings.bitrate_kbps) *
-                                                       band.height / settings.height));
+      band.bitrate_kbps = band_kbps(settings.bitrate_kbps, band.height, settings.height);
       band.threads = threads;
       band.max_encode_ms = 0.0;  // this encoder adapts the speed of all bands
       band.bands = 1;
@@ -583,8 +613,7 @@ VideoEncoder::~VideoEncoder() = default;
 void VideoEncoder::set_bitrate(int kbps) {
   if (kbps == settings_.bitrate_kbps) return;
   for (auto& band : bands_) {
-    band->set_bitrate(std::max(1, static_cast<int>(static_cast<long long>(kbps) * band->settings_.height /
-                                                   settings_.height)));
+    band->set_bitrate(band_kbps(kbps, band->settings_.height, settings_.height));
   }
   if (!bands_.empty()) {
     settings_.bitrate_kbps = kbps;
@@ -653,30 +682,22 @@ void VideoEncoder::reopen_av1_8bit(int speed) {
   for (auto& band : bands_) band->reopen_av1_8bit(speed);
 }
 
-// Each band's rows copied out and encoded by its own encoder, bands 1.. on
-// threads of their own beside band 0 on this one; every band is a key frame
-// when one is.
+// Each band encoded by its own encoder from its rows of `img` (converted in
+// place), bands 1.. on threads of their own beside band 0 on this one; every
+// band is a key frame when one is.
 EncodedVideoFrame VideoEncoder::encode_bands(const Image& img, bool key, double time_ms) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = bands_.size();
-  std::vector<Image> parts(n);
-  std::size_t offset = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const int rows = bands_[i]->settings_.height;
-    const std::size_t count = 3 * static_cast<std::size_t>(img.width) * static_cast<std::size_t>(rows);
-    parts[i] = Image{.width = img.width, .height = rows, .bit_depth = img.bit_depth,
-                     .rgb = std::vector<std::uint16_t>(img.rgb.begin() + static_cast<std::ptrdiff_t>(offset),
-                                                       img.rgb.begin() + static_cast<std::ptrdiff_t>(offset + count))};
-    offset += count;
-  }
+  std::vector<int> first_rows(n, 0);
+  for (std::size_t i = 1; i < n; ++i) first_rows[i] = first_rows[i - 1] + bands_[i - 1]->settings_.height;
   std::vector<std::future<EncodedVideoFrame>> others;
   for (std::size_t i = 1; i < n; ++i) {
-    others.push_back(std::async(std::launch::async, [this, &parts, i, key, time_ms] {
-      return bands_[i]->encode(parts[i], time_ms, key);
+    others.push_back(std::async(std::launch::async, [this, &img, &first_rows, i, key, time_ms] {
+      return bands_[i]->encode_rows(img, first_rows[i], time_ms, key);
     }));
   }
   std::vector<EncodedVideoFrame> frames;
-  frames.push_back(bands_[0]->encode(parts[0], time_ms, key));
+  frames.push_back(bands_[0]->encode_rows(img, 0, time_ms, key));
   for (auto& f : others) frames.push_back(f.get());
   EncodedVideoFrame out;
   out.key = key;
@@ -693,6 +714,14 @@ EncodedVideoFrame VideoEncoder::encode_bands(const Image& img, bool key, double 
 EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool force_key) {
   BEAMCAST_CHECK(img.width == settings_.width && img.height == settings_.height,
                  "VideoEncoder::encode: frame size differs from the encoder's");
+  return encode_rows(img, 0, time_ms, force_key);
+}
+
+// The encoder's picture from rows first_row.. of `img` (a band's encoder
+// reads its band of the whole picture; other encoders start at row 0).
+EncodedVideoFrame VideoEncoder::encode_rows(const Image& img, int first_row, double time_ms, bool force_key) {
+  BEAMCAST_CHECK(img.width == settings_.width && first_row >= 0 && first_row + settings_.height <= img.height,
+                 "VideoEncoder::encode: the band is outside the frame");
   const bool av1 = settings_.codec == VideoCodec::kAv1;
   if (!bands_.empty()) {
     const bool key = force_key || frames_ == 0 || key_next_;
@@ -707,12 +736,13 @@ EncodedVideoFrame VideoEncoder::encode(const Image& img, double time_ms, bool fo
   const auto t0 = std::chrono::steady_clock::now();
   BEAMCAST_CHECK(!av1 || impl_->aopen, "VideoEncoder: the AV1 encoder failed to reopen at 8 bits");
   // The encoder's picture says its range (set where the encoder opened).
+  const RgbRows rows = rows_of(img, first_row, settings_.height);
   if (av1 && settings_.bit_depth == 10) {
-    rgb_to_i010(img, i010_planes(*impl_->aimg));
+    to_i010(rows, i010_planes(*impl_->aimg));
   } else if (av1) {
-    rgb_to_i420(img, i420_planes(*impl_->aimg), color_range(*impl_->aimg));
+    to_i420(rows, i420_planes(*impl_->aimg), color_range(*impl_->aimg));
   } else {
-    rgb_to_i420(img, i420_planes(*impl_->img), color_range(*impl_->img));
+    to_i420(rows, i420_planes(*impl_->img), color_range(*impl_->img));
   }
   // The frame lasts until the next one; the first gets a 30 frames/s share.
   const double gap = frames_ == 0 ? 33.0 : time_ms - last_ms_;

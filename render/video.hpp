@@ -206,6 +206,7 @@ class VideoEncoder {
   void adapt_speed(double encode_ms);
   void set_av1_speed_all(int speed);
   void reopen_av1_8bit(int speed);
+  EncodedVideoFrame encode_rows(const Image& img, int first_row, double time_ms, bool force_key);
   EncodedVideoFrame encode_bands(const Image& img, bool key, double time_ms);
 };
 
