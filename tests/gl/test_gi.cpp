@@ -433,9 +433,9 @@ TEST(Gi, AShadowsOutlineStaysWhereTheOccluderPutsIt) {
 // edges and the floor's corners): the 4 x 4 rule's error for this geometry
 // peaks at 3.0e-3 straight under the light, so 4e-3; a cosine or area factor
 // wrong would be off by 10% or more. (The 200 x 200 sum per pixel took 46 s
-// of the sanitizer build's test time; the closed form takes none.) This checks every pixel with
-// every point (gi.direct_interleave 1); the interleaved default is checked
-// against the same rule after it.
+// of the sanitizer build's test time; the closed form takes none.) This
+// checks every pixel with every point (gi.direct_interleave 1); the
+// interleaved default is checked against the same rule after it.
 TEST(Gi, DirectLightOfAQuadLightMatchesItsIntegral) {
   constexpr double kRho = 0.7, kRadiance = 3.0, kSide = 0.4, kHeight = 1.0;
   json j = {
