@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The clang-tidy stage of scripts/test.sh: clang-tidy-14 (.clang-tidy) over
 every translation unit of build/compile_commands.json in the given folders,
-one process per core, the slowest files first.
+one process per core this process may use (as nproc counts), the slowest
+files first.
 
 run-clang-tidy-14 does the same from a Python set, whose order changes from
 run to run (string hashing is seeded per process): when the slowest file
@@ -58,7 +59,8 @@ def main():
         return path, r.returncode, r.stdout
 
     failed = []
-    with open(log_path, "w") as log, concurrent.futures.ThreadPoolExecutor(os.cpu_count()) as pool:
+    cores = len(os.sched_getaffinity(0))
+    with open(log_path, "w") as log, concurrent.futures.ThreadPoolExecutor(cores) as pool:
         for path, rc, out in pool.map(tidy, files):
             log.write(f"== {os.path.relpath(path, root)} (exit {rc})\n{out}")
             if rc != 0:
