@@ -1,5 +1,5 @@
-# beamcast_pch(TARGET SET...): precompiled headers for TARGET's own files, in
-# the builds that clang-14 compiles (the sanitizer and fuzz presets). Each SET
+# beamcast_pch(TARGET GROUP...): precompiled headers for TARGET's own files, in
+# the builds that clang-14 compiles (the sanitizer and fuzz presets). Each GROUP
 # names a list of headers below; CMake builds one header per target and
 # force-includes it in each of the target's files.
 #
@@ -34,8 +34,11 @@ function(beamcast_pch target)
     return()
   endif()
   set(headers)
-  foreach(set IN LISTS ARGN)
-    list(APPEND headers ${BEAMCAST_PCH_${set}})
+  foreach(group IN LISTS ARGN)
+    if(NOT DEFINED BEAMCAST_PCH_${group})
+      message(FATAL_ERROR "beamcast_pch(${target}): no header group ${group}")
+    endif()
+    list(APPEND headers ${BEAMCAST_PCH_${group}})
   endforeach()
   target_precompile_headers(${target} PRIVATE ${headers})
 endfunction()
